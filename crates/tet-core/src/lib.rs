@@ -1,0 +1,36 @@
+//! # tet-core
+//!
+//! The data model of a constrained Delaunay tetrahedralization (CDT) used as a
+//! ray-tracing acceleration structure: a ray walks from tetrahedron to
+//! neighbour until it crosses a *constrained face*, i.e. a face lying on a
+//! scene triangle.
+//!
+//! * [`TetMesh`] is the canonical, validated mesh every other crate builds on.
+//! * [`Link`] is the 32-bit neighbour reference shared by every layout: a
+//!   neighbour tet, the mesh boundary, or (flag bit set) an index into the
+//!   cold constrained-face table.
+//! * [`synthetic`] generates valid meshes without an external mesher (for tests,
+//!   fuzzing and benchmarks).
+//!
+//! Conventions (used by every layout and kernel):
+//! * tet `t` has vertices `tets[t] = [v0, v1, v2, v3]`, positively oriented:
+//!   `orient3d(v0, v1, v2, v3) > 0`, i.e. `((v1-v0) × (v2-v0)) · (v3-v0) > 0`;
+//! * face `k` of a tet is the face opposite vertex `k`, and neighbour `k` is the
+//!   tet across face `k`;
+//! * [`FACE_VERTICES`]`[k]` lists face `k`'s vertex slots in the order whose
+//!   right-hand normal points out of the tet.
+
+#![deny(missing_docs)]
+
+pub mod error;
+pub mod link;
+pub mod mesh;
+pub mod predicates;
+pub mod synthetic;
+mod validate;
+
+pub use error::MeshError;
+pub use link::{Link, LinkKind, MAX_TETS};
+pub use mesh::{
+    Attributes, ConstrainedFace, FACE_VERTICES, FaceSide, NO_TET, TetMesh, face_key,
+};
