@@ -23,9 +23,16 @@
 #![deny(missing_docs)]
 
 pub mod error;
+pub mod format;
+pub mod hilbert;
+pub mod layout;
 pub mod link;
+pub mod memory;
 pub mod mesh;
 pub mod predicates;
+pub mod regions;
+pub mod reorder;
+pub mod scene;
 pub mod synthetic;
 mod validate;
 
