@@ -1,1 +1,42 @@
-fn main() {}
+//! `tet-bench`: the user-facing command-line tool and benchmark harness.
+//! See the README for every subcommand and the `--json` schema.
+
+mod build;
+mod cli;
+mod info;
+mod load;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+use cli::{Cli, Command};
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::TetgenWorker => return tetgen_worker(),
+        Command::Build(a) => build::run(a, cli.json),
+        Command::Info(a) => info::run(a, cli.json),
+        Command::Render(_) | Command::Accuracy(_) | Command::Tables(_) => {
+            Err(anyhow::anyhow!("not available in this build"))
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(feature = "tetgen")]
+fn tetgen_worker() -> ExitCode {
+    ExitCode::from(tet_build::tetgen::worker::serve_stdio().clamp(0, 255) as u8)
+}
+
+#[cfg(not(feature = "tetgen"))]
+fn tetgen_worker() -> ExitCode {
+    eprintln!("error: built without the `tetgen` feature");
+    ExitCode::FAILURE
+}

@@ -1,1 +1,432 @@
-//! (being written)
+//! Exact self-intersection detection for triangle scenes.
+//!
+//! A constrained tetrahedralization needs its input triangles to meet only in
+//! shared vertices and shared edges. This module reports every pair of
+//! triangles (by input index) that meets anywhere else.
+//!
+//! * **Broad phase**: a uniform grid over the scene bounds; each triangle is
+//!   entered into the cells its bounding box overlaps; a candidate pair is
+//!   tested only in the cell holding the lower corner of the overlap of the
+//!   two bounding boxes, so each pair is tested once without a hash set.
+//! * **Narrow phase**, exact (`orient3d`/`orient2d` from `robust`), on
+//!   closed triangles. Vertices are "shared" when their positions are
+//!   exactly equal.
+//!   - no shared vertex: the triangles meet iff an edge of one meets the
+//!     other (closed segment–triangle tests, coplanar case in 2-D);
+//!   - one shared vertex `v`, `A = (v, a1, a2)`, `B = (v, b1, b2)`: they meet
+//!     beyond `v` iff segment `a1a2` meets `B` or `b1b2` meets `A` (the
+//!     common part of the two triangles is star-shaped from `v`, so it
+//!     reaches beyond `v` only by crossing an opposite edge);
+//!   - a shared edge `uw`, `A = (u, w, a)`, `B = (u, w, b)`: if not coplanar
+//!     they meet only along `uw`; if coplanar they overlap iff `a` and `b`
+//!     lie on the same side of `uw`;
+//!   - three shared vertices: a duplicate.
+//! * Exactly degenerate (collinear) triangles are skipped and listed
+//!   separately; [`crate::clean`] removes them.
+
+use glam::{DVec3, Vec3};
+use robust::{Coord, Coord3D};
+
+/// How two triangles meet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum IntersectionKind {
+    /// Not coplanar, and they meet beyond their shared vertices/edge
+    /// (crossing, or touching at a point that is not a shared vertex).
+    Transversal,
+    /// Coplanar and overlapping beyond their shared part.
+    Coplanar,
+    /// Same three vertex positions.
+    Duplicate,
+}
+
+/// A reported pair of triangles, `first < second` (input indices).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct IntersectingPair {
+    /// Lower triangle index.
+    pub first: u32,
+    /// Higher triangle index.
+    pub second: u32,
+    /// How they meet.
+    pub kind: IntersectionKind,
+}
+
+/// Result of [`find_self_intersections`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct IntersectionReport {
+    /// Offending pairs, sorted by `(first, second)`.
+    pub pairs: Vec<IntersectingPair>,
+    /// Triangles skipped because their vertices are exactly collinear.
+    pub degenerate: Vec<u32>,
+    /// Number of candidate pairs the broad phase passed to exact tests.
+    pub candidates: u64,
+}
+
+impl IntersectionReport {
+    /// True when no pair intersects.
+    pub fn is_clean(&self) -> bool {
+        self.pairs.is_empty()
+    }
+}
+
+fn c3(p: DVec3) -> Coord3D<f64> {
+    Coord3D {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+    }
+}
+
+/// Exact orientation sign of `d` relative to plane `abc` (−1, 0, +1; the
+/// sign convention only needs to be consistent within this module).
+fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> i8 {
+    let o = robust::orient3d(c3(a), c3(b), c3(c), c3(d));
+    (o > 0.0) as i8 - (o < 0.0) as i8
+}
+
+type P2 = (f64, f64);
+
+fn orient2(a: P2, b: P2, c: P2) -> i8 {
+    let o = robust::orient2d(
+        Coord { x: a.0, y: a.1 },
+        Coord { x: b.0, y: b.1 },
+        Coord { x: c.0, y: c.1 },
+    );
+    (o > 0.0) as i8 - (o < 0.0) as i8
+}
+
+/// Drop the coordinate `axis` (0 = x, 1 = y, 2 = z).
+fn project(p: DVec3, axis: usize) -> P2 {
+    match axis {
+        0 => (p.y, p.z),
+        1 => (p.z, p.x),
+        _ => (p.x, p.y),
+    }
+}
+
+/// A projection axis along which triangle `t` stays non-degenerate.
+fn projection_axis(t: &[DVec3; 3]) -> Option<usize> {
+    (0..3)
+        .rev()
+        .find(|&ax| orient2(project(t[0], ax), project(t[1], ax), project(t[2], ax)) != 0)
+}
+
+/// Exact 3-D collinearity of three points.
+fn degenerate(t: &[DVec3; 3]) -> bool {
+    projection_axis(t).is_none()
+}
+
+fn on_segment_2d(p: P2, a: P2, b: P2) -> bool {
+    // p collinear with ab assumed.
+    p.0 >= a.0.min(b.0) && p.0 <= a.0.max(b.0) && p.1 >= a.1.min(b.1) && p.1 <= a.1.max(b.1)
+}
+
+/// Closed 2-D segment–segment intersection.
+fn segments_meet_2d(p: P2, q: P2, a: P2, b: P2) -> bool {
+    let o1 = orient2(p, q, a);
+    let o2 = orient2(p, q, b);
+    let o3 = orient2(a, b, p);
+    let o4 = orient2(a, b, q);
+    if o1 * o2 < 0 && o3 * o4 < 0 {
+        return true;
+    }
+    (o1 == 0 && on_segment_2d(a, p, q))
+        || (o2 == 0 && on_segment_2d(b, p, q))
+        || (o3 == 0 && on_segment_2d(p, a, b))
+        || (o4 == 0 && on_segment_2d(q, a, b))
+}
+
+/// Closed 2-D point-in-triangle (triangle non-degenerate).
+fn point_in_triangle_2d(p: P2, a: P2, b: P2, c: P2) -> bool {
+    let s = orient2(a, b, c);
+    orient2(a, b, p) * s >= 0 && orient2(b, c, p) * s >= 0 && orient2(c, a, p) * s >= 0
+}
+
+/// Closed segment `pq` against closed non-degenerate triangle `t`, exact.
+fn segment_meets_triangle(p: DVec3, q: DVec3, t: &[DVec3; 3], axis: usize) -> bool {
+    let [a, b, c] = *t;
+    let op = orient(a, b, c, p);
+    let oq = orient(a, b, c, q);
+    if op * oq > 0 {
+        return false;
+    }
+    if op == 0 && oq == 0 {
+        // Coplanar: 2-D test in a projection where the triangle is non-degenerate.
+        let (p2, q2) = (project(p, axis), project(q, axis));
+        let (a2, b2, c2) = (project(a, axis), project(b, axis), project(c, axis));
+        return point_in_triangle_2d(p2, a2, b2, c2)
+            || point_in_triangle_2d(q2, a2, b2, c2)
+            || segments_meet_2d(p2, q2, a2, b2)
+            || segments_meet_2d(p2, q2, b2, c2)
+            || segments_meet_2d(p2, q2, c2, a2);
+    }
+    // The line pq crosses the plane at one point inside [p, q]; it lies in
+    // the closed triangle iff the line does not pass strictly outside any edge.
+    let s1 = orient(p, q, a, b);
+    let s2 = orient(p, q, b, c);
+    let s3 = orient(p, q, c, a);
+    !((s1 > 0 || s2 > 0 || s3 > 0) && (s1 < 0 || s2 < 0 || s3 < 0))
+}
+
+/// Do closed triangles `a` and `b` (no shared vertex) meet?
+fn triangles_meet(a: &[DVec3; 3], ax: usize, b: &[DVec3; 3], bx: usize) -> bool {
+    // Quick plane separation tests.
+    let sb: [i8; 3] = std::array::from_fn(|i| orient(a[0], a[1], a[2], b[i]));
+    if (sb[0] > 0 && sb[1] > 0 && sb[2] > 0) || (sb[0] < 0 && sb[1] < 0 && sb[2] < 0) {
+        return false;
+    }
+    let sa: [i8; 3] = std::array::from_fn(|i| orient(b[0], b[1], b[2], a[i]));
+    if (sa[0] > 0 && sa[1] > 0 && sa[2] > 0) || (sa[0] < 0 && sa[1] < 0 && sa[2] < 0) {
+        return false;
+    }
+    (0..3).any(|i| segment_meets_triangle(a[i], a[(i + 1) % 3], b, bx))
+        || (0..3).any(|i| segment_meets_triangle(b[i], b[(i + 1) % 3], a, ax))
+}
+
+fn coplanar(a: &[DVec3; 3], b: &[DVec3; 3]) -> bool {
+    (0..3).all(|i| orient(a[0], a[1], a[2], b[i]) == 0)
+}
+
+/// Exact test of one pair: `None` when they meet only in shared vertices or
+/// a shared edge (or not at all). Both triangles must be non-degenerate.
+pub fn classify_pair(a: [Vec3; 3], b: [Vec3; 3]) -> Option<IntersectionKind> {
+    let a = a.map(|p| p.as_dvec3());
+    let b = b.map(|p| p.as_dvec3());
+    let (ax, bx) = (projection_axis(&a)?, projection_axis(&b)?);
+    classify(&a, ax, &b, bx)
+}
+
+fn classify(a: &[DVec3; 3], ax: usize, b: &[DVec3; 3], bx: usize) -> Option<IntersectionKind> {
+    // Shared corners: (slot in a, slot in b).
+    let mut shared = [(0usize, 0usize); 3];
+    let mut n = 0;
+    for (i, pa) in a.iter().enumerate() {
+        for (j, pb) in b.iter().enumerate() {
+            if pa == pb {
+                if n < 3 {
+                    shared[n] = (i, j);
+                }
+                n += 1;
+            }
+        }
+    }
+    let kind = || {
+        if coplanar(a, b) {
+            IntersectionKind::Coplanar
+        } else {
+            IntersectionKind::Transversal
+        }
+    };
+    match n {
+        0 => triangles_meet(a, ax, b, bx).then(kind),
+        1 => {
+            let (i, j) = shared[0];
+            let (a1, a2) = (a[(i + 1) % 3], a[(i + 2) % 3]);
+            let (b1, b2) = (b[(j + 1) % 3], b[(j + 2) % 3]);
+            (segment_meets_triangle(a1, a2, b, bx) || segment_meets_triangle(b1, b2, a, ax))
+                .then(kind)
+        }
+        2 => {
+            let (i0, j0) = shared[0];
+            let (i1, _) = shared[1];
+            let ia = 3 - i0 - i1;
+            let jb = (0..3)
+                .find(|&j| a[i0] != b[j] && a[i1] != b[j])
+                .unwrap_or(j0);
+            let (u, w, pa, pb) = (a[i0], a[i1], a[ia], b[jb]);
+            if orient(u, w, pa, pb) != 0 {
+                return None; // planes meet only along the shared edge
+            }
+            let (u2, w2) = (project(u, ax), project(w, ax));
+            let sa = orient2(u2, w2, project(pa, ax));
+            let sb = orient2(u2, w2, project(pb, ax));
+            (sa * sb > 0).then_some(IntersectionKind::Coplanar)
+        }
+        _ => Some(IntersectionKind::Duplicate),
+    }
+}
+
+/// Find all pairs of triangles that meet beyond shared vertices/edges.
+///
+/// Indices out of range or non-finite coordinates make the affected
+/// triangles count as degenerate (run [`crate::clean::clean`] first for
+/// typed errors).
+pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> IntersectionReport {
+    let mut report = IntersectionReport::default();
+    let n = triangles.len();
+    let mut tris: Vec<[DVec3; 3]> = Vec::with_capacity(n);
+    let mut axes: Vec<u8> = Vec::with_capacity(n);
+    let mut live: Vec<u32> = Vec::with_capacity(n);
+    for (t, tri) in triangles.iter().enumerate() {
+        let ok = tri
+            .iter()
+            .all(|&v| (v as usize) < vertices.len() && vertices[v as usize].is_finite());
+        let pts = if ok {
+            tri.map(|v| vertices[v as usize].as_dvec3())
+        } else {
+            [DVec3::ZERO; 3]
+        };
+        let axis = if ok { projection_axis(&pts) } else { None };
+        match axis {
+            Some(ax) => {
+                axes.push(ax as u8);
+                live.push(t as u32);
+            }
+            None => {
+                axes.push(u8::MAX);
+                report.degenerate.push(t as u32);
+            }
+        }
+        tris.push(pts);
+    }
+    if live.len() < 2 {
+        return report;
+    }
+    let bb = |t: usize| {
+        let [a, b, c] = tris[t];
+        (a.min(b).min(c), a.max(b).max(c))
+    };
+    let (mut lo, mut hi) = bb(live[0] as usize);
+    let mut mean_extent = 0.0;
+    for &t in &live {
+        let (l, h) = bb(t as usize);
+        lo = lo.min(l);
+        hi = hi.max(h);
+        mean_extent += (h - l).max_element();
+    }
+    mean_extent /= live.len() as f64;
+    let extent = (hi - lo).max(DVec3::splat(1e-30));
+    // Cell size: about twice the mean triangle size, capped at ~4 cells per triangle.
+    let mut cell = (2.0 * mean_extent).max(extent.max_element() * 1e-6);
+    let max_cells = (4 * live.len()).max(64) as f64;
+    while (extent / cell).ceil().element_product() > max_cells {
+        cell *= 1.25;
+    }
+    // Large triangles cover many cells; coarsen until the (cell, triangle)
+    // entry count stays linear in the input.
+    let max_entries = 32 * live.len() + (1 << 16);
+    let (nx, ny, nz, cell) = loop {
+        let dims = (extent / cell).ceil().max(DVec3::ONE);
+        let (nx, ny, nz) = (dims.x as usize, dims.y as usize, dims.z as usize);
+        let index = |v: f64, n: usize| ((v.max(0.0) as usize).min(n - 1)) as u64;
+        let mut total = 0u64;
+        for &t in &live {
+            let (l, h) = bb(t as usize);
+            let (cl, ch) = (((l - lo) / cell).floor(), ((h - lo) / cell).floor());
+            total += (index(ch.x, nx) - index(cl.x, nx) + 1)
+                * (index(ch.y, ny) - index(cl.y, ny) + 1)
+                * (index(ch.z, nz) - index(cl.z, nz) + 1);
+        }
+        if total <= max_entries as u64 || nx * ny * nz == 1 {
+            break (nx, ny, nz, cell);
+        }
+        cell *= 2.0;
+    };
+    let cell_of = |p: DVec3| -> [usize; 3] {
+        let c = ((p - lo) / cell).floor();
+        [
+            (c.x.max(0.0) as usize).min(nx - 1),
+            (c.y.max(0.0) as usize).min(ny - 1),
+            (c.z.max(0.0) as usize).min(nz - 1),
+        ]
+    };
+    // Counting sort of (cell, triangle) entries.
+    let ncells = nx * ny * nz;
+    let mut counts = vec![0u32; ncells + 1];
+    let mut ranges = Vec::with_capacity(live.len());
+    for &t in &live {
+        let (l, h) = bb(t as usize);
+        let (cl, ch) = (cell_of(l), cell_of(h));
+        ranges.push((cl, ch));
+        for z in cl[2]..=ch[2] {
+            for y in cl[1]..=ch[1] {
+                for x in cl[0]..=ch[0] {
+                    counts[(z * ny + y) * nx + x + 1] += 1;
+                }
+            }
+        }
+    }
+    for i in 0..ncells {
+        counts[i + 1] += counts[i];
+    }
+    let mut fill = counts.clone();
+    let mut entries = vec![0u32; counts[ncells] as usize];
+    for (k, &t) in live.iter().enumerate() {
+        let (cl, ch) = ranges[k];
+        for z in cl[2]..=ch[2] {
+            for y in cl[1]..=ch[1] {
+                for x in cl[0]..=ch[0] {
+                    let c = (z * ny + y) * nx + x;
+                    entries[fill[c] as usize] = t;
+                    fill[c] += 1;
+                }
+            }
+        }
+    }
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let c = (z * ny + y) * nx + x;
+                let list = &entries[counts[c] as usize..counts[c + 1] as usize];
+                for (i, &s) in list.iter().enumerate() {
+                    let (sl, sh) = bb(s as usize);
+                    for &t in &list[i + 1..] {
+                        let (tl, th) = bb(t as usize);
+                        if sl.cmpgt(th).any() || tl.cmpgt(sh).any() {
+                            continue;
+                        }
+                        // Test the pair only in the cell of the overlap's lower corner.
+                        if cell_of(sl.max(tl)) != [x, y, z] {
+                            continue;
+                        }
+                        report.candidates += 1;
+                        let (a, b) = (s.min(t) as usize, s.max(t) as usize);
+                        if let Some(kind) =
+                            classify(&tris[a], axes[a] as usize, &tris[b], axes[b] as usize)
+                        {
+                            report.pairs.push(IntersectingPair {
+                                first: a as u32,
+                                second: b as u32,
+                                kind,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+    }
+    report.pairs.sort_unstable_by_key(|p| (p.first, p.second));
+    report
+}
+
+/// Brute-force O(n²) reference of [`find_self_intersections`] (for tests).
+pub fn find_self_intersections_brute_force(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+) -> Vec<IntersectingPair> {
+    let pts: Vec<[DVec3; 3]> = triangles
+        .iter()
+        .map(|t| t.map(|v| vertices[v as usize].as_dvec3()))
+        .collect();
+    let mut out = Vec::new();
+    for i in 0..pts.len() {
+        if degenerate(&pts[i]) {
+            continue;
+        }
+        for j in i + 1..pts.len() {
+            if degenerate(&pts[j]) {
+                continue;
+            }
+            let (ai, aj) = (projection_axis(&pts[i]), projection_axis(&pts[j]));
+            if let (Some(ai), Some(aj)) = (ai, aj)
+                && let Some(kind) = classify(&pts[i], ai, &pts[j], aj)
+            {
+                out.push(IntersectingPair {
+                    first: i as u32,
+                    second: j as u32,
+                    kind,
+                });
+            }
+        }
+    }
+    out
+}

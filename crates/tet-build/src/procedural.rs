@@ -1,1 +1,411 @@
-//! (being written)
+//! Procedural scenes that need no files: the paper's torus-knot scenes and
+//! simple shapes for tests.
+//!
+//! ## The torus knot
+//!
+//! The paper's `torus_knot.obj` is a 3ds Max TorusKnot primitive: a (p, q) =
+//! (2, 3) knot swept by a 12-sided tube over 120 segments (1,440 vertices,
+//! 2,880 triangles). Fitting the file's ring centres gives the centre line
+//! (y up, segment `s`, `t = 2πs/120`, `u = q·t`):
+//!
+//! ```text
+//! ρ(t) = c / (1 − k·sin u),   centre = (ρ·cos(−p·t), ρ·cos u, ρ·sin(−p·t))
+//! c = 0.91555, k = 5/11, tube radius r = 0.40711
+//! ```
+//!
+//! (residual 1e-4 = the file's 4-decimal rounding). Tube side `j` of a ring
+//! sits at angle `90° − 30°·j` from the centre's radial direction (the
+//! centre position projected perpendicular to the tangent `T`), towards
+//! `T × radial`. Against the file, vertex by vertex: mean deviation 2.4e-4,
+//! max 6.8e-4; bounding box equal to 4 decimals
+//! (`tests/procedural.rs`). Triangles are the file's: `(s:j, s+1:j, s+1:j+1)` and
+//! `(s:j, s+1:j+1, s:j+1)` (ring:side), outward winding.
+//!
+//! ## Scene layouts
+//!
+//! "Torus Knots" = 27 knots translated by `{−5, 0, 5}³` (x outermost, z
+//! innermost, as in `scenes.json`); "Torus Knots in a Box" = the box object
+//! (box.obj, `[-10,10]³`, scaled by `(−2.1, −1.1, −2.1)`, i.e. mirrored and
+//! facing inward) followed by the 27 knots. Camera and light are the
+//! `scenes.json` values transcribed as constants.
+
+use glam::{DVec3, Vec3};
+use tet_core::scene::{Camera, PointLight};
+
+use crate::scene::{MeshData, ObjectPlacement, Scene, Transform, orbit_camera};
+
+/// Names accepted by [`by_name`].
+pub const NAMES: &[&str] = &[
+    "torus-knot",
+    "torus-knots",
+    "torus-knots-box",
+    "cube",
+    "tetrahedron",
+    "sphere",
+    "two-quads",
+    "thin-slab",
+];
+
+/// Build a procedural scene by name (see [`NAMES`]).
+pub fn by_name(name: &str) -> Option<Scene> {
+    let single = |n: &str, mesh: MeshData| single_object_scene(n, &mesh);
+    Some(match name {
+        "torus-knot" => single("torus-knot", torus_knot(&TorusKnotParams::default())),
+        "torus-knots" => torus_knots(false),
+        "torus-knots-box" => torus_knots(true),
+        "cube" => single("cube", cube(1.0)),
+        "tetrahedron" => single("tetrahedron", tetrahedron()),
+        "sphere" => single("sphere", icosphere(2)),
+        "two-quads" => single("two-quads", two_quads(0.5)),
+        "thin-slab" => single("thin-slab", thin_slab(0.01)),
+        _ => return None,
+    })
+}
+
+fn single_object_scene(name: &str, mesh: &MeshData) -> Scene {
+    Scene::from_objects(
+        name,
+        &[ObjectPlacement {
+            name: name.into(),
+            mesh,
+            transform: Transform::IDENTITY,
+            pre_transform: None,
+        }],
+        None,
+        Vec::new(),
+    )
+    .expect("procedural meshes are small and finite")
+}
+
+/// Parameters of the torus-knot tube (defaults: fitted to the paper's file).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TorusKnotParams {
+    /// Turns around the symmetry (y) axis.
+    pub p: u32,
+    /// Turns through the torus hole.
+    pub q: u32,
+    /// Rings along the curve.
+    pub segments: u32,
+    /// Vertices per ring.
+    pub sides: u32,
+    /// Centre-line scale `c`.
+    pub c: f64,
+    /// Centre-line eccentricity `k` (< 1).
+    pub k: f64,
+    /// Tube radius.
+    pub tube_radius: f64,
+}
+
+impl Default for TorusKnotParams {
+    fn default() -> Self {
+        TorusKnotParams {
+            p: 2,
+            q: 3,
+            segments: 120,
+            sides: 12,
+            c: 0.91555,
+            k: 5.0 / 11.0,
+            tube_radius: 0.40711,
+        }
+    }
+}
+
+/// The torus-knot tube: `segments·sides` vertices, `2·segments·sides`
+/// triangles, per-vertex normals (radial from the centre line). Vertex
+/// `s·sides + j` is side `j` of ring `s`.
+pub fn torus_knot(params: &TorusKnotParams) -> MeshData {
+    let TorusKnotParams {
+        p,
+        q,
+        segments,
+        sides,
+        c,
+        k,
+        tube_radius: r,
+    } = *params;
+    let (p, q) = (p as f64, q as f64);
+    let mut positions = Vec::with_capacity((segments * sides) as usize);
+    let mut normals = Vec::with_capacity(positions.capacity());
+    for s in 0..segments {
+        let t = std::f64::consts::TAU * s as f64 / segments as f64;
+        let (u, th) = (q * t, -p * t);
+        let denom = 1.0 - k * u.sin();
+        let rho = c / denom;
+        let drho = c * k * q * u.cos() / (denom * denom);
+        let centre = DVec3::new(rho * th.cos(), rho * u.cos(), rho * th.sin());
+        let tangent = DVec3::new(
+            drho * th.cos() + rho * p * th.sin(),
+            drho * u.cos() - rho * q * u.sin(),
+            drho * th.sin() - rho * p * th.cos(),
+        )
+        .normalize();
+        let radial = (centre - centre.dot(tangent) * tangent).normalize();
+        let binormal = tangent.cross(radial);
+        for j in 0..sides {
+            let phi = std::f64::consts::FRAC_PI_2 - std::f64::consts::TAU * j as f64 / sides as f64;
+            let dir = phi.cos() * radial + phi.sin() * binormal;
+            positions.push((centre + r * dir).as_vec3());
+            normals.push(dir.as_vec3());
+        }
+    }
+    let mut triangles = Vec::with_capacity((2 * segments * sides) as usize);
+    let idx = |s: u32, j: u32| (s % segments) * sides + (j % sides);
+    for s in 0..segments {
+        for j in 0..sides {
+            let (a, b, c2, d) = (idx(s, j), idx(s + 1, j), idx(s + 1, j + 1), idx(s, j + 1));
+            triangles.push([a, b, c2]);
+            triangles.push([a, c2, d]);
+        }
+    }
+    MeshData::single_index(positions, triangles, Some(normals))
+}
+
+/// The 27 grid translations of the "Torus Knots" scene (x outermost).
+pub fn torus_knot_grid() -> Vec<DVec3> {
+    let steps = [-5.0, 0.0, 5.0];
+    let mut out = Vec::with_capacity(27);
+    for x in steps {
+        for y in steps {
+            for z in steps {
+                out.push(DVec3::new(x, y, z));
+            }
+        }
+    }
+    out
+}
+
+/// The box object of the "in a Box" scenes: box.obj (`[-10,10]³`, outward
+/// winding, one normal per face), vertex and face order as in the file.
+pub fn neptun_box() -> MeshData {
+    let positions = [
+        [-10.0, -10.0, 10.0],
+        [-10.0, -10.0, -10.0],
+        [10.0, -10.0, -10.0],
+        [10.0, -10.0, 10.0],
+        [-10.0, 10.0, 10.0],
+        [10.0, 10.0, 10.0],
+        [10.0, 10.0, -10.0],
+        [-10.0, 10.0, -10.0],
+    ]
+    .map(Vec3::from_array)
+    .to_vec();
+    let normals = [
+        [0.0, -1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, -1.0],
+        [-1.0, 0.0, 0.0],
+    ]
+    .map(Vec3::from_array)
+    .to_vec();
+    let faces: [[u32; 3]; 12] = [
+        [1, 2, 3],
+        [3, 4, 1],
+        [5, 6, 7],
+        [7, 8, 5],
+        [1, 4, 6],
+        [6, 5, 1],
+        [4, 3, 7],
+        [7, 6, 4],
+        [3, 2, 8],
+        [8, 7, 3],
+        [2, 1, 5],
+        [5, 8, 2],
+    ];
+    let triangles: Vec<[u32; 3]> = faces.iter().map(|f| f.map(|i| i - 1)).collect();
+    let normal_idx: Vec<[u32; 3]> = (0..12u32).map(|t| [t / 2; 3]).collect();
+    MeshData {
+        positions,
+        triangles,
+        normals: Some((normals, normal_idx)),
+        uvs: None,
+    }
+}
+
+/// Scale of the box object in "Torus Knots in a Box" (`scenes.json`).
+pub const TORUS_KNOTS_BOX_SCALE: [f64; 3] = [-2.1, -1.1, -2.1];
+
+/// Camera of the torus-knot scenes: orbit (0.5, 1.0) rad, distance 20,
+/// target at the origin (`scenes.json`).
+pub fn torus_knots_camera() -> Camera {
+    orbit_camera(0.5, 1.0, 20.0, DVec3::ZERO)
+}
+
+/// Light of the torus-knot scenes: white point light at (6, 10, 8).
+pub fn torus_knots_light() -> PointLight {
+    PointLight {
+        position: Vec3::new(6.0, 10.0, 8.0),
+        color: Vec3::ONE,
+        intensity: 1.0,
+    }
+}
+
+fn torus_knots(with_box: bool) -> Scene {
+    let knot = torus_knot(&TorusKnotParams::default());
+    let boxm = neptun_box();
+    let mut placed = Vec::new();
+    if with_box {
+        placed.push(ObjectPlacement {
+            name: "box".into(),
+            mesh: &boxm,
+            transform: Transform {
+                scale: DVec3::from_array(TORUS_KNOTS_BOX_SCALE),
+                ..Transform::IDENTITY
+            },
+            pre_transform: None,
+        });
+    }
+    for t in torus_knot_grid() {
+        placed.push(ObjectPlacement {
+            name: "Torus Knot".into(),
+            mesh: &knot,
+            transform: Transform::translate(t),
+            pre_transform: None,
+        });
+    }
+    let name = if with_box {
+        "Torus Knots in a Box"
+    } else {
+        "Torus Knots"
+    };
+    Scene::from_objects(
+        name,
+        &placed,
+        Some(torus_knots_camera()),
+        vec![torus_knots_light()],
+    )
+    .expect("procedural meshes are small and finite")
+}
+
+/// Axis-aligned cube `[-h, h]³`: 8 vertices, 12 outward triangles.
+pub fn cube(h: f32) -> MeshData {
+    box_mesh(Vec3::splat(-h), Vec3::splat(h))
+}
+
+/// Axis-aligned box `[min, max]`: 8 vertices (vertex `i` has x = max when
+/// bit 0 of `i` is set, y when bit 1, z when bit 2), 12 outward triangles.
+pub fn box_mesh(min: Vec3, max: Vec3) -> MeshData {
+    let positions: Vec<Vec3> = (0..8)
+        .map(|i| {
+            Vec3::new(
+                if i & 1 != 0 { max.x } else { min.x },
+                if i & 2 != 0 { max.y } else { min.y },
+                if i & 4 != 0 { max.z } else { min.z },
+            )
+        })
+        .collect();
+    MeshData::single_index(positions, BOX_TRIANGLES.to_vec(), None)
+}
+
+/// Outward triangles of the 8-corner box numbering of [`box_mesh`].
+pub const BOX_TRIANGLES: [[u32; 3]; 12] = [
+    [0, 2, 1],
+    [1, 2, 3], // z = min (normal −z)
+    [4, 5, 6],
+    [5, 7, 6], // z = max
+    [0, 1, 4],
+    [1, 5, 4], // y = min
+    [2, 6, 3],
+    [3, 6, 7], // y = max
+    [0, 4, 2],
+    [2, 4, 6], // x = min
+    [1, 3, 5],
+    [3, 7, 5], // x = max
+];
+
+/// Regular-ish tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1), outward.
+pub fn tetrahedron() -> MeshData {
+    let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+    let triangles = vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+    MeshData::single_index(positions, triangles, None)
+}
+
+/// Unit icosphere: icosahedron subdivided `levels` times and projected onto
+/// the sphere (`10·4^levels + 2` vertices, `20·4^levels` triangles), with
+/// normals = positions.
+pub fn icosphere(levels: u32) -> MeshData {
+    let g = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut pts: Vec<DVec3> = [
+        [-1.0, g, 0.0],
+        [1.0, g, 0.0],
+        [-1.0, -g, 0.0],
+        [1.0, -g, 0.0],
+        [0.0, -1.0, g],
+        [0.0, 1.0, g],
+        [0.0, -1.0, -g],
+        [0.0, 1.0, -g],
+        [g, 0.0, -1.0],
+        [g, 0.0, 1.0],
+        [-g, 0.0, -1.0],
+        [-g, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|a| DVec3::from_array(*a).normalize())
+    .collect();
+    let mut tris: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::with_capacity(tris.len() * 4);
+        let mut midpoint = |a: u32, b: u32, pts: &mut Vec<DVec3>| -> u32 {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                pts.push(((pts[a as usize] + pts[b as usize]) * 0.5).normalize());
+                pts.len() as u32 - 1
+            })
+        };
+        for [a, b, c] in tris {
+            let ab = midpoint(a, b, &mut pts);
+            let bc = midpoint(b, c, &mut pts);
+            let ca = midpoint(c, a, &mut pts);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        tris = next;
+    }
+    let positions: Vec<Vec3> = pts.iter().map(|p| p.as_vec3()).collect();
+    let normals = positions.clone();
+    MeshData::single_index(positions, tris, Some(normals))
+}
+
+/// Two parallel unit squares `[0,1]²` at z = 0 and z = `gap`, both facing +z.
+pub fn two_quads(gap: f32) -> MeshData {
+    let mut positions = Vec::new();
+    for z in [0.0, gap] {
+        positions.extend([
+            Vec3::new(0.0, 0.0, z),
+            Vec3::new(1.0, 0.0, z),
+            Vec3::new(1.0, 1.0, z),
+            Vec3::new(0.0, 1.0, z),
+        ]);
+    }
+    let triangles = vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]];
+    MeshData::single_index(positions, triangles, None)
+}
+
+/// A thin closed slab `[-1,1]² × [-t/2, t/2]` (8 vertices, 12 triangles).
+pub fn thin_slab(thickness: f32) -> MeshData {
+    box_mesh(
+        Vec3::new(-1.0, -1.0, -thickness / 2.0),
+        Vec3::new(1.0, 1.0, thickness / 2.0),
+    )
+}

@@ -1,1 +1,33 @@
-//! placeholder
+//! # tet-trace-cpu
+//!
+//! CPU ray traversal through a constrained tetrahedralization: a ray walks
+//! from the tet containing its origin, neighbour by neighbour, until it
+//! crosses a constrained face (a scene triangle).
+//!
+//! * [`ray`]: [`Ray`], [`Hit`], [`TraceOutcome`] (hit / miss / reported failure);
+//! * [`locate`]: exact point location (seed 000 §4.2);
+//! * [`walk`]: the watertight traversal engine and its projections;
+//! * kernels, one per method: [`sctp`], [`tet32`], [`tet20`], [`tet16`], [`tet80`];
+//! * [`reference`]: f64 brute-force closest hit and ray generators for tests;
+//! * [`render`]: pinhole renderer, Lambert shading, PNG, heat maps, stats;
+//! * [`secondary`]: shadow, reflection and refraction rays (seed 000 §6).
+
+#![deny(missing_docs)]
+
+pub mod kernel;
+pub mod locate;
+pub mod ray;
+pub mod reference;
+pub mod render;
+pub mod sctp;
+pub mod secondary;
+pub mod tet16;
+pub mod tet20;
+pub mod tet32;
+pub mod tet80;
+pub mod walk;
+
+pub use kernel::{Tracer, WalkTracer};
+pub use locate::{LocateError, locate};
+pub use ray::{Failure, Hit, Ray, TraceOutcome};
+pub use walk::{DuffF32, DuffF64, OriginF32, Projection, Start, TripleF32};

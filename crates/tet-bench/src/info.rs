@@ -1,0 +1,216 @@
+//! `tet-bench info`: counts, regions and exact bytes per layout.
+
+use anyhow::Result;
+use serde::Serialize;
+use tet_core::TetMesh;
+use tet_core::memory::MemoryReport;
+use tet_core::regions::{compute_regions, locate_seeds_brute, prune_unreachable};
+
+use crate::cli::InfoArgs;
+use crate::load::{BuildSummary, Loaded, load};
+
+/// Bytes of one layout (JSON `layouts[]`).
+#[derive(Clone, Debug, Serialize)]
+pub struct LayoutBytes {
+    /// `baseline32`, `tet32`, `tet20`, `tet16` or `tet80`.
+    pub name: &'static str,
+    /// Hot data: tet records + point positions read by the walk.
+    pub hot_bytes: usize,
+    /// Cold data: constrained-face table, attributes, anchors, reconstruction data.
+    pub cold_bytes: usize,
+    /// hot + cold.
+    pub total_bytes: usize,
+    /// Tet records.
+    pub tets_bytes: usize,
+    /// Point positions.
+    pub points_bytes: usize,
+    /// Constrained-face table.
+    pub constrained_bytes: usize,
+    /// Optional attributes (normals, UVs, materials), only when present.
+    pub attributes_bytes: usize,
+    /// Start-tet anchors (Tet20/Tet16).
+    pub anchors_bytes: usize,
+    /// Data kept only to decode the layout back (Tet80 vertex ids).
+    pub reconstruction_bytes: usize,
+    /// Hot bytes per tet.
+    pub hot_bytes_per_tet: f64,
+}
+
+/// Region summary (JSON `regions`).
+#[derive(Clone, Debug, Serialize)]
+pub struct RegionSummary {
+    /// Regions bounded by constrained faces.
+    pub count: usize,
+    /// Tets in the largest region.
+    pub largest: u32,
+    /// Tets in the smallest region.
+    pub smallest: u32,
+    /// Single-tet regions.
+    pub singletons: usize,
+    /// Up to ten largest sizes.
+    pub top_sizes: Vec<u32>,
+}
+
+/// Effect of pruning unreachable regions (JSON `pruned`).
+#[derive(Clone, Debug, Serialize)]
+pub struct PruneSummary {
+    /// Regions kept.
+    pub regions_kept: usize,
+    /// Regions removed.
+    pub regions_removed: usize,
+    /// Tets removed.
+    pub tets_removed: usize,
+    /// Points removed.
+    pub points_removed: usize,
+    /// Constrained faces removed.
+    pub constrained_removed: usize,
+    /// Bytes per layout after pruning.
+    pub layouts: Vec<LayoutBytes>,
+}
+
+/// The `info` document.
+#[derive(Clone, Debug, Serialize)]
+pub struct Info {
+    /// Scene or file name.
+    pub name: String,
+    /// Scene triangles referenced by the mesh.
+    pub triangles: u32,
+    /// Points.
+    pub points: usize,
+    /// Tets.
+    pub tets: usize,
+    /// Constrained faces.
+    pub constrained_faces: usize,
+    /// Connected components (Tet20/Tet16 anchors).
+    pub components: usize,
+    /// Regions.
+    pub regions: RegionSummary,
+    /// Bytes per layout.
+    pub layouts: Vec<LayoutBytes>,
+    /// Construction report when built here.
+    pub build: Option<BuildSummary>,
+    /// Pruning report with `--prune`.
+    pub pruned: Option<PruneSummary>,
+}
+
+/// Bytes per layout of a mesh.
+pub fn layout_bytes(mesh: &TetMesh) -> (MemoryReport, Vec<LayoutBytes>) {
+    let report = MemoryReport::for_mesh(mesh);
+    let tets = mesh.tets.len().max(1) as f64;
+    let layouts = report
+        .layouts
+        .iter()
+        .map(|l| LayoutBytes {
+            name: l.name,
+            hot_bytes: l.hot(),
+            cold_bytes: l.cold(),
+            total_bytes: l.total(),
+            tets_bytes: l.tets,
+            points_bytes: l.points,
+            constrained_bytes: l.constrained,
+            attributes_bytes: l.attributes,
+            anchors_bytes: l.anchors,
+            reconstruction_bytes: l.reconstruction,
+            hot_bytes_per_tet: l.hot() as f64 / tets,
+        })
+        .collect();
+    (report, layouts)
+}
+
+/// Computes the `info` document of a loaded mesh.
+pub fn info(loaded: &Loaded, prune: bool) -> Result<Info> {
+    let mesh = &loaded.mesh;
+    let (report, layouts) = layout_bytes(mesh);
+    let r = compute_regions(mesh).report();
+    let pruned = if prune {
+        let mut copy = mesh.clone();
+        let mut points = vec![loaded.camera.position];
+        points.extend(loaded.lights.iter().map(|l| l.position));
+        let seeds = locate_seeds_brute(&copy, &points)?;
+        let p = prune_unreachable(&mut copy, &seeds)?;
+        Some(PruneSummary {
+            regions_kept: p.regions_kept,
+            regions_removed: p.regions_removed,
+            tets_removed: p.tets_removed,
+            points_removed: p.points_removed,
+            constrained_removed: p.constrained_removed,
+            layouts: layout_bytes(&copy).1,
+        })
+    } else {
+        None
+    };
+    Ok(Info {
+        name: loaded.name.clone(),
+        triangles: mesh.triangle_count,
+        points: mesh.points.len(),
+        tets: mesh.tets.len(),
+        constrained_faces: mesh.constrained.len(),
+        components: report.component_count,
+        regions: RegionSummary {
+            count: r.count,
+            largest: r.largest,
+            smallest: r.smallest,
+            singletons: r.singletons,
+            top_sizes: r.top_sizes,
+        },
+        layouts,
+        build: loaded.build.clone(),
+        pruned,
+    })
+}
+
+fn mb(b: usize) -> f64 {
+    b as f64 / 1e6
+}
+
+/// `tet-bench info`.
+pub fn run(args: &InfoArgs, json: bool) -> Result<()> {
+    let loaded = load(&args.scene, &args.build, json)?;
+    let info = info(&loaded, args.prune)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&info)?);
+        return Ok(());
+    }
+    println!("{}", info.name);
+    println!(
+        "  triangles {}  points {}  tets {}  constrained faces {}  components {}",
+        info.triangles, info.points, info.tets, info.constrained_faces, info.components
+    );
+    println!(
+        "  regions {} (largest {} tets, smallest {}, {} single-tet)",
+        info.regions.count, info.regions.largest, info.regions.smallest, info.regions.singletons
+    );
+    if let Some(b) = &info.build {
+        crate::build::print_build(b);
+    }
+    print_layouts(&info.layouts);
+    if let Some(p) = &info.pruned {
+        println!(
+            "  pruned to the camera's and lights' regions: removed {} of {} regions, {} tets, {} points, {} constrained faces",
+            p.regions_removed,
+            p.regions_kept + p.regions_removed,
+            p.tets_removed,
+            p.points_removed,
+            p.constrained_removed
+        );
+        print_layouts(&p.layouts);
+    }
+    Ok(())
+}
+
+fn print_layouts(layouts: &[LayoutBytes]) {
+    println!(
+        "  {:<11} {:>10} {:>10} {:>10} {:>10}",
+        "layout", "hot MB", "cold MB", "total MB", "B/tet hot"
+    );
+    for l in layouts {
+        println!(
+            "  {:<11} {:>10.3} {:>10.3} {:>10.3} {:>10.1}",
+            l.name,
+            mb(l.hot_bytes),
+            mb(l.cold_bytes),
+            mb(l.total_bytes),
+            l.hot_bytes_per_tet
+        );
+    }
+}

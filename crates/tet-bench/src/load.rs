@@ -1,0 +1,216 @@
+//! Resolving a `SCENE|FILE` argument: a mesh file is loaded, a scene is
+//! loaded and built (TetGen in a worker process, killed at the time limit).
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use glam::Vec3;
+use tet_build::scene::Scene;
+use tet_core::TetMesh;
+use tet_core::scene::{Camera, PointLight};
+
+use crate::cli::BuildFlags;
+
+/// File extension of mesh files written by `tet-bench build`.
+pub const MESH_EXTENSION: &str = "tmesh";
+
+/// A mesh ready to trace, with what is known of its scene.
+pub struct Loaded {
+    /// Name for reports.
+    pub name: String,
+    /// The mesh.
+    pub mesh: TetMesh,
+    /// The scene it was built from (absent for mesh files).
+    pub scene: Option<Scene>,
+    /// Camera (the scene's, or one framing the mesh).
+    pub camera: Camera,
+    /// Point lights (the scene's, or one at the camera).
+    pub lights: Vec<PointLight>,
+    /// Construction report when built here.
+    pub build: Option<BuildSummary>,
+}
+
+/// What a build cost.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BuildSummary {
+    /// TetGen switches.
+    pub switches: String,
+    /// Scene triangles after cleaning.
+    pub scene_triangles: usize,
+    /// Steiner points added.
+    pub steiner_points: usize,
+    /// Seconds: cleaning.
+    pub clean_s: f64,
+    /// Seconds: TetGen (including worker start and transfer).
+    pub tetgen_s: f64,
+    /// Seconds: neighbours, constrained faces and validation.
+    pub assemble_s: f64,
+    /// Seconds: Hilbert reordering (0 when skipped).
+    pub reorder_s: f64,
+    /// Seconds: everything.
+    pub total_s: f64,
+    /// Peak resident memory of the TetGen worker, KiB.
+    pub worker_peak_kib: Option<u64>,
+    /// Cleaning: vertices merged, triangles dropped (repeated vertex, zero
+    /// area, duplicate), unused vertices removed.
+    pub cleaning: CleaningSummary,
+}
+
+/// Counts of what cleaning changed.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct CleaningSummary {
+    /// Exactly-equal vertices merged.
+    pub merged_vertices: usize,
+    /// Triangles dropped for a repeated vertex.
+    pub repeated_vertex_triangles: usize,
+    /// Triangles dropped for zero area.
+    pub zero_area_triangles: usize,
+    /// Exact duplicate triangles dropped.
+    pub duplicate_triangles: usize,
+    /// Unused vertices removed.
+    pub unused_vertices: usize,
+}
+
+/// Loads a mesh file, or loads and builds a scene.
+pub fn load(spec: &str, flags: &BuildFlags, quiet: bool) -> Result<Loaded> {
+    let path = Path::new(spec);
+    if path.extension().is_some_and(|e| e == MESH_EXTENSION) {
+        let mesh = tet_core::format::load(path)?;
+        let camera = framing_camera(&mesh);
+        let lights = vec![light_at(camera.position)];
+        return Ok(Loaded {
+            name: path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            mesh,
+            scene: None,
+            camera,
+            lights,
+            build: None,
+        });
+    }
+    let scene = Scene::load(spec).with_context(|| format!("cannot load scene `{spec}`"))?;
+    let (mesh, build) = build_scene(&scene, flags, quiet)?;
+    let camera = scene.camera.unwrap_or_else(|| framing_camera(&mesh));
+    let lights = if scene.lights.is_empty() {
+        vec![light_at(camera.position)]
+    } else {
+        scene.lights.clone()
+    };
+    Ok(Loaded {
+        name: scene.name.clone(),
+        mesh,
+        scene: Some(scene),
+        camera,
+        lights,
+        build: Some(build),
+    })
+}
+
+#[cfg(feature = "tetgen")]
+fn build_scene(scene: &Scene, flags: &BuildFlags, quiet: bool) -> Result<(TetMesh, BuildSummary)> {
+    use std::sync::Arc;
+    use tet_build::bbox::BoxSpec;
+    use tet_build::pipeline::{BuildOptions, build};
+    use tet_build::tetgen::{Isolation, WorkerCommand};
+
+    let start = Instant::now();
+    let spinner = if quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        let pb = indicatif::ProgressBar::new_spinner();
+        pb.enable_steady_tick(Duration::from_millis(120));
+        pb
+    };
+    let pb = spinner.clone();
+    let name = scene.name.clone();
+    let mut options = BuildOptions {
+        isolation: Isolation::Worker(WorkerCommand {
+            program: std::env::current_exe().context("cannot find this executable")?,
+            args: vec!["tetgen-worker".into()],
+            timeout: Some(Duration::from_secs_f64(flags.time_limit.max(0.001))),
+        }),
+        enclosing_box: (!flags.no_box).then(BoxSpec::default),
+        progress: Some(Arc::new(move |p: &tet_build::pipeline::Progress| {
+            pb.set_message(format!("building {name}: {:?}", p.stage));
+        })),
+        ..BuildOptions::default()
+    };
+    options.tetgen.quality = flags.quality;
+    options.tetgen.max_steiner = flags.max_steiner;
+    let (mut mesh, report) = build(scene, &options)
+        .with_context(|| format!("cannot build a tetrahedral mesh of `{}`", scene.name))?;
+    let reorder_start = Instant::now();
+    if !flags.no_sort {
+        spinner.set_message(format!("building {}: Hilbert reordering", scene.name));
+        tet_core::reorder::hilbert_reorder(&mut mesh)?;
+    }
+    let reorder_s = reorder_start.elapsed().as_secs_f64();
+    spinner.finish_and_clear();
+    let t = report.times;
+    let summary = BuildSummary {
+        switches: report.switches.clone(),
+        scene_triangles: report.scene_triangles,
+        steiner_points: report.steiner_points,
+        clean_s: t.clean.as_secs_f64(),
+        tetgen_s: t.tetgen.as_secs_f64(),
+        assemble_s: (t.constrained_faces + t.assemble + t.validate + t.rounding).as_secs_f64(),
+        reorder_s,
+        total_s: start.elapsed().as_secs_f64(),
+        worker_peak_kib: report.worker_peak_memory_kib,
+        cleaning: CleaningSummary {
+            merged_vertices: report.clean.merged_vertices.len(),
+            repeated_vertex_triangles: report.clean.repeated_vertex_triangles.len(),
+            zero_area_triangles: report.clean.zero_area_triangles.len(),
+            duplicate_triangles: report.clean.duplicate_triangles.len(),
+            unused_vertices: report.clean.unused_vertices.len(),
+        },
+    };
+    Ok((mesh, summary))
+}
+
+#[cfg(not(feature = "tetgen"))]
+fn build_scene(scene: &Scene, _: &BuildFlags, _: bool) -> Result<(TetMesh, BuildSummary)> {
+    bail!(
+        "`{}` is a scene, but this tet-bench was built without the `tetgen` feature: \
+         pass a .{MESH_EXTENSION} mesh file instead",
+        scene.name
+    )
+}
+
+/// A camera looking at the mesh's bounding box from +z, framing it.
+pub fn framing_camera(mesh: &TetMesh) -> Camera {
+    let (min, max) = mesh
+        .points
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(*p), b.max(*p)));
+    if !min.is_finite() {
+        return Camera::default();
+    }
+    let center = (min + max) * 0.5;
+    let radius = (max - min).length() * 0.5;
+    Camera {
+        position: center + Vec3::new(0.0, 0.0, radius * 2.6),
+        target: center,
+        up: Vec3::Y,
+        vfov_deg: 45.0,
+    }
+}
+
+fn light_at(position: Vec3) -> PointLight {
+    PointLight {
+        position,
+        color: Vec3::ONE,
+        intensity: 1.0,
+    }
+}
+
+/// Fails with a helpful message when the mesh is empty.
+pub fn require_tets(loaded: &Loaded) -> Result<()> {
+    if loaded.mesh.tets.is_empty() {
+        bail!("`{}` has no tetrahedra", loaded.name);
+    }
+    Ok(())
+}

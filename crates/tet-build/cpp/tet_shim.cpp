@@ -1,0 +1,99 @@
+// tet-build's C ABI shim around TetGen 1.5 (compiled with -DTETLIBRARY, so
+// terminatetetgen() throws an int instead of calling exit()). Every C++
+// exception is caught here: nothing unwinds into Rust.
+#include "tet_shim.h"
+#include "tetgen.h"
+
+#include <cstdio>
+#include <new>
+#include <unistd.h>
+
+namespace {
+struct Result {
+    tetgenio out;
+};
+}
+
+extern "C" int32_t tetshim_tetrahedralize(const double *points, int32_t npoints,
+                                          const int32_t *triangles, const int32_t *markers,
+                                          int32_t ntriangles, const char *switches,
+                                          void **handle, TetShimView *view) {
+    *handle = nullptr;
+    if (npoints < 0 || ntriangles < 0 || points == nullptr ||
+        (ntriangles > 0 && triangles == nullptr)) {
+        return TETSHIM_BAD_INPUT;
+    }
+    Result *res = nullptr;
+    try {
+        tetgenbehavior b;
+        if (!b.parse_commandline(switches)) {
+            return TETSHIM_BAD_SWITCHES;
+        }
+        tetgenio in;
+        in.firstnumber = 0;
+        in.numberofpoints = npoints;
+        in.pointlist = new double[3 * (size_t)npoints];
+        for (size_t i = 0; i < 3 * (size_t)npoints; ++i) in.pointlist[i] = points[i];
+        in.numberoffacets = ntriangles;
+        if (ntriangles > 0) {
+            in.facetlist = new tetgenio::facet[ntriangles];
+            in.facetmarkerlist = new int[ntriangles];
+            for (int32_t t = 0; t < ntriangles; ++t) {
+                tetgenio::facet &f = in.facetlist[t];
+                tetgenio::init(&f);
+                f.numberofpolygons = 1;
+                f.polygonlist = new tetgenio::polygon[1];
+                tetgenio::init(&f.polygonlist[0]);
+                f.polygonlist[0].numberofvertices = 3;
+                f.polygonlist[0].vertexlist = new int[3];
+                for (int k = 0; k < 3; ++k) {
+                    int v = triangles[3 * (size_t)t + k];
+                    if (v < 0 || v >= npoints) return TETSHIM_BAD_INPUT;
+                    f.polygonlist[0].vertexlist[k] = v;
+                }
+                in.facetmarkerlist[t] = markers ? markers[t] : t + 1;
+            }
+        }
+        res = new Result();
+        int status = tetrahedralize(&b, &in, &res->out, nullptr, nullptr);
+        if (status != 0) {
+            delete res;
+            return TETSHIM_FLAT_INPUT;
+        }
+    } catch (int code) {
+        delete res;
+        return code;
+    } catch (std::bad_alloc &) {
+        delete res;
+        return 1;
+    } catch (...) {
+        delete res;
+        return TETSHIM_UNKNOWN_EXCEPTION;
+    }
+    tetgenio &o = res->out;
+    view->npoints = o.numberofpoints;
+    view->points = o.pointlist;
+    view->ntets = o.numberoftetrahedra;
+    view->tets = o.tetrahedronlist;
+    view->neighbors = o.neighborlist;
+    view->nfaces = o.numberoftrifaces;
+    view->faces = o.trifacelist;
+    view->face_markers = o.trifacemarkerlist;
+    *handle = res;
+    return TETSHIM_OK;
+}
+
+extern "C" void tetshim_free(void *handle) {
+    delete static_cast<Result *>(handle);
+}
+
+extern "C" int32_t tetshim_redirect_stdout(void) {
+    fflush(stdout);
+    int saved = dup(1);
+    if (saved < 0) return -1;
+    if (dup2(2, 1) < 0) {
+        close(saved);
+        return -1;
+    }
+    return saved;
+}

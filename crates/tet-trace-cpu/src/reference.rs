@@ -1,0 +1,255 @@
+//! Test support: an f64 brute-force closest hit over every constrained face,
+//! and ray generators (random, aimed at vertices / edge midpoints / face
+//! centroids, axis-aligned).
+//!
+//! The brute force is independent of the walk: it never looks at tets or
+//! links, only at [`TetMesh::constrained`] and [`TetMesh::points`]. Its
+//! ray–triangle test is watertight in the orientation sense: with
+//! `qᵢ = Pᵢ − o`, the edge functions `d · (qᵢ × qⱼ)` are evaluated in f64
+//! (on f32 inputs) and a point on a shared edge counts for both triangles
+//! (closed triangles), so no ray slips through a closed surface; ties between
+//! triangles at equal `t` are reported via [`RefHit::edge_distance`], which
+//! tests use to skip ambiguous rays.
+
+use glam::{DVec3, Vec3};
+use tet_core::TetMesh;
+use tet_core::synthetic::SplitMix64;
+
+use crate::ray::Ray;
+
+/// The closest constrained face along a ray, by brute force in f64.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RefHit {
+    /// Constrained-face index.
+    pub face: u32,
+    /// Scene triangle id.
+    pub triangle: u32,
+    /// Ray parameter.
+    pub t: f64,
+    /// Barycentrics w.r.t. the face's `vertices`.
+    pub barycentrics: [f64; 3],
+    /// Distance from the hit point to the nearest edge of its triangle (0 on
+    /// an edge): small values mark rays whose hit triangle is ambiguous.
+    pub edge_distance: f64,
+    /// Gap in `t` to the next-closest hit on another face (∞ if none).
+    pub t_gap: f64,
+}
+
+/// Distance from `p` to segment `ab`.
+fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let l = ab.length_squared();
+    let s = if l > 0.0 {
+        ((p - a).dot(ab) / l).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + ab * s - p).length()
+}
+
+/// Intersection of the ray's line with triangle `v` (closed), as
+/// `(t, barycentrics)`; `None` when the line misses it or is parallel.
+pub fn ray_triangle(ray: &Ray, v: [Vec3; 3]) -> Option<(f64, [f64; 3])> {
+    let o = ray.origin.as_dvec3();
+    let d = ray.direction.as_dvec3();
+    let q = v.map(|p| p.as_dvec3() - o);
+    let w = [
+        d.dot(q[1].cross(q[2])),
+        d.dot(q[2].cross(q[0])),
+        d.dot(q[0].cross(q[1])),
+    ];
+    let inside =
+        (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0) || (w[0] <= 0.0 && w[1] <= 0.0 && w[2] <= 0.0);
+    let sum = w[0] + w[1] + w[2];
+    if !inside || sum == 0.0 {
+        return None;
+    }
+    let b = w.map(|x| x / sum);
+    let p = q[0] * b[0] + q[1] * b[1] + q[2] * b[2];
+    Some((p.dot(d) / d.length_squared(), b))
+}
+
+/// The closest constrained face with `t ∈ [ray.t_min, ray.t_max]`, by brute force.
+pub fn closest_hit(mesh: &TetMesh, ray: &Ray) -> Option<RefHit> {
+    let mut best: Option<RefHit> = None;
+    let mut second = f64::INFINITY;
+    for (i, cf) in mesh.constrained.iter().enumerate() {
+        let v = cf.vertices.map(|k| mesh.points[k as usize]);
+        let Some((t, b)) = ray_triangle(ray, v) else {
+            continue;
+        };
+        if t < ray.t_min as f64 || t > ray.t_max as f64 {
+            continue;
+        }
+        if best.is_none_or(|h| t < h.t) {
+            if let Some(h) = best {
+                second = h.t;
+            }
+            let vd = v.map(|p| p.as_dvec3());
+            let p = ray.origin.as_dvec3() + ray.direction.as_dvec3() * t;
+            let edge_distance = segment_distance(p, vd[0], vd[1])
+                .min(segment_distance(p, vd[1], vd[2]))
+                .min(segment_distance(p, vd[2], vd[0]));
+            best = Some(RefHit {
+                face: i as u32,
+                triangle: cf.triangle,
+                t,
+                barycentrics: b,
+                edge_distance,
+                t_gap: f64::INFINITY,
+            });
+        } else {
+            second = second.min(t);
+        }
+    }
+    best.map(|mut h| {
+        h.t_gap = second - h.t;
+        h
+    })
+}
+
+/// True when the ray's line crosses the plane of some constrained face (with
+/// `t ≥ t_min − tol`) within distance `tol` of one of that face's edges: the
+/// first hit of such a ray depends on rounding (it may land on the
+/// neighbouring face, or slip past a free edge), so comparisons skip it.
+pub fn grazes_an_edge(mesh: &TetMesh, ray: &Ray, tol: f64) -> bool {
+    let o = ray.origin.as_dvec3();
+    let d = ray.direction.as_dvec3();
+    mesh.constrained.iter().any(|cf| {
+        let v = cf.vertices.map(|k| mesh.points[k as usize].as_dvec3());
+        let n = (v[1] - v[0]).cross(v[2] - v[0]);
+        let den = n.dot(d);
+        if den == 0.0 {
+            // Parallel: ambiguous if the line lies in (or very near) the plane.
+            return (n.dot(v[0] - o) / n.length()).abs() < tol;
+        }
+        let t = n.dot(v[0] - o) / den;
+        if t < ray.t_min as f64 - tol || t > ray.t_max as f64 + tol {
+            return false;
+        }
+        let p = o + d * t;
+        segment_distance(p, v[0], v[1]) < tol
+            || segment_distance(p, v[1], v[2]) < tol
+            || segment_distance(p, v[2], v[0]) < tol
+    })
+}
+
+/// A uniformly random unit direction.
+pub fn random_direction(rng: &mut SplitMix64) -> Vec3 {
+    loop {
+        let v = Vec3::new(
+            rng.range_f32(-1.0, 1.0),
+            rng.range_f32(-1.0, 1.0),
+            rng.range_f32(-1.0, 1.0),
+        );
+        let l = v.length_squared();
+        if l > 1e-4 && l <= 1.0 {
+            return v / l.sqrt();
+        }
+    }
+}
+
+/// A random point inside a random tet (by random barycentrics), with the tet.
+pub fn random_point_inside(mesh: &TetMesh, rng: &mut SplitMix64) -> (Vec3, u32) {
+    let t = (rng.next_u64() % mesh.tets.len() as u64) as u32;
+    let p = mesh.tet_points(t);
+    let mut w = [0f32; 4];
+    for x in &mut w {
+        *x = -(rng.next_f64().max(1e-12).ln()) as f32;
+    }
+    let s: f32 = w.iter().sum();
+    let q = p[0] * w[0] + p[1] * w[1] + p[2] * w[2] + p[3] * w[3];
+    (q / s, t)
+}
+
+/// What a generated ray is aimed at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Aim {
+    /// A random direction.
+    Random,
+    /// Exactly at a mesh vertex (the direction is `vertex − origin`).
+    Vertex,
+    /// At the midpoint of a tet edge.
+    EdgeMidpoint,
+    /// At the centroid of a tet face.
+    FaceCentroid,
+}
+
+/// A ray from a random point inside the mesh, aimed as asked, with a
+/// tet that contains its origin.
+pub fn random_ray(mesh: &TetMesh, rng: &mut SplitMix64, aim: Aim) -> (Ray, u32) {
+    let (o, t) = random_point_inside(mesh, rng);
+    let pick = |rng: &mut SplitMix64| {
+        let t = (rng.next_u64() % mesh.tets.len() as u64) as usize;
+        (mesh.tet_points(t as u32), rng.next_u64())
+    };
+    let target = match aim {
+        Aim::Random => return (Ray::new(o, random_direction(rng)), t),
+        Aim::Vertex => {
+            let (p, r) = pick(rng);
+            p[(r % 4) as usize]
+        }
+        Aim::EdgeMidpoint => {
+            let (p, r) = pick(rng);
+            let a = (r % 4) as usize;
+            let b = (a + 1 + (r / 4 % 3) as usize) % 4;
+            (p[a] + p[b]) * 0.5
+        }
+        Aim::FaceCentroid => {
+            let (p, r) = pick(rng);
+            let k = (r % 4) as usize;
+            let s = tet_core::FACE_VERTICES[k];
+            (p[s[0]] + p[s[1]] + p[s[2]]) / 3.0
+        }
+    };
+    let d = target - o;
+    if d.length_squared() > 0.0 {
+        (Ray::new(o, d), t)
+    } else {
+        (Ray::new(o, Vec3::X), t)
+    }
+}
+
+/// A ray starting exactly on a mesh vertex, an edge midpoint or a face
+/// centroid (`aim`), in a random direction, with `t_min = 0`. The origin lies
+/// on tet boundaries, the hardest case for a start tet. Returns the ray only;
+/// locate its origin with [`crate::locate::locate`].
+pub fn ray_from_feature(mesh: &TetMesh, rng: &mut SplitMix64, aim: Aim) -> Ray {
+    let t = (rng.next_u64() % mesh.tets.len() as u64) as u32;
+    let p = mesh.tet_points(t);
+    let r = rng.next_u64();
+    let o = match aim {
+        Aim::Random | Aim::Vertex => p[(r % 4) as usize],
+        Aim::EdgeMidpoint => {
+            let a = (r % 4) as usize;
+            let b = (a + 1 + (r / 4 % 3) as usize) % 4;
+            (p[a] + p[b]) * 0.5
+        }
+        Aim::FaceCentroid => {
+            let s = tet_core::FACE_VERTICES[(r % 4) as usize];
+            (p[s[0]] + p[s[1]] + p[s[2]]) / 3.0
+        }
+    };
+    Ray::new(o, random_direction(rng))
+}
+
+/// An axis-aligned ray (direction `±x`, `±y` or `±z`) from a point whose
+/// coordinates are multiples of `1/4` inside the box `[lo, hi]`: on an
+/// unjittered grid mesh it runs exactly along edges, through vertices and in
+/// face planes.
+pub fn axis_ray(rng: &mut SplitMix64, lo: Vec3, hi: Vec3) -> Ray {
+    let q = |rng: &mut SplitMix64, a: f32, b: f32| {
+        let steps = ((b - a) * 4.0).floor().max(0.0) as u64;
+        let k = if steps > 2 {
+            1 + rng.next_u64() % (steps - 1)
+        } else {
+            1
+        };
+        (a + k as f32 * 0.25).min(b)
+    };
+    let o = Vec3::new(q(rng, lo.x, hi.x), q(rng, lo.y, hi.y), q(rng, lo.z, hi.z));
+    let axis = (rng.next_u64() % 6) as usize;
+    let mut d = Vec3::ZERO;
+    d[axis % 3] = if axis < 3 { 1.0 } else { -1.0 };
+    Ray::new(o, d)
+}

@@ -1,0 +1,402 @@
+//! Pinhole renderer: primary rays through 16×16 tiles scheduled with rayon,
+//! Lambert shading with point lights and optional shadow rays, PNG output,
+//! a heat map of tets visited per pixel, and per-frame statistics for the
+//! bench harness.
+//!
+//! Conventions (`../shared/scenes/scenes.json`, `conventions` block):
+//! `forward = normalize(target − position)`,
+//! `right = −normalize(up × forward)`, `cam_up = −(forward × right)`; image
+//! plane at distance 1 with half-height `tan(vfov/2)` (45° ⇒ `tan(π/8)`),
+//! aspect `W/H`; pixel `(i, j)` (i right, j down) has direction
+//! `normalize(forward + right·tan(vfov/2)·aspect·(2i/W − 1) +
+//! cam_up·tan(vfov/2)·(1 − 2j/H))` — integer pixel corners, no `+0.5`,
+//! unless [`RenderOptions::pixel_centers`]. Shading: background 0.1 grey;
+//! per hit `Σ color·intensity·clamp(n·normalize(L − p), 0, 1)`, no falloff,
+//! `n` the interpolated vertex normal when the mesh has normals, else the
+//! face normal from the source triangle's winding.
+
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+use glam::Vec3;
+use rayon::prelude::*;
+use tet_core::TetMesh;
+use tet_core::scene::{Camera, PointLight};
+use thiserror::Error;
+
+use crate::kernel::Tracer;
+use crate::locate::{LocateError, locate};
+use crate::ray::{Hit, Ray, TraceOutcome};
+use crate::secondary::{face_normal, light_visible};
+use crate::walk::Start;
+
+/// Tile edge in pixels.
+pub const TILE: u32 = 16;
+
+/// Rendering errors.
+#[derive(Debug, Error)]
+pub enum RenderError {
+    /// The camera could not be located in the mesh.
+    #[error("camera at {position:?}: {source}")]
+    Camera {
+        /// Camera position.
+        position: Vec3,
+        /// Why.
+        source: LocateError,
+    },
+    /// Width or height is zero.
+    #[error("image size {width}×{height} is empty")]
+    EmptyImage {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+    },
+    /// Writing a PNG failed.
+    #[error("writing {path}: {source}")]
+    Png {
+        /// Output path.
+        path: String,
+        /// The encoder/IO error.
+        source: png::EncodingError,
+    },
+    /// Creating the output file failed.
+    #[error("creating {path}: {source}")]
+    Io {
+        /// Output path.
+        path: String,
+        /// The IO error.
+        source: std::io::Error,
+    },
+}
+
+/// What to render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOptions {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Cast shadow rays to every light.
+    pub shadows: bool,
+    /// Sample pixel centres (`i + 0.5`) instead of the neptun corners.
+    pub pixel_centers: bool,
+    /// Background grey level.
+    pub background: f32,
+    /// Shade only (no light) with the normal's absolute cosine to the view:
+    /// useful when the scene has no lights.
+    pub headlight: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: 1920,
+            height: 1440,
+            shadows: false,
+            pixel_centers: false,
+            background: 0.1,
+            headlight: false,
+        }
+    }
+}
+
+/// Per-frame statistics.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameStats {
+    /// Wall time of the whole frame (primary + shadow rays + shading), ms.
+    pub ms: f64,
+    /// Primary rays cast.
+    pub rays: u64,
+    /// Primary rays that hit.
+    pub hits: u64,
+    /// Tets visited by primary rays.
+    pub tets_visited: u64,
+    /// Primary rays that failed (step cap, lost).
+    pub failures: u64,
+    /// Shadow rays cast.
+    pub shadow_rays: u64,
+}
+
+impl FrameStats {
+    /// Million primary rays per second.
+    pub fn mrays_per_s(&self) -> f64 {
+        self.rays as f64 / (self.ms * 1e3)
+    }
+}
+
+/// A rendered frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Linear RGB per pixel, row-major from the top.
+    pub color: Vec<Vec3>,
+    /// Tets visited per pixel.
+    pub tets: Vec<u32>,
+    /// Hit triangle per pixel (`u32::MAX` for none).
+    pub triangle: Vec<u32>,
+    /// Statistics.
+    pub stats: FrameStats,
+}
+
+/// The camera's ray generator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PinholeCamera {
+    /// Eye.
+    pub position: Vec3,
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    half_h: f32,
+    aspect: f32,
+    width: f32,
+    height: f32,
+    offset: f32,
+}
+
+impl PinholeCamera {
+    /// Builds the generator for a `width × height` image.
+    pub fn new(camera: &Camera, width: u32, height: u32, pixel_centers: bool) -> Self {
+        let forward = (camera.target - camera.position).normalize();
+        let right = -camera.up.cross(forward).normalize();
+        let up = -forward.cross(right);
+        PinholeCamera {
+            position: camera.position,
+            forward,
+            right,
+            up,
+            half_h: (camera.vfov_deg.to_radians() * 0.5).tan(),
+            aspect: width as f32 / height as f32,
+            width: width as f32,
+            height: height as f32,
+            offset: if pixel_centers { 0.5 } else { 0.0 },
+        }
+    }
+
+    /// Primary ray of pixel `(i, j)` (normalised direction).
+    pub fn ray(&self, i: u32, j: u32) -> Ray {
+        let x = 2.0 * (i as f32 + self.offset) / self.width - 1.0;
+        let y = 1.0 - 2.0 * (j as f32 + self.offset) / self.height;
+        let d = self.forward
+            + self.right * (self.half_h * self.aspect * x)
+            + self.up * (self.half_h * y);
+        Ray::new(self.position, d.normalize())
+    }
+}
+
+/// Shading normal at a hit: interpolated vertex normal if present, else the
+/// face normal from the winding.
+pub fn shading_normal(mesh: &TetMesh, hit: &Hit) -> Vec3 {
+    if let Some(normals) = &mesh.attributes.normals {
+        let cf = &mesh.constrained[hit.face as usize];
+        let n = cf
+            .vertices
+            .iter()
+            .zip(hit.barycentrics)
+            .map(|(&v, w)| normals.get(v as usize).copied().unwrap_or(Vec3::ZERO) * w)
+            .sum::<Vec3>()
+            .normalize_or_zero();
+        if n != Vec3::ZERO {
+            return n;
+        }
+    }
+    face_normal(mesh, hit.face)
+}
+
+struct Pixel {
+    color: Vec3,
+    tets: u32,
+    triangle: u32,
+    hit: bool,
+    failed: bool,
+    shadow_rays: u32,
+}
+
+/// Renders one frame with `tracer`. The camera is located once (from tet 0);
+/// every primary ray starts in its tet.
+pub fn render<T: Tracer + ?Sized>(
+    tracer: &T,
+    camera: &Camera,
+    lights: &[PointLight],
+    opts: &RenderOptions,
+) -> Result<Frame, RenderError> {
+    let (w, h) = (opts.width, opts.height);
+    if w == 0 || h == 0 {
+        return Err(RenderError::EmptyImage {
+            width: w,
+            height: h,
+        });
+    }
+    let t0 = Instant::now();
+    let mesh = tracer.mesh();
+    let start = locate(mesh, camera.position, 0).map_err(|source| RenderError::Camera {
+        position: camera.position,
+        source,
+    })?;
+    let cam = PinholeCamera::new(camera, w, h, opts.pixel_centers);
+    let tiles_x = w.div_ceil(TILE);
+    let tiles_y = h.div_ceil(TILE);
+    let tiles: Vec<(u32, Vec<Pixel>)> = (0..tiles_x * tiles_y)
+        .into_par_iter()
+        .map(|tile| {
+            let (tx, ty) = (tile % tiles_x, tile / tiles_x);
+            let mut rays = Vec::with_capacity((TILE * TILE) as usize);
+            for j in ty * TILE..((ty + 1) * TILE).min(h) {
+                for i in tx * TILE..((tx + 1) * TILE).min(w) {
+                    rays.push(cam.ray(i, j));
+                }
+            }
+            let mut outcomes = vec![TraceOutcome::Miss { tets_visited: 0 }; rays.len()];
+            tracer.trace_batch(&rays, Start::Tet(start), &mut outcomes);
+            let out = rays
+                .iter()
+                .zip(outcomes)
+                .map(|(ray, o)| shade(tracer, mesh, ray, o, lights, opts))
+                .collect();
+            (tile, out)
+        })
+        .collect();
+    let n = (w * h) as usize;
+    let mut frame = Frame {
+        width: w,
+        height: h,
+        color: vec![Vec3::ZERO; n],
+        tets: vec![0; n],
+        triangle: vec![u32::MAX; n],
+        stats: FrameStats::default(),
+    };
+    for (tile, pixels) in tiles {
+        let (tx, ty) = (tile % tiles_x, tile / tiles_x);
+        let mut it = pixels.into_iter();
+        for j in ty * TILE..((ty + 1) * TILE).min(h) {
+            for i in tx * TILE..((tx + 1) * TILE).min(w) {
+                let Some(p) = it.next() else { break };
+                let k = (j * w + i) as usize;
+                frame.color[k] = p.color;
+                frame.tets[k] = p.tets;
+                frame.triangle[k] = p.triangle;
+                frame.stats.rays += 1;
+                frame.stats.hits += p.hit as u64;
+                frame.stats.failures += p.failed as u64;
+                frame.stats.tets_visited += p.tets as u64;
+                frame.stats.shadow_rays += p.shadow_rays as u64;
+            }
+        }
+    }
+    frame.stats.ms = t0.elapsed().as_secs_f64() * 1e3;
+    Ok(frame)
+}
+
+fn shade<T: Tracer + ?Sized>(
+    tracer: &T,
+    mesh: &TetMesh,
+    ray: &Ray,
+    out: TraceOutcome,
+    lights: &[PointLight],
+    opts: &RenderOptions,
+) -> Pixel {
+    let mut px = Pixel {
+        color: Vec3::splat(opts.background),
+        tets: out.tets_visited(),
+        triangle: u32::MAX,
+        hit: false,
+        failed: out.is_failure(),
+        shadow_rays: 0,
+    };
+    let TraceOutcome::Hit(hit) = out else {
+        return px;
+    };
+    px.hit = true;
+    px.triangle = hit.triangle;
+    let n = shading_normal(mesh, &hit);
+    let p = ray.at(hit.t);
+    if opts.headlight {
+        px.color = Vec3::splat(n.dot(-ray.direction.normalize()).abs());
+        return px;
+    }
+    let mut c = Vec3::ZERO;
+    for light in lights {
+        let l = (light.position - p).normalize_or_zero();
+        let cos = n.dot(l).clamp(0.0, 1.0);
+        if cos <= 0.0 {
+            continue;
+        }
+        if opts.shadows {
+            px.shadow_rays += 1;
+            if !light_visible(tracer, &hit, light.position) {
+                continue;
+            }
+        }
+        c += light.color * light.intensity * cos;
+    }
+    px.color = c;
+    px
+}
+
+fn write_png(path: &Path, w: u32, h: u32, rgb: &[u8]) -> Result<(), RenderError> {
+    let name = path.display().to_string();
+    let file = std::fs::File::create(path).map_err(|source| RenderError::Io {
+        path: name.clone(),
+        source,
+    })?;
+    let mut buf = std::io::BufWriter::new(file);
+    let mut enc = png::Encoder::new(&mut buf, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let png_err = |source| RenderError::Png {
+        path: name.clone(),
+        source,
+    };
+    let mut writer = enc.write_header().map_err(png_err)?;
+    writer.write_image_data(rgb).map_err(png_err)?;
+    writer.finish().map_err(png_err)?;
+    buf.flush().map_err(|source| RenderError::Io {
+        path: name.clone(),
+        source,
+    })
+}
+
+impl Frame {
+    /// 8-bit RGB bytes of the colour image (`clamp(c, 0, 1)·255`, no gamma,
+    /// like neptun).
+    pub fn rgb8(&self) -> Vec<u8> {
+        self.color
+            .iter()
+            .flat_map(|c| c.to_array())
+            .map(|x| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)
+            .collect()
+    }
+
+    /// 8-bit RGB bytes of the heat map: tets visited per pixel on a
+    /// blue → green → red ramp, scaled to `max` (the frame's maximum when
+    /// `None`).
+    pub fn heatmap_rgb8(&self, max: Option<u32>) -> Vec<u8> {
+        let m = max
+            .unwrap_or_else(|| self.tets.iter().copied().max().unwrap_or(1))
+            .max(1) as f32;
+        self.tets
+            .iter()
+            .flat_map(|&t| {
+                let x = (t as f32 / m).clamp(0.0, 1.0);
+                let r = (2.0 * x - 1.0).clamp(0.0, 1.0);
+                let g = 1.0 - (2.0 * x - 1.0).abs();
+                let b = (1.0 - 2.0 * x).clamp(0.0, 1.0);
+                [r, g, b].map(|c| (c * 255.0 + 0.5) as u8)
+            })
+            .collect()
+    }
+
+    /// Writes the colour image as PNG.
+    pub fn save_png(&self, path: &Path) -> Result<(), RenderError> {
+        write_png(path, self.width, self.height, &self.rgb8())
+    }
+
+    /// Writes the tets-visited heat map as PNG (see [`Frame::heatmap_rgb8`]).
+    pub fn save_heatmap(&self, path: &Path, max: Option<u32>) -> Result<(), RenderError> {
+        write_png(path, self.width, self.height, &self.heatmap_rgb8(max))
+    }
+}

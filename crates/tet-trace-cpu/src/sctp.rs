@@ -1,0 +1,57 @@
+//! ScTP kernel: scalar triple products on the 32-byte baseline layout
+//! (Lagae & Dutré 2008, as summarised in seed 000 §2 and seed 001 §2).
+//!
+//! Layout: [`tet_core::layout::Baseline32`] = four vertex ids + four links.
+//! The ray passes left of edge `a → b` when `d · ((Pa − o) × (Pb − o)) > 0`
+//! (a scalar triple product, [`TripleF32`]); Lagae & Dutré need 3–6 of them
+//! per tet without the entry face. Using the entry face (whose three edge
+//! signs are known from the previous tet), the exit face needs exactly two
+//! (Algorithm 1 of seed 000 on the triple-product signs, the same decision
+//! procedure as the 2-D walk): per step one 12-byte point load, 3
+//! subtractions, two triple products (2 × (6 mul + 3 sub) + 2 × (3 mul + 2
+//! add)), and the link of the exit vertex's slot. The original neptun ScTP
+//! ignored the entry face; this one does not. Zero is decided by the
+//! vertex-index rule, so the walk is watertight in the sense of
+//! [`crate::walk`].
+
+use tet_core::TetMesh;
+use tet_core::layout::{Baseline32Mesh, LayoutError};
+
+use crate::kernel::WalkTracer;
+use crate::walk::{Projection, Topology, TripleF32};
+
+impl Topology for Baseline32Mesh {
+    #[inline(always)]
+    fn vx(&self, tet: u32) -> u32 {
+        let v = self.tets[tet as usize].v;
+        v[0] ^ v[1] ^ v[2] ^ v[3]
+    }
+    #[inline(always)]
+    fn exit_link(&self, tet: u32, _f: [u32; 3], _d: u32, exiting: u32, _entry: u32) -> u32 {
+        let r = &self.tets[tet as usize];
+        let n = r.n;
+        if exiting == r.v[0] {
+            n[0].0
+        } else if exiting == r.v[1] {
+            n[1].0
+        } else if exiting == r.v[2] {
+            n[2].0
+        } else {
+            n[3].0
+        }
+    }
+}
+
+/// ScTP tracer (default: f32 triple products).
+pub type SctpTracer<'m, P = TripleF32> = WalkTracer<'m, Baseline32Mesh, P>;
+
+impl<'m, P: Projection> WalkTracer<'m, Baseline32Mesh, P> {
+    /// Encodes `mesh` (validated) in the baseline layout.
+    pub fn new(mesh: &'m TetMesh) -> Result<Self, LayoutError> {
+        Ok(Self::with_layout(
+            mesh,
+            Baseline32Mesh::from_mesh(mesh)?,
+            "sctp",
+        ))
+    }
+}

@@ -1,0 +1,51 @@
+//! Tet20 kernel (Aman et al., seed 000 §3–4, Algorithms 1, 4, 5).
+//!
+//! Layout: [`tet_core::layout::Tet20`] = `VX` + four links in the order of the
+//! rank of their opposite vertex id (20 bytes). Per step (operation count of
+//! the paper): one 4-byte load of `VX^next`, 3 xors for `idx₃`, one 12-byte
+//! point load, the projection (f32: 3 subtractions, 6 multiplications, 4
+//! additions), the exit face by Algorithm 1 (two 2-D determinants: 4
+//! multiplications, 2 subtractions, 2 comparisons, see [`crate::walk`]), the
+//! rank `order_a` of the exit vertex among the four ids (4 comparisons) and
+//! one 4-byte link load `N_{order_a}` (Algorithm 5).
+//!
+//! | paper | code |
+//! |---|---|
+//! | `idx_0..2`, `p_0..2` | walk state `ids`, `p` |
+//! | `VX^next` | [`Topology::vx`] |
+//! | `order_a`, GETNEXTTET20 | [`tet_core::layout::rank_of`], [`Tet20::neighbor_by_rank`] |
+
+use tet_core::TetMesh;
+use tet_core::layout::{LayoutError, Tet20, Tet20Mesh, rank_of};
+
+use crate::kernel::WalkTracer;
+use crate::walk::{DuffF32, DuffF64, Projection, Topology};
+
+impl Topology for Tet20Mesh {
+    #[inline(always)]
+    fn vx(&self, tet: u32) -> u32 {
+        self.tets[tet as usize].vx
+    }
+    #[inline(always)]
+    fn exit_link(&self, tet: u32, f: [u32; 3], d: u32, exiting: u32, _entry: u32) -> u32 {
+        let rec: &Tet20 = &self.tets[tet as usize];
+        rec.neighbor_by_rank(rank_of(exiting, [f[0], f[1], f[2], d]))
+            .0
+    }
+}
+
+/// Tet20 tracer with projection `P`.
+pub type Tet20Tracer<'m, P = DuffF32> = WalkTracer<'m, Tet20Mesh, P>;
+/// Tet20 in f64.
+pub type Tet20TracerF64<'m> = Tet20Tracer<'m, DuffF64>;
+
+impl<'m, P: Projection> WalkTracer<'m, Tet20Mesh, P> {
+    /// Encodes `mesh` (validated) in the Tet20 layout.
+    pub fn new(mesh: &'m TetMesh) -> Result<Self, LayoutError> {
+        Ok(Self::with_layout(
+            mesh,
+            Tet20Mesh::from_mesh(mesh)?,
+            "tet20",
+        ))
+    }
+}

@@ -1,0 +1,779 @@
+//! The traversal engine shared by every kernel: a ray walks from the tet
+//! containing its origin, one tet per step, until it crosses a constrained
+//! face or the mesh boundary.
+//!
+//! # The projected (2-D) walk of Aman et al. (seed 000 §4, Algorithm 1)
+//!
+//! A basis `(u, v)` orthogonal to the ray direction `d` (with
+//! `(u × v) · d > 0`) maps every vertex `P` to the 2-D point
+//! `p = (u·(P−o), v·(P−o))` (a [`Projection`]); the ray becomes the origin
+//! `(0, 0)`. With the outward faces of a positive tet, the ray leaves through
+//! the face whose projection winds counter-clockwise around the origin. The
+//! walk keeps the three vertices of the current entry face (`idx₀..₂`, paper
+//! `idx_0..2`, code `ids`) and their projections (`p₀..₂`, code `p`) in
+//! counter-clockwise order. Entering a tet, it fetches the one new vertex
+//! `idx₃ = idx₀ ⊕ idx₁ ⊕ idx₂ ⊕ VX` (paper `VX^i`, code [`Topology::vx`]),
+//! projects it (`p₃`) and decides with two 2-D determinants `det(p₃, pᵢ)` which
+//! of the three faces through `p₃` holds the origin (paper Algorithm 1,
+//! code [`exit_slot`]): 4 multiplications and 2 comparisons. The vertex that
+//! leaves the face is replaced by `idx₃` in place, which keeps the
+//! counter-clockwise order; the neighbour across the exit face comes from the
+//! layout ([`Topology::exit_link`]: Algorithms 3, 5, 7).
+//!
+//! # Why the walk is watertight
+//!
+//! Every decision is the sign of `det(pₐ, p_b) = pₐ.x·p_b.y − pₐ.y·p_b.x`
+//! for a *mesh edge* `(a, b)`: whether the ray passes left or right of it.
+//! The walk cannot slip between two tets, loop, or skip a face as long as
+//! every tet sharing an edge sees the *same* answer for it. That holds here
+//! bit for bit, in f32, with no epsilon:
+//!
+//! 1. identical operands: `pₐ` is a pure function of the vertex position and
+//!    the ray (same formula, computed whenever the vertex is fetched), so every
+//!    tet around the edge sees the same two 2-D points;
+//! 2. exact antisymmetry: IEEE multiplication is commutative and
+//!    `fl(x − y) = −fl(y − x)`, so `det(p_b, pₐ) = −det(pₐ, p_b)` exactly
+//!    (no fused multiply-add is used: Rust never contracts implicitly), i.e.
+//!    seen from either orientation of the edge the answer is the same;
+//! 3. one tie rule for zero (the ray touches the edge's projection, e.g. it
+//!    passes through a vertex or along an edge): the origin is perturbed
+//!    symbolically to `(ε, ε²)` (simulation of simplicity), so a zero
+//!    determinant is decided by `sign(pₐ.y − p_b.y)`, then `sign(p_b.x − pₐ.x)`
+//!    (exact comparisons), and, when both points coincide (an edge parallel to
+//!    the ray), by the global vertex indices (`a < b` ⇒ left). Each step is
+//!    antisymmetric, so the rule never answers differently for the same edge.
+//!
+//! Each kernel's operation count is in its module docs. The engine is generic
+//! over the projection (f32, f64, projected origin of Eq. 4–5, or the 3-D
+//! scalar triple products of [`crate::sctp`], which use the same decisions)
+//! and over the layout ([`Topology`]), and monomorphised per pair.
+
+use glam::{DVec2, DVec3, Vec2, Vec3};
+use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
+
+use crate::locate::star;
+use crate::ray::{DEFAULT_STEP_CAP, Failure, Hit, Ray, TraceOutcome};
+
+/// How a ray's vertices are mapped to the quantities whose signs steer the walk.
+pub trait Projection: Copy + Send + Sync {
+    /// A projected vertex.
+    type P: Copy;
+    /// Short name for reports.
+    const NAME: &'static str;
+    /// Builds the projection of a (valid) ray.
+    fn setup(ray: &Ray) -> Self;
+    /// Projects one mesh vertex (must be a pure function of `p` and the ray).
+    fn project(&self, p: Vec3) -> Self::P;
+    /// True when the ray passes to the left of the directed edge `a → b`,
+    /// i.e. `det(pa, pb) > 0` with the tie rule of the module docs.
+    /// Exactly antisymmetric: `left(a, b) == !left(b, a)`.
+    fn left(&self, a: Self::P, ia: u32, b: Self::P, ib: u32) -> bool;
+}
+
+/// The tie rule of the module docs for 2-D points with an already computed
+/// determinant.
+macro_rules! left_2d {
+    ($a:expr, $ia:expr, $b:expr, $ib:expr) => {{
+        let (a, b) = ($a, $b);
+        let det = a.x * b.y - a.y * b.x;
+        if det != 0.0 {
+            det > 0.0
+        } else if a.y != b.y {
+            a.y > b.y
+        } else if a.x != b.x {
+            b.x > a.x
+        } else {
+            $ia < $ib
+        }
+    }};
+}
+
+/// Duff et al.'s orthonormal basis for a unit vector `n`, ordered so that
+/// `u × v` points along `n`.
+fn duff_basis(n: DVec3) -> (DVec3, DVec3) {
+    let sign = 1.0f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    let u = DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    let v = DVec3::new(b, sign + n.y * n.y * a, -n.y);
+    if u.cross(v).dot(n) >= 0.0 {
+        (u, v)
+    } else {
+        (v, u)
+    }
+}
+
+/// f32 projection `p = (u·(P−o), v·(P−o))` with Duff et al.'s basis
+/// (6 multiplications, 4 additions, 3 subtractions per vertex).
+#[derive(Clone, Copy, Debug)]
+pub struct DuffF32 {
+    o: Vec3,
+    u: Vec3,
+    v: Vec3,
+}
+
+impl Projection for DuffF32 {
+    type P = Vec2;
+    const NAME: &'static str = "f32";
+    fn setup(ray: &Ray) -> Self {
+        let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
+        DuffF32 {
+            o: ray.origin,
+            u: u.as_vec3(),
+            v: v.as_vec3(),
+        }
+    }
+    #[inline(always)]
+    fn project(&self, p: Vec3) -> Vec2 {
+        let q = p - self.o;
+        Vec2::new(self.u.dot(q), self.v.dot(q))
+    }
+    #[inline(always)]
+    fn left(&self, a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
+        left_2d!(a, ia, b, ib)
+    }
+}
+
+/// f32 projection with the projected ray origin of Eq. 4–5:
+/// `p = (u·P − po.x, v·P − po.y)`, `po = (u·o, v·o)` (one subtraction per
+/// coordinate instead of three, less accurate far from the world origin).
+#[derive(Clone, Copy, Debug)]
+pub struct OriginF32 {
+    po: Vec2,
+    u: Vec3,
+    v: Vec3,
+}
+
+impl Projection for OriginF32 {
+    type P = Vec2;
+    const NAME: &'static str = "f32-po";
+    fn setup(ray: &Ray) -> Self {
+        let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
+        let (u, v) = (u.as_vec3(), v.as_vec3());
+        OriginF32 {
+            po: Vec2::new(u.dot(ray.origin), v.dot(ray.origin)),
+            u,
+            v,
+        }
+    }
+    #[inline(always)]
+    fn project(&self, p: Vec3) -> Vec2 {
+        Vec2::new(self.u.dot(p) - self.po.x, self.v.dot(p) - self.po.y)
+    }
+    #[inline(always)]
+    fn left(&self, a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
+        left_2d!(a, ia, b, ib)
+    }
+}
+
+/// f64 variant of [`DuffF32`] (points converted exactly to f64).
+#[derive(Clone, Copy, Debug)]
+pub struct DuffF64 {
+    o: DVec3,
+    u: DVec3,
+    v: DVec3,
+}
+
+impl Projection for DuffF64 {
+    type P = DVec2;
+    const NAME: &'static str = "f64";
+    fn setup(ray: &Ray) -> Self {
+        let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
+        DuffF64 {
+            o: ray.origin.as_dvec3(),
+            u,
+            v,
+        }
+    }
+    #[inline(always)]
+    fn project(&self, p: Vec3) -> DVec2 {
+        let q = p.as_dvec3() - self.o;
+        DVec2::new(self.u.dot(q), self.v.dot(q))
+    }
+    #[inline(always)]
+    fn left(&self, a: DVec2, ia: u32, b: DVec2, ib: u32) -> bool {
+        left_2d!(a, ia, b, ib)
+    }
+}
+
+/// 3-D scalar triple products (Lagae & Dutré): a vertex maps to `q = P − o`
+/// and the ray passes left of edge `a → b` when `d · (qa × qb) > 0`
+/// (= `det(pa, pb)` up to a positive factor). `a × b = −(b × a)`
+/// component-wise exactly, so the product is exactly antisymmetric. Zero is
+/// decided as in 2-D by perturbing the origin by `ε u + ε² v` (`u, v` the
+/// Duff basis): first `sign((qa − qb) · v)`, then `sign((qb − qa) · u)`, then
+/// the vertex indices (`a < b` ⇒ left), each antisymmetric.
+#[derive(Clone, Copy, Debug)]
+pub struct TripleF32 {
+    o: Vec3,
+    d: Vec3,
+    u: Vec3,
+    v: Vec3,
+}
+
+impl Projection for TripleF32 {
+    type P = Vec3;
+    const NAME: &'static str = "f32-stp";
+    fn setup(ray: &Ray) -> Self {
+        let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
+        TripleF32 {
+            o: ray.origin,
+            d: ray.direction,
+            u: u.as_vec3(),
+            v: v.as_vec3(),
+        }
+    }
+    #[inline(always)]
+    fn project(&self, p: Vec3) -> Vec3 {
+        p - self.o
+    }
+    #[inline(always)]
+    fn left(&self, a: Vec3, ia: u32, b: Vec3, ib: u32) -> bool {
+        let s = self.d.dot(a.cross(b));
+        if s != 0.0 {
+            return s > 0.0;
+        }
+        let e = a - b;
+        let y = e.dot(self.v);
+        if y != 0.0 {
+            return y > 0.0;
+        }
+        let x = e.dot(self.u);
+        if x != 0.0 { x < 0.0 } else { ia < ib }
+    }
+}
+
+/// The hot connectivity of a layout, as the walk needs it.
+pub trait Topology: Sync {
+    /// Xor of the four vertex indices of `tet` (paper `VX^i`).
+    fn vx(&self, tet: u32) -> u32;
+    /// Raw [`Link`] of `tet` across the face opposite vertex `exiting`.
+    ///
+    /// `face` is the entry face, `d` the fourth vertex, `exiting ∈ face`,
+    /// `entry_raw` the raw link of `tet` across the entry face (the previous
+    /// tet, or the constrained face crossed), which Tet16 needs.
+    fn exit_link(&self, tet: u32, face: [u32; 3], d: u32, exiting: u32, entry_raw: u32) -> u32;
+}
+
+/// Where a walk starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Start {
+    /// In a tet containing the ray origin (closed: the origin may be on its
+    /// boundary); see [`crate::locate::locate`].
+    Tet(u32),
+    /// Just past constrained face `face`, inside tet `tet` (one of its two
+    /// sides); the origin lies on the face. Used by secondary rays: the face
+    /// itself is never reported again.
+    Face {
+        /// Index into [`TetMesh::constrained`].
+        face: u32,
+        /// The side to walk into.
+        tet: u32,
+    },
+}
+
+/// Which slot of the counter-clockwise entry face `(a, b, c)` the new vertex
+/// `d` replaces (paper Algorithm 1): the exit face is the entry face with that
+/// slot replaced by `d`.
+///
+/// Algorithm 1 as written: if the ray is left of `d → a`, the exit face is
+/// `(a, b, d)` (slot 2) when it is right of `d → b`, else `(d, b, c)` (slot
+/// 0); if it is right of `d → a`, the exit face is `(c, a, d)` (slot 1) when
+/// it is left of `d → c`, else slot 0. That needs two edge tests but a
+/// data-dependent branch per step that mispredicts about half the time, so
+/// the three signs are computed branch-free and the same decision is looked
+/// up in [`EXIT_SLOT`] (one more determinant, no misprediction). Both forms
+/// give identical results (the table ignores `d → c` when left of `d → a`
+/// and `d → b` otherwise), so the watertightness argument is unchanged.
+#[inline(always)]
+pub fn exit_slot<P: Projection>(
+    proj: &P,
+    p: &[P::P; 3],
+    ids: &[u32; 3],
+    pd: P::P,
+    d: u32,
+) -> usize {
+    let sa = proj.left(pd, d, p[0], ids[0]) as usize;
+    let sb = proj.left(pd, d, p[1], ids[1]) as usize;
+    let sc = proj.left(pd, d, p[2], ids[2]) as usize;
+    EXIT_SLOT[sa | (sb << 1) | (sc << 2)] as usize
+}
+
+/// Algorithm 1 as a table over `left(d→a) | left(d→b) << 1 | left(d→c) << 2`.
+pub const EXIT_SLOT: [u8; 8] = [0, 2, 0, 0, 1, 2, 1, 0];
+
+/// The walk state just after choosing an exit face.
+struct State<P: Projection> {
+    tet: u32,
+    ids: [u32; 3],
+    p: [P::P; 3],
+    link: u32,
+    visited: u32,
+}
+
+/// Exit face of a tet containing the origin: the outward face whose
+/// projection winds counter-clockwise around the origin.
+fn start_in_tet<P: Projection>(mesh: &TetMesh, proj: &P, tet: u32) -> Option<State<P>> {
+    let v = mesh.tets[tet as usize];
+    let p = v.map(|i| proj.project(mesh.points[i as usize]));
+    let state = |k: usize| {
+        let [a, b, c] = FACE_VERTICES[k];
+        State {
+            tet,
+            ids: [v[a], v[b], v[c]],
+            p: [p[a], p[b], p[c]],
+            link: mesh.neighbors[tet as usize][k].0,
+            visited: 1,
+        }
+    };
+    for (k, s) in FACE_VERTICES.iter().enumerate() {
+        let [a, b, c] = *s;
+        if proj.left(p[a], v[a], p[b], v[b])
+            && proj.left(p[b], v[b], p[c], v[c])
+            && proj.left(p[c], v[c], p[a], v[a])
+        {
+            return Some(state(k));
+        }
+    }
+    None
+}
+
+/// Last resort when rounding left no tet around the origin with a
+/// counter-clockwise exit face: the face of `tet` whose smallest f64 edge
+/// function `d · (qa × qb)` is largest (the face the line leaves through, up
+/// to rounding).
+fn start_fallback<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) -> State<P> {
+    let v = mesh.tets[tet as usize];
+    let o = ray.origin.as_dvec3();
+    let d = ray.direction.as_dvec3();
+    let q = v.map(|i| mesh.points[i as usize].as_dvec3() - o);
+    let score = |k: usize| {
+        let [a, b, c] = FACE_VERTICES[k];
+        let e = |x: usize, y: usize| d.dot(q[x].cross(q[y]));
+        e(a, b).min(e(b, c)).min(e(c, a))
+    };
+    let k = (0..4)
+        .max_by(|&x, &y| score(x).total_cmp(&score(y)))
+        .unwrap_or(0);
+    let [a, b, c] = FACE_VERTICES[k];
+    let ids = [v[a], v[b], v[c]];
+    State {
+        tet,
+        ids,
+        p: ids.map(|i| proj.project(mesh.points[i as usize])),
+        link: mesh.neighbors[tet as usize][k].0,
+        visited: 1,
+    }
+}
+
+/// The tet around the ray origin and the face through which the ray line
+/// leaves it (the `start_in_tet` search of [`trace`], with its fallback to the
+/// other tets around an origin on a face, edge or vertex).
+pub fn start_exit_face<P: Projection>(mesh: &TetMesh, ray: &Ray, tet: u32) -> Option<(u32, usize)> {
+    let proj = P::setup(ray);
+    let found = |t: u32| {
+        start_in_tet(mesh, &proj, t).map(|s| {
+            let k = (0..4)
+                .find(|&k| {
+                    mesh.neighbors[t as usize][k].0 == s.link && {
+                        let f = mesh.face_vertices(t, k);
+                        f.contains(&s.ids[0]) && f.contains(&s.ids[1]) && f.contains(&s.ids[2])
+                    }
+                })
+                .unwrap_or(0);
+            (t, k)
+        })
+    };
+    found(tet)
+        .or_else(|| {
+            star(mesh, ray.origin, tet, 256)
+                .into_iter()
+                .skip(1)
+                .find_map(found)
+        })
+        .or_else(|| {
+            let s = start_fallback(mesh, &proj, ray, tet);
+            let k = (0..4).find(|&k| {
+                mesh.neighbors[tet as usize][k].0 == s.link && {
+                    let f = mesh.face_vertices(tet, k);
+                    s.ids.iter().all(|i| f.contains(i))
+                }
+            })?;
+            Some((tet, k))
+        })
+}
+
+/// One ray in flight: its projection, walk state, the tet it enters next
+/// and the raw link it enters through.
+pub struct Lane<P: Projection> {
+    proj: P,
+    st: State<P>,
+    next: u32,
+    entry_raw: u32,
+}
+
+/// Traces `ray` from `start` with projection `P` over layout `topo`, visiting
+/// at most `cap` tets. `mesh` provides the cold data (points, start tet,
+/// constrained-face table) and must be the mesh `topo` was built from.
+pub fn trace<P: Projection, T: Topology>(
+    mesh: &TetMesh,
+    topo: &T,
+    ray: &Ray,
+    start: Start,
+    cap: u32,
+) -> TraceOutcome {
+    let mut lane = match begin::<P>(mesh, ray, start) {
+        Ok(lane) => lane,
+        Err(out) => return out,
+    };
+    loop {
+        if let Some(out) = step(mesh, topo, ray, &mut lane, cap) {
+            return out;
+        }
+    }
+}
+
+/// Traces many rays from one start with `K` walks interleaved on one thread:
+/// each round advances every lane by one tet, so the CPU overlaps the
+/// dependent load → project → decide → load chains of independent rays
+/// (memory-level parallelism without SIMD). Results are identical to
+/// [`trace`] ray by ray (same [`step`]). `out.len()` must equal `rays.len()`.
+pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
+    mesh: &TetMesh,
+    topo: &T,
+    rays: &[Ray],
+    start: Start,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    let n = rays.len().min(out.len());
+    let mut lanes: [Option<(usize, Lane<P>)>; K] = std::array::from_fn(|_| None);
+    let mut queued = 0;
+    loop {
+        let mut active = false;
+        for lane in lanes.iter_mut() {
+            while lane.is_none() && queued < n {
+                let i = queued;
+                queued += 1;
+                match begin::<P>(mesh, &rays[i], start) {
+                    Ok(l) => *lane = Some((i, l)),
+                    Err(o) => out[i] = o,
+                }
+            }
+            active |= lane.is_some();
+        }
+        if !active {
+            return;
+        }
+        for lane in lanes.iter_mut() {
+            if let Some((i, l)) = lane
+                && let Some(o) = step(mesh, topo, &rays[*i], l, cap)
+            {
+                out[*i] = o;
+                *lane = None;
+            }
+        }
+    }
+}
+
+/// Everything before the hot loop: ray checks, projection set-up, the start
+/// tet's exit face (or the restart on a constrained face) and its link.
+/// `Err` when the walk already ended (invalid ray, hit or miss in the start
+/// tet).
+fn begin<P: Projection>(mesh: &TetMesh, ray: &Ray, start: Start) -> Result<Lane<P>, TraceOutcome> {
+    if !ray.is_valid() {
+        return Err(TraceOutcome::Failed {
+            failure: Failure::InvalidRay,
+            tets_visited: 0,
+        });
+    }
+    let proj = P::setup(ray);
+    let points = &mesh.points[..];
+    let st: State<P> = match start {
+        Start::Tet(t) => {
+            if t as usize >= mesh.tets.len() {
+                return Err(TraceOutcome::Failed {
+                    failure: Failure::Lost,
+                    tets_visited: 0,
+                });
+            }
+            match start_in_tet(mesh, &proj, t) {
+                Some(s) => s,
+                None => {
+                    // The origin is on the start tet's boundary and the ray
+                    // leaves it at once: try the other tets around the origin.
+                    let found = star(mesh, ray.origin, t, 256)
+                        .into_iter()
+                        .skip(1)
+                        .find_map(|c| start_in_tet(mesh, &proj, c));
+                    found.unwrap_or_else(|| start_fallback(mesh, &proj, ray, t))
+                }
+            }
+        }
+        Start::Face { face, tet } => {
+            let side = mesh
+                .constrained
+                .get(face as usize)
+                .and_then(|cf| cf.side_of(tet));
+            let Some(side) = side else {
+                return Err(TraceOutcome::Failed {
+                    failure: Failure::Lost,
+                    tets_visited: 0,
+                });
+            };
+            let v = mesh.tets[tet as usize];
+            let [a, b, c] = FACE_VERTICES[side.face as usize];
+            // Entering `tet` through this face: counter-clockwise = inward order.
+            let ids = [v[a], v[c], v[b]];
+            let st = State {
+                tet: NO_TET,
+                p: ids.map(|i| proj.project(points[i as usize])),
+                ids,
+                link: Link::constrained(face).0,
+                visited: 0,
+            };
+            let entry_raw = st.link;
+            return Ok(Lane {
+                proj,
+                st,
+                next: tet,
+                entry_raw,
+            });
+        }
+    };
+    // Resolve the start tet's exit link.
+    let link = Link(st.link);
+    if let Some(n) = link.as_tet() {
+        let entry_raw = st.tet;
+        return Ok(Lane {
+            proj,
+            st,
+            next: n,
+            entry_raw,
+        });
+    }
+    match resolve_face(mesh, ray, &st, link) {
+        Resolved::Done(out) => Err(out),
+        Resolved::Cross(n) => {
+            let entry_raw = st.link;
+            Ok(Lane {
+                proj,
+                st,
+                next: n,
+                entry_raw,
+            })
+        }
+    }
+}
+
+enum Resolved {
+    Done(TraceOutcome),
+    Cross(u32),
+}
+
+/// A non-tet link was reached: boundary (miss), or a constrained face (hit,
+/// miss beyond `t_max`, or crossing when before `t_min`).
+#[inline(never)]
+fn resolve_face<P: Projection>(mesh: &TetMesh, ray: &Ray, st: &State<P>, link: Link) -> Resolved {
+    let Some(c) = link.as_constrained() else {
+        return Resolved::Done(TraceOutcome::Miss {
+            tets_visited: st.visited,
+        });
+    };
+    let cf = &mesh.constrained[c as usize];
+    let (t, w) = face_hit(mesh, ray, st.ids);
+    if t < ray.t_min as f64 {
+        return match cf.other_side(st.tet) {
+            Some(s) if s.exists() => Resolved::Cross(s.tet),
+            _ => Resolved::Done(TraceOutcome::Miss {
+                tets_visited: st.visited,
+            }),
+        };
+    }
+    if t > ray.t_max as f64 {
+        return Resolved::Done(TraceOutcome::Miss {
+            tets_visited: st.visited,
+        });
+    }
+    let mut bary = [0f32; 3];
+    for (k, &vk) in cf.vertices.iter().enumerate() {
+        let j = st.ids.iter().position(|&x| x == vk).unwrap_or(k);
+        bary[k] = w[j] as f32;
+    }
+    let far = cf.other_side(st.tet).map_or(NO_TET, |s| s.tet);
+    Resolved::Done(TraceOutcome::Hit(Hit {
+        triangle: cf.triangle,
+        face: c,
+        t: t as f32,
+        barycentrics: bary,
+        tet: st.tet,
+        far_tet: far,
+        tets_visited: st.visited,
+    }))
+}
+
+/// Ray parameter and barycentrics (w.r.t. `ids`) of the line's crossing with
+/// triangle `ids`, in f64 (computed once per ray, at the hit).
+pub fn face_hit(mesh: &TetMesh, ray: &Ray, ids: [u32; 3]) -> (f64, [f64; 3]) {
+    let o = ray.origin.as_dvec3();
+    let d = ray.direction.as_dvec3();
+    let q = ids.map(|i| mesh.points[i as usize].as_dvec3() - o);
+    let w = [
+        d.dot(q[1].cross(q[2])),
+        d.dot(q[2].cross(q[0])),
+        d.dot(q[0].cross(q[1])),
+    ];
+    let sum = w[0] + w[1] + w[2];
+    let w = if sum != 0.0 && sum.is_finite() {
+        w.map(|x| x / sum)
+    } else {
+        [1.0 / 3.0; 3]
+    };
+    let hit = q[0] * w[0] + q[1] * w[1] + q[2] * w[2];
+    (hit.dot(d) / d.length_squared(), w)
+}
+
+/// The hot loop body: enter `lane.next` through the face `lane.st.ids`
+/// (raw back-link `lane.entry_raw`), choose the exit face, follow its link.
+/// `Some` when the walk ended.
+#[inline(always)]
+pub fn step<P: Projection, T: Topology>(
+    mesh: &TetMesh,
+    topo: &T,
+    ray: &Ray,
+    lane: &mut Lane<P>,
+    cap: u32,
+) -> Option<TraceOutcome> {
+    let st = &mut lane.st;
+    if st.visited >= cap {
+        return Some(TraceOutcome::Failed {
+            failure: Failure::StepCap,
+            tets_visited: st.visited,
+        });
+    }
+    let next = lane.next;
+    let d = st.ids[0] ^ st.ids[1] ^ st.ids[2] ^ topo.vx(next);
+    let Some(&pd3) = mesh.points.get(d as usize) else {
+        return Some(TraceOutcome::Failed {
+            failure: Failure::Lost,
+            tets_visited: st.visited,
+        });
+    };
+    let pd = lane.proj.project(pd3);
+    let slot = exit_slot(&lane.proj, &st.p, &st.ids, pd, d);
+    let exiting = st.ids[slot];
+    let raw = topo.exit_link(next, st.ids, d, exiting, lane.entry_raw);
+    // Branch-free replacement (no variable-indexed store to the stack).
+    for k in 0..3 {
+        let hit = slot == k;
+        st.ids[k] = if hit { d } else { st.ids[k] };
+        st.p[k] = if hit { pd } else { st.p[k] };
+    }
+    st.tet = next;
+    st.link = raw;
+    st.visited += 1;
+    if raw < Link::BOUNDARY.0 {
+        lane.entry_raw = next;
+        lane.next = raw;
+        return None;
+    }
+    match resolve_face(mesh, ray, st, Link(raw)) {
+        Resolved::Done(out) => Some(out),
+        Resolved::Cross(n) => {
+            lane.entry_raw = raw;
+            lane.next = n;
+            None
+        }
+    }
+}
+
+/// Default step cap for a mesh: `2 × tets + 1024`, at most
+/// [`DEFAULT_STEP_CAP`] (a straight walk never visits a tet twice).
+pub fn step_cap(mesh: &TetMesh) -> u32 {
+    (2 * mesh.tets.len() as u64 + 1024).min(DEFAULT_STEP_CAP as u64) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tet_core::synthetic::SplitMix64;
+
+    fn rnd(rng: &mut SplitMix64) -> f32 {
+        // Wide dynamic range, with exact repeats and zeros.
+        match rng.next_u64() % 8 {
+            0 => 0.0,
+            1 => 1.0,
+            _ => rng.range_f32(-1.0, 1.0) * 2f32.powi((rng.next_u64() % 20) as i32 - 10),
+        }
+    }
+
+    #[test]
+    fn edge_test_is_exactly_antisymmetric_with_ties() {
+        let mut rng = SplitMix64(3);
+        let ray = Ray::new(Vec3::new(0.1, 0.2, 0.3), Vec3::new(0.3, -0.5, 0.8));
+        let p32 = DuffF32::setup(&ray);
+        let p64 = DuffF64::setup(&ray);
+        let pt = TripleF32::setup(&ray);
+        for i in 0..20000u32 {
+            let a = Vec2::new(rnd(&mut rng), rnd(&mut rng));
+            let b = if i % 3 == 0 {
+                a * 2.0
+            } else {
+                Vec2::new(rnd(&mut rng), rnd(&mut rng))
+            };
+            assert_ne!(p32.left(a, 1, b, 2), p32.left(b, 2, a, 1), "{a:?} {b:?}");
+            let (ad, bd) = (a.as_dvec2(), b.as_dvec2());
+            assert_ne!(p64.left(ad, 1, bd, 2), p64.left(bd, 2, ad, 1));
+            let a3 = Vec3::new(a.x, a.y, rnd(&mut rng));
+            let b3 = if i % 5 == 0 {
+                a3
+            } else {
+                Vec3::new(b.x, b.y, rnd(&mut rng))
+            };
+            assert_ne!(pt.left(a3, 7, b3, 9), pt.left(b3, 9, a3, 7));
+        }
+    }
+
+    #[test]
+    fn tie_rule_matches_a_perturbed_origin() {
+        // det = 0 with a.y > b.y: the origin moved by (ε, ε²) is left of a→b.
+        let p = DuffF32::setup(&Ray::new(Vec3::ZERO, Vec3::Z));
+        let (a, b) = (Vec2::new(0.0, 1.0), Vec2::new(0.0, -1.0));
+        let eps = 1e-3f64;
+        let exact = (b.x as f64 - a.x as f64) * (eps * eps - a.y as f64)
+            - (b.y as f64 - a.y as f64) * (eps - a.x as f64);
+        assert_eq!(p.left(a, 5, b, 6), exact > 0.0);
+    }
+
+    #[test]
+    fn exit_table_is_algorithm_1() {
+        for i in 0..8usize {
+            let (sa, sb, sc) = (i & 1 != 0, i & 2 != 0, i & 4 != 0);
+            let alg1 = if sa {
+                if sb { 0 } else { 2 }
+            } else if sc {
+                1
+            } else {
+                0
+            };
+            assert_eq!(EXIT_SLOT[i] as usize, alg1, "case {i}");
+        }
+    }
+
+    #[test]
+    fn basis_is_right_handed_around_the_direction() {
+        let mut rng = SplitMix64(8);
+        for _ in 0..1000 {
+            let d = crate::reference::random_direction(&mut rng)
+                .as_dvec3()
+                .normalize();
+            let (u, v) = duff_basis(d);
+            assert!((u.cross(v) - d).length() < 1e-9);
+            assert!(u.dot(d).abs() < 1e-12 && v.dot(d).abs() < 1e-12);
+        }
+        for d in [DVec3::Z, -DVec3::Z, DVec3::X, -DVec3::Y] {
+            let (u, v) = duff_basis(d);
+            assert!((u.cross(v) - d).length() < 1e-12);
+        }
+    }
+}

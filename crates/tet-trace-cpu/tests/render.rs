@@ -1,0 +1,101 @@
+//! The renderer against the brute-force reference, pixel by pixel.
+
+use glam::Vec3;
+use tet_core::scene::{Camera, PointLight};
+use tet_core::synthetic::{GridSpec, kuhn_grid};
+use tet_trace_cpu::DuffF32;
+use tet_trace_cpu::reference::{closest_hit, grazes_an_edge};
+use tet_trace_cpu::render::{PinholeCamera, RenderOptions, render};
+use tet_trace_cpu::tet20::Tet20Tracer;
+
+#[test]
+fn frame_matches_reference_and_writes_png() {
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [6, 6, 6],
+        jitter: 0.1,
+        shell: Some(([2; 3], [4; 3])),
+        seed: 5,
+        ..Default::default()
+    });
+    let tracer = Tet20Tracer::<DuffF32>::new(&mesh).unwrap();
+    let camera = Camera {
+        position: Vec3::new(0.6, 1.1, 5.4),
+        target: Vec3::splat(3.0),
+        up: Vec3::Y,
+        vfov_deg: 45.0,
+    };
+    let lights = [PointLight {
+        position: Vec3::new(1.0, 5.5, 5.0),
+        color: Vec3::ONE,
+        intensity: 1.0,
+    }];
+    let opts = RenderOptions {
+        width: 40,
+        height: 30,
+        shadows: true,
+        ..Default::default()
+    };
+    let frame = render(&tracer, &camera, &lights, &opts).unwrap();
+    assert_eq!(frame.stats.rays, 1200);
+    assert_eq!(frame.stats.failures, 0);
+    let hits = frame.triangle.iter().filter(|&&t| t != u32::MAX).count() as u64;
+    assert_eq!(frame.stats.hits, hits);
+    assert!(
+        hits > 100 && hits < 1200,
+        "the shell covers part of the view: {hits}"
+    );
+    assert_eq!(
+        frame.stats.tets_visited,
+        frame.tets.iter().map(|&t| t as u64).sum::<u64>()
+    );
+
+    // Independent: brute-force hit per pixel from the same camera model.
+    let cam = PinholeCamera::new(&camera, 40, 30, false);
+    let mut compared = 0;
+    for j in 0..30 {
+        for i in 0..40 {
+            let ray = cam.ray(i, j);
+            if grazes_an_edge(&mesh, &ray, 1e-3) {
+                continue;
+            }
+            let want = closest_hit(&mesh, &ray).map_or(u32::MAX, |h| h.triangle);
+            assert_eq!(
+                frame.triangle[(j * 40 + i) as usize],
+                want,
+                "pixel ({i}, {j})"
+            );
+            compared += 1;
+        }
+    }
+    assert!(compared > 1000);
+    // Centre pixel direction follows the scenes.json convention (i = W/2 is
+    // exactly forward, no half-pixel offset).
+    let centre = cam.ray(20, 15).direction;
+    assert!((centre - (camera.target - camera.position).normalize()).length() < 1e-6);
+
+    let dir = std::env::temp_dir().join(format!("tet-trace-cpu-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("frame.png");
+    frame.save_png(&path).unwrap();
+    frame.save_heatmap(&dir.join("heat.png"), None).unwrap();
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
+    let reader = decoder.read_info().unwrap();
+    assert_eq!((reader.info().width, reader.info().height), (40, 30));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn camera_outside_the_mesh_is_an_error() {
+    let mesh = kuhn_grid(&GridSpec::default());
+    let tracer = Tet20Tracer::<DuffF32>::new(&mesh).unwrap();
+    let camera = Camera {
+        position: Vec3::splat(10.0),
+        ..Default::default()
+    };
+    let opts = RenderOptions {
+        width: 4,
+        height: 4,
+        ..Default::default()
+    };
+    assert!(render(&tracer, &camera, &[], &opts).is_err());
+}
