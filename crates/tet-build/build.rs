@@ -138,15 +138,16 @@ fn from_cargo_metadata() -> Result<PathBuf, String> {
         .as_array()
         .ok_or("no packages in cargo metadata")?;
     for p in packages {
-        if p["name"] == "tritet" && p["version"] == TRITET_VERSION {
-            if let Some(m) = p["manifest_path"].as_str() {
-                let dir = Path::new(m)
-                    .parent()
-                    .unwrap_or(Path::new("."))
-                    .join("c_code");
-                if has_sources(&dir) {
-                    return Ok(dir);
-                }
+        if p["name"] == "tritet"
+            && p["version"] == TRITET_VERSION
+            && let Some(m) = p["manifest_path"].as_str()
+        {
+            let dir = Path::new(m)
+                .parent()
+                .unwrap_or(Path::new("."))
+                .join("c_code");
+            if has_sources(&dir) {
+                return Ok(dir);
             }
         }
     }

@@ -37,7 +37,7 @@ pub enum Command {
 }
 
 /// How to build a mesh from a scene.
-#[derive(Debug, Clone, Args)]
+#[derive(Debug, Clone, Copy, Args)]
 pub struct BuildFlags {
     /// TetGen quality bound (radius-edge ratio, `-q`); off by default (`-pY` only).
     #[arg(long)]
@@ -104,15 +104,6 @@ pub enum Method {
 }
 
 impl Method {
-    /// The tet-walking methods.
-    pub const TET: [Method; 5] = [
-        Method::Sctp,
-        Method::Tet80,
-        Method::Tet32,
-        Method::Tet20,
-        Method::Tet16,
-    ];
-
     /// Name as on the command line.
     pub fn name(self) -> &'static str {
         match self {
@@ -181,9 +172,13 @@ pub struct AccuracyArgs {
     /// Methods to check (comma separated) or `all`.
     #[arg(long, default_value = "all")]
     pub methods: String,
-    /// Number of random rays (in addition to the camera rays' sample).
+    /// Random rays from interior points (in addition to the camera image).
     #[arg(long, default_value_t = 100_000)]
     pub rays: usize,
+    /// Side of the square camera image whose primary rays are checked
+    /// (Maria et al. count failures per 1024² image).
+    #[arg(long, default_value_t = 1024)]
+    pub image: u32,
     /// Random seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,

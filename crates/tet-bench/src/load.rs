@@ -92,6 +92,11 @@ pub fn load(spec: &str, flags: &BuildFlags, quiet: bool) -> Result<Loaded> {
         });
     }
     let scene = Scene::load(spec).with_context(|| format!("cannot load scene `{spec}`"))?;
+    from_scene(scene, flags, quiet)
+}
+
+/// Builds a loaded scene.
+pub fn from_scene(scene: Scene, flags: &BuildFlags, quiet: bool) -> Result<Loaded> {
     let (mesh, build) = build_scene(&scene, flags, quiet)?;
     let camera = scene.camera.unwrap_or_else(|| framing_camera(&mesh));
     let lights = if scene.lights.is_empty() {
@@ -109,10 +114,29 @@ pub fn load(spec: &str, flags: &BuildFlags, quiet: bool) -> Result<Loaded> {
     })
 }
 
+/// The enclosing box: scene, camera and lights grown by 10 % of the largest
+/// extent on every side, so that primary and shadow rays start inside the mesh.
 #[cfg(feature = "tetgen")]
-fn build_scene(scene: &Scene, flags: &BuildFlags, quiet: bool) -> Result<(TetMesh, BuildSummary)> {
+fn enclosing_box(scene: &Scene) -> tet_build::bbox::BoxSpec {
+    let mut pts: Vec<Vec3> = scene.vertices.clone();
+    if let Some(c) = scene.camera {
+        pts.push(c.position);
+    }
+    pts.extend(scene.lights.iter().map(|l| l.position));
+    let (min, max) = pts
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(*p), b.max(*p)));
+    let margin = ((max - min).max_element() * 0.1).max(1e-3 * max.abs().max(min.abs()).max_element()).max(1e-6);
+    tet_build::bbox::BoxSpec::Fixed {
+        min: min - Vec3::splat(margin),
+        max: max + Vec3::splat(margin),
+    }
+}
+
+/// Builds a scene's mesh (TetGen in a worker process), Hilbert-sorted unless `--no-sort`.
+#[cfg(feature = "tetgen")]
+pub fn build_scene(scene: &Scene, flags: &BuildFlags, quiet: bool) -> Result<(TetMesh, BuildSummary)> {
     use std::sync::Arc;
-    use tet_build::bbox::BoxSpec;
     use tet_build::pipeline::{BuildOptions, build};
     use tet_build::tetgen::{Isolation, WorkerCommand};
 
@@ -132,7 +156,7 @@ fn build_scene(scene: &Scene, flags: &BuildFlags, quiet: bool) -> Result<(TetMes
             args: vec!["tetgen-worker".into()],
             timeout: Some(Duration::from_secs_f64(flags.time_limit.max(0.001))),
         }),
-        enclosing_box: (!flags.no_box).then(BoxSpec::default),
+        enclosing_box: (!flags.no_box).then(|| enclosing_box(scene)),
         progress: Some(Arc::new(move |p: &tet_build::pipeline::Progress| {
             pb.set_message(format!("building {name}: {:?}", p.stage));
         })),
@@ -171,8 +195,9 @@ fn build_scene(scene: &Scene, flags: &BuildFlags, quiet: bool) -> Result<(TetMes
     Ok((mesh, summary))
 }
 
+/// Without TetGen, scenes cannot be built.
 #[cfg(not(feature = "tetgen"))]
-fn build_scene(scene: &Scene, _: &BuildFlags, _: bool) -> Result<(TetMesh, BuildSummary)> {
+pub fn build_scene(scene: &Scene, _: &BuildFlags, _: bool) -> Result<(TetMesh, BuildSummary)> {
     bail!(
         "`{}` is a scene, but this tet-bench was built without the `tetgen` feature: \
          pass a .{MESH_EXTENSION} mesh file instead",

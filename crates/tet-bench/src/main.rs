@@ -1,10 +1,17 @@
 //! `tet-bench`: the user-facing command-line tool and benchmark harness.
 //! See the README for every subcommand and the `--json` schema.
 
+mod accuracy;
 mod build;
+mod brute;
+mod bvh;
 mod cli;
+mod extremes;
 mod info;
 mod load;
+mod methods;
+mod render;
+mod tables;
 
 use std::process::ExitCode;
 
@@ -17,9 +24,9 @@ fn main() -> ExitCode {
         Command::TetgenWorker => return tetgen_worker(),
         Command::Build(a) => build::run(a, cli.json),
         Command::Info(a) => info::run(a, cli.json),
-        Command::Render(_) | Command::Accuracy(_) | Command::Tables(_) => {
-            Err(anyhow::anyhow!("not available in this build"))
-        }
+        Command::Render(a) => render::run(a, cli.json),
+        Command::Accuracy(a) => accuracy::run(a, cli.json),
+        Command::Tables(a) => tables::run(a, cli.json),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

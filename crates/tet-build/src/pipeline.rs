@@ -171,7 +171,8 @@ pub struct BuildReport {
     pub switches: String,
     /// Stage times.
     pub times: StageTimes,
-    /// Peak resident memory (VmHWM, KiB): this process, and the worker's when isolated.
+    /// Peak resident memory (VmHWM, KiB) of this process since it started
+    /// (not only this build), or of the worker when that is larger.
     pub peak_memory_kib: Option<u64>,
     /// The isolated worker's peak resident memory (KiB), when isolated.
     pub worker_peak_memory_kib: Option<u64>,
@@ -365,7 +366,7 @@ pub fn build(scene: &Scene, options: &BuildOptions) -> Result<(TetMesh, BuildRep
             .map(|p| p.as_dvec3().to_array())
             .filter(|p| known.binary_search(&key64(*p)).is_err())
             .collect();
-        extra.sort_by(|a, b| key64(*a).cmp(&key64(*b)));
+        extra.sort_by_key(|p| key64(*p));
         extra.dedup_by(|a, b| key64(*a) == key64(*b));
         input.points.extend(extra);
     };

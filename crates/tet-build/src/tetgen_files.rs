@@ -119,6 +119,9 @@ fn read_text(path: &Path) -> Result<String, FilesError> {
     })
 }
 
+/// A data line: its 1-based number and its fields.
+type Record<'t> = (usize, Vec<&'t str>);
+
 /// Parses records after the header: checks the count and consecutive
 /// indices, returns the numbering base (index of the first record) and each
 /// record's fields after the index.
@@ -127,7 +130,7 @@ fn records<'t>(
     lines: &mut dyn Iterator<Item = (usize, Vec<&'t str>)>,
     count: usize,
     min_fields: usize,
-) -> Result<(i64, Vec<(usize, Vec<&'t str>)>), FilesError> {
+) -> Result<(i64, Vec<Record<'t>>), FilesError> {
     let mut base = 0i64;
     let mut out = Vec::with_capacity(count);
     for k in 0..count {

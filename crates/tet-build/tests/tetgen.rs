@@ -258,6 +258,17 @@ fn rejected_before_tetgen() {
         run(flat, vec![[0, 1, 2], [1, 3, 2]]),
         Err(TetgenError::FlatInput)
     );
+    // Tilted plane x + y + z = 1 (exactly representable points): also flat.
+    let tilted = vec![
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.25, 0.25, 0.5],
+    ];
+    assert_eq!(
+        run(tilted, vec![[0, 1, 2], [0, 3, 1]]),
+        Err(TetgenError::FlatInput)
+    );
 }
 
 #[test]
@@ -282,7 +293,9 @@ fn near_parallel_pair(gap: f64) -> TetgenInput {
     let (mut p, mut t) = cube([-2.0; 3], 4.0);
     let b = p.len() as u32;
     p.extend([[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]]);
-    p.extend([[-1.0, -1.0, gap], [1.0, -1.0, gap], [0.0, 1.0, 2.0 * gap]]);
+    // The upper triangle is the lower one turned by 180°: their edges cross
+    // in projection, so refinement squeezes tets between them.
+    p.extend([[-1.0, 1.0, gap], [1.0, 1.0, gap], [0.0, -1.0, 2.0 * gap]]);
     t.push([b, b + 1, b + 2]);
     t.push([b + 3, b + 4, b + 5]);
     TetgenInput::with_index_markers(p, t)
@@ -293,8 +306,9 @@ fn near_parallel_pair_with_quality_is_capped_by_steiner_limit() {
     // Two nearly parallel triangles 1e-6 apart inside a box: -q may refine
     // without end between them; -S caps the Steiner points.
     let options = TetgenOptions {
-        quality: Some(1.5),
+        quality: Some(1.1),
         max_steiner: Some(2000),
+        preserve_surface: false,
         ..TetgenOptions::default()
     };
     let start = std::time::Instant::now();
@@ -314,10 +328,13 @@ fn near_parallel_pair_with_quality_is_capped_by_steiner_limit() {
 
 #[test]
 fn near_parallel_pair_with_uncapped_quality_returns_within_the_limit() {
-    // Without -S: either TetGen finishes, fails with a typed error, or the
-    // worker is killed at the 3 s limit — the call returns in every case.
+    // Without -S (and without -Y, so TetGen may split the facets) -q keeps
+    // refining between the two facets (observed: still running after 3 s,
+    // while the capped run above takes milliseconds). The worker is killed
+    // at the 3 s limit; a typed TetGen error would also be acceptable.
     let options = TetgenOptions {
         quality: Some(1.1),
+        preserve_surface: false,
         ..TetgenOptions::default()
     };
     let start = std::time::Instant::now();

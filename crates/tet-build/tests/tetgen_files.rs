@@ -44,9 +44,9 @@ fn node_ele_face_neigh_round_trip() {
     // Neighbours written: across constrained faces too, the real tet.
     let n = files.neighbors.as_ref().unwrap();
     for (t, row) in n.iter().enumerate() {
-        for k in 0..4 {
+        for (k, &got) in row.iter().enumerate() {
             let expect = mesh.across(t as u32, k).map_or(-1, |s| s.tet as i32);
-            assert_eq!(row[k], expect);
+            assert_eq!(got, expect);
         }
     }
 }

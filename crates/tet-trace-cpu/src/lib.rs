@@ -5,10 +5,10 @@
 //! crosses a constrained face (a scene triangle).
 //!
 //! * [`ray`]: [`Ray`], [`Hit`], [`TraceOutcome`] (hit / miss / reported failure);
-//! * [`locate`]: exact point location (seed 000 §4.2);
+//! * [`mod@locate`]: exact point location (seed 000 §4.2);
 //! * [`walk`]: the watertight traversal engine and its projections;
 //! * kernels, one per method: [`sctp`], [`tet32`], [`tet20`], [`tet16`], [`tet80`];
-//! * [`reference`]: f64 brute-force closest hit and ray generators for tests;
+//! * [`mod@reference`]: f64 brute-force closest hit and ray generators for tests;
 //! * [`render`]: pinhole renderer, Lambert shading, PNG, heat maps, stats;
 //! * [`secondary`]: shadow, reflection and refraction rays (seed 000 §6).
 

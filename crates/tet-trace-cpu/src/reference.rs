@@ -4,12 +4,13 @@
 //!
 //! The brute force is independent of the walk: it never looks at tets or
 //! links, only at [`TetMesh::constrained`] and [`TetMesh::points`]. Its
-//! ray–triangle test is watertight in the orientation sense: with
-//! `qᵢ = Pᵢ − o`, the edge functions `d · (qᵢ × qⱼ)` are evaluated in f64
-//! (on f32 inputs) and a point on a shared edge counts for both triangles
-//! (closed triangles), so no ray slips through a closed surface; ties between
-//! triangles at equal `t` are reported via [`RefHit::edge_distance`], which
-//! tests use to skip ambiguous rays.
+//! ray–triangle test uses the orientation form: with `qᵢ = Pᵢ − o`, the edge
+//! functions `d · (qᵢ × qⱼ)` are evaluated in f64 (on f32 inputs) and
+//! triangles are closed (a point on a shared edge counts for both), so no
+//! ray slips through a closed surface. Rays whose answer depends on rounding
+//! (passing within a tolerance of a triangle edge, see [`grazes_an_edge`];
+//! two hits at nearly equal `t`, see [`RefHit::t_gap`]) are what tests skip
+//! when they compare kernels with the reference.
 
 use glam::{DVec3, Vec3};
 use tet_core::TetMesh;

@@ -5,14 +5,21 @@
 //! The ray passes left of edge `a → b` when `d · ((Pa − o) × (Pb − o)) > 0`
 //! (a scalar triple product, [`TripleF32`]); Lagae & Dutré need 3–6 of them
 //! per tet without the entry face. Using the entry face (whose three edge
-//! signs are known from the previous tet), the exit face needs exactly two
+//! signs are known from the previous tet), the exit face needs two
 //! (Algorithm 1 of seed 000 on the triple-product signs, the same decision
-//! procedure as the 2-D walk): per step one 12-byte point load, 3
-//! subtractions, two triple products (2 × (6 mul + 3 sub) + 2 × (3 mul + 2
-//! add)), and the link of the exit vertex's slot. The original neptun ScTP
-//! ignored the entry face; this one does not. Zero is decided by the
-//! vertex-index rule, so the walk is watertight in the sense of
-//! [`crate::walk`].
+//! procedure as the 2-D walk; the engine evaluates a third one to stay
+//! branch-free, see [`crate::walk::exit_slot`]): per step one 12-byte point
+//! load, 3 subtractions, three triple products (each 6 mul + 3 sub for the
+//! cross product, 3 mul + 2 add for the dot), and the link of the exit
+//! vertex's slot. The original neptun ScTP
+//! ignored the entry face; this one does not. Zero is decided by an
+//! antisymmetric tie rule ([`TripleF32`]), so every edge gets one answer in
+//! every tet; but `d · (q × q')` cancels catastrophically when the ray passes
+//! near a vertex (both `q` are nearly parallel to `d`), so the f32 answers
+//! are not realisable by any line there: rays aimed at vertices can end on a
+//! wrong face or loop to the step cap (reported as a failure). The 2-D
+//! projection removes the `d` component before multiplying and does not
+//! suffer from this (see the robustness census in `tests/robustness.rs`).
 
 use tet_core::TetMesh;
 use tet_core::layout::{Baseline32Mesh, LayoutError};

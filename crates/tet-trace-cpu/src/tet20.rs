@@ -4,8 +4,10 @@
 //! rank of their opposite vertex id (20 bytes). Per step (operation count of
 //! the paper): one 4-byte load of `VX^next`, 3 xors for `idx₃`, one 12-byte
 //! point load, the projection (f32: 3 subtractions, 6 multiplications, 4
-//! additions), the exit face by Algorithm 1 (two 2-D determinants: 4
-//! multiplications, 2 subtractions, 2 comparisons, see [`crate::walk`]), the
+//! additions), the exit face by Algorithm 1 (the paper's two 2-D
+//! determinants, 4 multiplications and 2 comparisons, are evaluated here as
+//! three branch-free determinants plus an 8-entry table, see
+//! [`crate::walk::exit_slot`]), the
 //! rank `order_a` of the exit vertex among the four ids (4 comparisons) and
 //! one 4-byte link load `N_{order_a}` (Algorithm 5).
 //!

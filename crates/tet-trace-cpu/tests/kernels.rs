@@ -174,11 +174,18 @@ fn batches_equal_single_rays() {
     let rays: Vec<Ray> = (0..203)
         .map(|i| match i % 3 {
             0 => Ray::new(origin, tet_trace_cpu::reference::random_direction(&mut rng)),
-            1 => Ray::new(origin, mesh.points[(rng.next_u64() % mesh.points.len() as u64) as usize] - origin),
+            1 => Ray::new(
+                origin,
+                mesh.points[(rng.next_u64() % mesh.points.len() as u64) as usize] - origin,
+            ),
             _ => Ray::new(origin, Vec3::ZERO), // invalid: reported, not traced
         })
         .collect();
-    for t in all_f32(&mesh).iter().chain(others(&mesh).iter()).chain(lenient(&mesh).iter()) {
+    for t in all_f32(&mesh)
+        .iter()
+        .chain(others(&mesh).iter())
+        .chain(lenient(&mesh).iter())
+    {
         let mut out = vec![TraceOutcome::Miss { tets_visited: 0 }; rays.len()];
         t.trace_batch(&rays, Start::Tet(start), &mut out);
         for (r, o) in rays.iter().zip(&out) {

@@ -1,1 +1,181 @@
-//! placeholder
+//! # tet-trace-gpu
+//!
+//! Ray traversal through a constrained tetrahedralization as portable
+//! [`wgpu`] compute shaders (WGSL): one invocation walks one ray from tet to
+//! tet until it crosses a constrained face (a scene triangle) or leaves the
+//! mesh. Runs on any adapter wgpu's Vulkan backend finds, including the
+//! software rasteriser lavapipe (Debian package `mesa-vulkan-drivers`), which
+//! is what the tests use on machines without a GPU.
+//!
+//! * [`GpuContext`]: adapter + device, with the adapter's highest limits and
+//!   timestamp queries when available;
+//! * [`GpuTracer`]: a mesh uploaded in one compact layout ([`GpuLayout`]:
+//!   Tet20, Tet32, Tet16) with its kernel; [`GpuTracer::trace_batch`] traces
+//!   arbitrary rays (secondary rays from the CPU side), [`GpuTracer::render`]
+//!   generates camera rays on the GPU;
+//! * results are [`tet_trace_cpu::TraceOutcome`]s (the CPU hit records, same
+//!   meaning field by field) plus [`DispatchStats`].
+//!
+//! ## The kernels: a port of the CPU walk (seed 000, Algorithms 1–7)
+//!
+//! `src/walk.wgsl` is a statement-by-statement port of
+//! `tet_trace_cpu::walk::step` with the `DuffF32` projection (see that
+//! module's docs for the watertightness argument); each layout appends its
+//! `layout_vx` / `layout_exit` functions (ports of the CPU `Topology`
+//! implementations: Tet32 Algorithm 3 compares the exit vertex with the three
+//! stored ids, Tet20 Algorithm 5 indexes the rank-ordered links, Tet16
+//! Algorithm 7 xors the carried entry link with two `NX` differences). The
+//! Tet80 Plücker walk of Maria et al. has no GPU kernel yet.
+//!
+//! | paper (seed 000) | CPU (`tet-trace-cpu`) | WGSL |
+//! |---|---|---|
+//! | `idx_0..2`, `p_0..2` | `State::ids`, `State::p` | `s_ids`, `s_p` |
+//! | `VX^next`, `idx_3 = idx_0 ⊕ idx_1 ⊕ idx_2 ⊕ VX` | `Topology::vx` | `layout_vx`, `d` |
+//! | projection onto `(u, v)` ⊥ ray | `DuffF32::project` | `project` |
+//! | Algorithm 1 (exit face) | `exit_slot`, `EXIT_SLOT` | `exit_slot` (table packed in a `u32`) |
+//! | GETNEXTTET32/20/16 (Alg. 3, 5, 7) | `Topology::exit_link` | `layout_exit` |
+//! | `order_a`, `order_b` | `rank_of` | `rank_of` |
+//! | entry link (Tet16) | `Lane::entry_raw` | `s_entry` |
+//! | tie rule (symbolic perturbation) | `left_2d!` | `left` |
+//! | constrained-face crossing / hit | `resolve_face`, `face_hit` | `resolve` |
+//!
+//! GPU buffers: points (`12 B` each, `f32 x,y,z`), the layout's tet records
+//! (Tet20 `20 B`: `VX` + four links in rank order; Tet32 `32 B`; Tet16
+//! `16 B`), and a 24-byte constrained-face record
+//! (`triangle, front tet, back tet, v0, v1, v2`) that the kernel needs to
+//! report the triangle, to order the barycentrics like the CPU and to cross
+//! faces before `t_min` (secondary rays). Normals and other attributes stay
+//! on the host ([`GpuMemory`] reports the bytes).
+//!
+//! ## Where the GPU may differ from the CPU kernel
+//!
+//! * **Edge test.** The CPU computes `det = a.x·b.y − a.y·b.x` and tests its
+//!   sign. WGSL gives no control over fused multiply-add contraction, and a
+//!   fused `fma(a.x, b.y, −a.y·b.x)` is *not* exactly antisymmetric, which would
+//!   break watertightness. The kernel therefore compares the two rounded
+//!   products, `a.x·b.y > a.y·b.x`: for finite values `fl(l − r) > 0 ⇔ l > r`
+//!   (gradual underflow), so this is the CPU decision bit for bit, and no
+//!   contraction can apply (there is no addition). Differences only when a
+//!   product overflows to ±∞ or underflows into a subnormal on an adapter that
+//!   flushes subnormals to zero (coordinates beyond `~1e19` or below `~1e-19`
+//!   relative to the ray origin).
+//! * **Projection.** `u·(P − o)` is written as the CPU's left-to-right sum
+//!   (`u.x q.x + u.y q.y + u.z q.z`), but a driver may contract it into FMAs.
+//!   The walk stays watertight (every tet sees the same projected vertex,
+//!   because it is the same pure function in the same shader), but the
+//!   projected values, hence rare near-tie decisions, may differ from the CPU.
+//!   The tests measure how often (`tests/tet20.rs` prints the counts).
+//! * **Projection basis.** For [`GpuTracer::trace_batch`] the host builds Duff
+//!   et al.'s basis in f64 and rounds it to f32, exactly as the CPU does, and
+//!   uploads it with the ray. Camera rays made on the GPU
+//!   ([`GpuTracer::render`]) build it in f32 (no portable f64 in WGSL), and the
+//!   ray directions themselves may differ in the last bit (Vulkan allows
+//!   inexact `sqrt` and division); camera images therefore agree with the CPU
+//!   renderer per triangle except on rays that graze an edge.
+//! * **Hit point.** The CPU computes `t` and barycentrics once per ray in f64;
+//!   the kernel does it in f32 (same formula). They agree to f32 rounding, and
+//!   the decision `t < t_min` (cross a constrained face before the ray's start
+//!   interval) can differ when `t` is within rounding of `t_min`.
+//! * **Start.** For batch rays the host runs the CPU's exact start logic
+//!   (`tet_trace_cpu::walk::start_exit_face`: start tet, the tets around an
+//!   origin on a face/edge/vertex, last-resort fallback) and uploads the
+//!   resulting exit face, so the GPU starts exactly where the CPU starts.
+//!   Camera rays start on the GPU in the one start tet (`start_in_tet`); the
+//!   few rays whose origin lies on that tet's boundary so that no face winds
+//!   around it are re-traced through the batch path (CPU-generated rays).
+//!
+//! ## Limits
+//!
+//! Every storage buffer must fit the device's `max_storage_buffer_binding_size`
+//! and `max_buffer_size`. [`GpuContext`] requests the adapter's highest limits
+//! (e.g. 128 MiB bindings on lavapipe, up to 2–4 GiB on hardware); a mesh array
+//! that does not fit gives [`GpuError::TooLarge`] naming the buffer and the
+//! limit. Ray batches and camera frames are split into as many dispatches as
+//! the limits (and the 65 535-workgroup dispatch limit) require. Splitting one
+//! mesh array across several bindings is not implemented.
+//!
+//! ## Timing
+//!
+//! With `Features::TIMESTAMP_QUERY` every dispatch is bracketed by timestamp
+//! writes and [`DispatchStats::gpu_ms`] holds the summed GPU time; wall time
+//! (submit to results on the host) is always in [`DispatchStats::wall_ms`].
+
+#![deny(missing_docs)]
+
+mod context;
+mod tracer;
+
+pub use context::{GpuContext, GpuOptions, REQUIRE_ADAPTER_ENV};
+pub use tracer::{DispatchStats, GpuFrame, GpuLayout, GpuMemory, GpuTracer};
+
+use thiserror::Error;
+
+/// Everything that can go wrong on the GPU path; each variant names what
+/// failed.
+#[derive(Debug, Error)]
+pub enum GpuError {
+    /// No adapter (GPU or software) could be obtained.
+    #[error("no wgpu adapter available: {reason}")]
+    NoAdapter {
+        /// What wgpu reported.
+        reason: String,
+    },
+    /// The adapter refused to create a device.
+    #[error("could not create a wgpu device on {adapter}: {reason}")]
+    Device {
+        /// Adapter name.
+        adapter: String,
+        /// What wgpu reported.
+        reason: String,
+    },
+    /// A buffer exceeds one of the device limits.
+    #[error(
+        "{buffer}: {bytes} bytes exceed the device limit {limit} = {value} bytes \
+         (splitting a mesh array over several bindings is not implemented)"
+    )]
+    TooLarge {
+        /// Which buffer ("tet20 records", "points", ...).
+        buffer: &'static str,
+        /// Its size in bytes.
+        bytes: u64,
+        /// Name of the wgpu limit (`max_storage_buffer_binding_size`, ...).
+        limit: &'static str,
+        /// The limit's value.
+        value: u64,
+    },
+    /// The mesh could not be encoded in the layout.
+    #[error(transparent)]
+    Layout(#[from] tet_core::layout::LayoutError),
+    /// More elements than the kernel's 32-bit indices can address.
+    #[error("{what}: {count} exceeds the GPU kernel's limit of {limit}")]
+    TooMany {
+        /// What was counted.
+        what: &'static str,
+        /// How many there are.
+        count: usize,
+        /// The largest supported count.
+        limit: usize,
+    },
+    /// `rays` and `starts` of a batch differ in length.
+    #[error("batch has {rays} rays but {starts} starts")]
+    LengthMismatch {
+        /// Number of rays.
+        rays: usize,
+        /// Number of starts.
+        starts: usize,
+    },
+    /// Invalid camera set-up (start tet out of range, empty image, ...).
+    #[error("camera: {detail}")]
+    Camera {
+        /// What is wrong.
+        detail: String,
+    },
+    /// wgpu reported a validation or out-of-memory error.
+    #[error("wgpu error during {during}: {message}")]
+    Wgpu {
+        /// The operation.
+        during: &'static str,
+        /// wgpu's message.
+        message: String,
+    },
+}

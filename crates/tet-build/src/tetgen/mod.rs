@@ -121,15 +121,15 @@ impl TetgenOptions {
     }
 
     fn check(&self) -> Result<(), TetgenError> {
-        if let Some(q) = self.quality {
-            if !(q.is_finite() && q > 0.0) {
-                return Err(TetgenError::BadOption(format!("quality ratio {q}")));
-            }
+        if let Some(q) = self.quality
+            && !(q.is_finite() && q > 0.0)
+        {
+            return Err(TetgenError::BadOption(format!("quality ratio {q}")));
         }
-        if let Some(t) = self.coplanar_tolerance {
-            if !(t.is_finite() && t > 0.0) {
-                return Err(TetgenError::BadOption(format!("coplanar tolerance {t}")));
-            }
+        if let Some(t) = self.coplanar_tolerance
+            && !(t.is_finite() && t > 0.0)
+        {
+            return Err(TetgenError::BadOption(format!("coplanar tolerance {t}")));
         }
         Ok(())
     }
@@ -256,8 +256,8 @@ pub enum TetgenError {
     /// TetGen rejected the switch string.
     #[error("TetGen rejected the switches {0:?}")]
     BadSwitches(String),
-    /// TetGen's input has zero extent along an axis (TetGen cannot build a 3-D mesh).
-    #[error("input is flat: zero extent along a coordinate axis")]
+    /// All input points are coplanar: no tetrahedron exists.
+    #[error("input is flat: all points are coplanar")]
     FlatInput,
     /// TetGen code 1.
     #[error("TetGen ran out of memory (code 1)")]
@@ -405,6 +405,16 @@ pub fn check_input(input: &TetgenInput) -> Result<(), TetgenError> {
         key.sort_unstable();
         keys.push((key, t));
     }
+    // All points coplanar: no tetrahedron exists (TetGen itself only
+    // detects an axis-aligned plane). Triangle 0 is not degenerate here.
+    let [a, b, c] = input.triangles[0].map(|v| glam::DVec3::from_array(input.points[v as usize]));
+    if input
+        .points
+        .iter()
+        .all(|&p| tet_core::predicates::orient3d(a, b, c, glam::DVec3::from_array(p)) == 0.0)
+    {
+        return Err(TetgenError::FlatInput);
+    }
     keys.sort_unstable();
     for w in keys.windows(2) {
         if w[0].0 == w[1].0 {
@@ -460,7 +470,9 @@ pub(crate) fn run_in_process(
     // TetGen's predicates keep global state set per run (exactinit: error
     // bounds and static filters scaled to the input's bounding box), so two
     // runs in one process must never overlap.
-    let _serial = TETGEN_LOCK.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let _serial = TETGEN_LOCK
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
     let start = Instant::now();
     // SAFETY: the pointers reference live buffers of the lengths passed
     // (3 × points, 3 × triangles, 1 × markers — check_input guarantees

@@ -7,13 +7,33 @@
 //! [`run_worker`] is the parent side: it spawns the command, streams the
 //! request, reads the reply and kills the child at the time limit.
 //!
-//! Wire format (little-endian): request = `b"TETREQ01"`, switches (u32 length
-//! + UTF-8), points (u32 count + 3 f64 each), triangles (u32 count + 3 u32
-//! each), markers (one i32 per triangle). Reply = `b"TETRES01"`, status i32
-//! (0 = ok, else a shim/TetGen code), then on success points, tets (u32 count
-//! + 4 u32), neighbours flag (u8) and 4 i32 per tet, faces (u32 count + 3
-//! u32), markers (i32 each); always followed by TetGen seconds (f64) and the
-//! worker's peak memory in KiB (u64, 0 when unknown).
+//! Hosting the worker in another binary (e.g. `tet-bench`):
+//!
+//! ```no_run
+//! use std::time::Duration;
+//! use tet_build::tetgen::{Isolation, WorkerCommand};
+//! // First thing in main(): the hidden subcommand serves one request.
+//! if std::env::args().nth(1).as_deref() == Some("__tetgen-worker") {
+//!     std::process::exit(tet_build::tetgen::worker::serve_stdio());
+//! }
+//! // Elsewhere: run TetGen in a re-executed copy of this binary.
+//! let isolation = Isolation::Worker(WorkerCommand {
+//!     program: std::env::current_exe().unwrap(),
+//!     args: vec!["__tetgen-worker".into()],
+//!     timeout: Some(Duration::from_secs(600)),
+//! });
+//! ```
+//!
+//! Wire format (little-endian).
+//!
+//! * Request: `b"TETREQ01"`, switches (u32 length and UTF-8), points (u32
+//!   count, 3 f64 each), triangles (u32 count, 3 u32 each), markers (one i32
+//!   per triangle).
+//! * Reply: `b"TETRES01"`, status i32 (0 = ok, else a shim/TetGen code);
+//!   on success points, tets (u32 count, 4 u32 each), a neighbours flag (u8)
+//!   with 4 i32 per tet, faces (u32 count, 3 u32 each) and one i32 marker per
+//!   face; always followed by TetGen seconds (f64) and the worker's peak
+//!   memory in KiB (u64, 0 when unknown).
 //!
 //! TetGen prints its diagnostics with `printf`; [`serve_stdio`] first points
 //! C stdout at stderr so they cannot corrupt the reply.
@@ -266,17 +286,17 @@ pub fn run_worker(
             Ok(None) => {}
             Err(e) => return Err(io_err("wait", e)),
         }
-        if let Some(limit) = cmd.timeout {
-            if start.elapsed() > limit {
-                let _ = child.kill();
-                let _ = child.wait();
-                let _ = writer.join();
-                let _ = reader.join();
-                let _ = err_reader.join();
-                return Err(TetgenError::Timeout {
-                    seconds: limit.as_secs_f64(),
-                });
-            }
+        if let Some(limit) = cmd.timeout
+            && start.elapsed() > limit
+        {
+            let _ = child.kill();
+            let _ = child.wait();
+            let _ = writer.join();
+            let _ = reader.join();
+            let _ = err_reader.join();
+            return Err(TetgenError::Timeout {
+                seconds: limit.as_secs_f64(),
+            });
         }
         std::thread::sleep(Duration::from_millis(5));
     };

@@ -1,0 +1,110 @@
+//! The adversarial cases of `accuracy --extremes`: the scene scaled by 1e-4
+//! and 1e4 and translated by 1e5 (each rebuilt from the transformed
+//! triangles, since rounding a built mesh's points can invert tets), and a
+//! sliver-heavy synthetic mesh.
+
+use anyhow::{Result, bail};
+use glam::Vec3;
+use tet_core::TetMesh;
+use tet_core::scene::{Camera, PointLight};
+use tet_core::synthetic::{GridSpec, kuhn_grid};
+
+use crate::cli::BuildFlags;
+use crate::load::{Loaded, framing_camera, from_scene};
+
+/// The transforms applied to the scene.
+const TRANSFORMS: [(&str, f32, f32); 3] = [
+    ("scale-1e-4", 1e-4, 0.0),
+    ("scale-1e4", 1e4, 0.0),
+    ("translate-1e5", 1.0, 1e5),
+];
+
+fn apply(p: Vec3, scale: f32, shift: f32) -> Vec3 {
+    p * scale + Vec3::splat(shift)
+}
+
+/// Builds every extreme case (an error skips that case).
+pub fn cases(loaded: &Loaded, flags: &BuildFlags, quiet: bool) -> Vec<(String, Result<Loaded>)> {
+    let mut out: Vec<(String, Result<Loaded>)> = TRANSFORMS
+        .iter()
+        .map(|&(name, scale, shift)| (name.to_string(), transformed(loaded, flags, quiet, scale, shift)))
+        .collect();
+    out.push(("kuhn-slivers".into(), Ok(slivers())));
+    out
+}
+
+fn transformed(loaded: &Loaded, flags: &BuildFlags, quiet: bool, scale: f32, shift: f32) -> Result<Loaded> {
+    let camera = Camera {
+        position: apply(loaded.camera.position, scale, shift),
+        target: apply(loaded.camera.target, scale, shift),
+        ..loaded.camera
+    };
+    let lights: Vec<PointLight> = loaded
+        .lights
+        .iter()
+        .map(|l| PointLight {
+            position: apply(l.position, scale, shift),
+            ..*l
+        })
+        .collect();
+    if let Some(scene) = &loaded.scene {
+        let mut s = scene.clone();
+        for v in &mut s.vertices {
+            *v = apply(*v, scale, shift);
+        }
+        s.camera = Some(camera);
+        s.lights = lights;
+        s.name = format!("{} ({scale:e}x + {shift:e})", scene.name);
+        return from_scene(s, flags, quiet);
+    }
+    let mut mesh: TetMesh = loaded.mesh.clone();
+    for p in &mut mesh.points {
+        *p = apply(*p, scale, shift);
+    }
+    if let Err(e) = mesh.validate() {
+        bail!("the transformed mesh file is invalid in f32 ({e}); pass a scene to rebuild it instead");
+    }
+    Ok(Loaded {
+        name: loaded.name.clone(),
+        mesh,
+        scene: None,
+        camera,
+        lights,
+        build: None,
+    })
+}
+
+/// A 12×12×12 Kuhn grid squashed 1000× along z (every tet a sliver), with
+/// 30 % of its faces constrained; the camera sits at its centre.
+fn slivers() -> Loaded {
+    let mut mesh = kuhn_grid(&GridSpec {
+        cells: [12, 12, 12],
+        jitter: 0.15,
+        constrained_fraction: 0.3,
+        seed: 7,
+        ..GridSpec::default()
+    });
+    for p in &mut mesh.points {
+        p.z *= 1e-3;
+    }
+    if mesh.validate().is_err() {
+        // Squashing rounded a tet flat: fall back to the unsquashed grid.
+        for p in &mut mesh.points {
+            p.z *= 1e3;
+        }
+    }
+    let center = Vec3::new(6.01, 6.02, 6.03e-3);
+    let camera = Camera {
+        position: center,
+        target: center + Vec3::new(1.0, 0.3, 0.0),
+        ..framing_camera(&mesh)
+    };
+    Loaded {
+        name: "kuhn-slivers".into(),
+        mesh,
+        scene: None,
+        camera,
+        lights: Vec::new(),
+        build: None,
+    }
+}

@@ -1,0 +1,38 @@
+//! Which tracer implements each `--method` at each precision.
+
+use anyhow::{Result, bail};
+use tet_core::TetMesh;
+use tet_trace_cpu::kernel::Tracer;
+use tet_trace_cpu::sctp::SctpTracer;
+use tet_trace_cpu::tet16::{Tet16Tracer, Tet16TracerF64};
+use tet_trace_cpu::tet20::{Tet20Tracer, Tet20TracerF64};
+use tet_trace_cpu::tet32::{Tet32Tracer, Tet32TracerF64};
+use tet_trace_cpu::tet80::Tet80Tracer;
+
+use crate::bvh::BvhTracer;
+use crate::cli::Method;
+
+/// Builds the tracer of `method` over `mesh`, in f64 when `f64` is set.
+pub fn tracer<'m>(method: Method, f64: bool, mesh: &'m TetMesh) -> Result<Box<dyn Tracer + 'm>> {
+    Ok(match (method, f64) {
+        (Method::Sctp, false) => Box::new(<SctpTracer<'_>>::new(mesh)?),
+        (Method::Tet80, false) => Box::new(Tet80Tracer::new(mesh)?),
+        (Method::Tet32, false) => Box::new(<Tet32Tracer<'_>>::new(mesh)?),
+        (Method::Tet32, true) => Box::new(Tet32TracerF64::new(mesh)?),
+        (Method::Tet20, false) => Box::new(<Tet20Tracer<'_>>::new(mesh)?),
+        (Method::Tet20, true) => Box::new(Tet20TracerF64::new(mesh)?),
+        (Method::Tet16, false) => Box::new(<Tet16Tracer<'_>>::new(mesh)?),
+        (Method::Tet16, true) => Box::new(Tet16TracerF64::new(mesh)?),
+        (Method::Obvhs, false) => Box::new(BvhTracer::new(mesh)),
+        (Method::Brute, _) => Box::new(crate::brute::BruteTracer { mesh }),
+        (m, true) => bail!("method {} has no f64 variant", m.name()),
+    })
+}
+
+/// True when `method` has an f64 variant.
+pub fn has_f64(method: Method) -> bool {
+    matches!(
+        method,
+        Method::Tet32 | Method::Tet20 | Method::Tet16 | Method::Brute
+    )
+}

@@ -1,0 +1,181 @@
+//! `tet-bench render`: frames with one method, best and median timings.
+
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+use tet_trace_cpu::kernel::Tracer;
+use tet_trace_cpu::render::{Frame, FrameStats, RenderOptions, render};
+
+use crate::cli::{Method, RenderArgs};
+use crate::load::{Loaded, load, require_tets};
+use crate::methods::tracer;
+
+/// Timings of one method on one scene (JSON document of `render`, and rows
+/// of the `tables` render table).
+#[derive(Clone, Debug, Serialize)]
+pub struct RenderDoc {
+    /// Scene name.
+    pub scene: String,
+    /// `--method`.
+    pub method: Method,
+    /// Tracer name with precision (e.g. `tet20/duff-f32`).
+    pub tracer: String,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Worker threads.
+    pub threads: usize,
+    /// Frames timed (after one untimed warm-up frame).
+    pub frames: u32,
+    /// Fastest frame, ms.
+    pub best_ms: f64,
+    /// Median frame, ms.
+    pub median_ms: f64,
+    /// Primary rays per second in the fastest frame, millions.
+    pub mrays_per_s: f64,
+    /// Mean tets visited per primary ray (0 for BVH methods).
+    pub tets_per_ray: f64,
+    /// Primary rays per frame.
+    pub rays: u64,
+    /// Primary rays that hit.
+    pub hits: u64,
+    /// Primary rays whose walk failed (step cap, lost, invalid).
+    pub failures: u64,
+    /// Shadow rays per frame.
+    pub shadow_rays: u64,
+    /// Seconds to encode the layout or build the BVH.
+    pub setup_s: f64,
+    /// Hot bytes of the method's structure (layout, or 0 for BVH).
+    pub hot_bytes: usize,
+    /// Compile-time CPU features the kernels were built with.
+    pub target_features: Vec<&'static str>,
+}
+
+/// CPU features enabled at compile time (shows whether `target-cpu=native` was used).
+pub fn target_features() -> Vec<&'static str> {
+    let mut f = Vec::new();
+    if cfg!(target_feature = "sse4.1") {
+        f.push("sse4.1");
+    }
+    if cfg!(target_feature = "avx") {
+        f.push("avx");
+    }
+    if cfg!(target_feature = "avx2") {
+        f.push("avx2");
+    }
+    if cfg!(target_feature = "fma") {
+        f.push("fma");
+    }
+    if cfg!(target_feature = "avx512f") {
+        f.push("avx512f");
+    }
+    if cfg!(target_feature = "neon") {
+        f.push("neon");
+    }
+    f
+}
+
+/// Runs `threads` workers (None: all cores).
+pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    let mut b = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        b = b.num_threads(n.max(1));
+    }
+    Ok(b.build()?)
+}
+
+/// Renders `frames` timed frames (plus a warm-up) and summarises them;
+/// returns the last frame for images.
+pub fn time_method(
+    loaded: &Loaded,
+    method: Method,
+    opts: &RenderOptions,
+    frames: u32,
+    pool: &rayon::ThreadPool,
+) -> Result<(RenderDoc, Frame)> {
+    let setup = Instant::now();
+    let t: Box<dyn Tracer + '_> = tracer(method, false, &loaded.mesh)?;
+    let setup_s = setup.elapsed().as_secs_f64();
+    let hot_bytes = crate::info::layout_bytes(&loaded.mesh)
+        .1
+        .iter()
+        .find(|l| l.name == method.name())
+        .map_or(0, |l| l.hot_bytes);
+    let run = || render(t.as_ref(), &loaded.camera, &loaded.lights, opts);
+    let mut frame = pool.install(run).context("render failed")?;
+    let mut stats: Vec<FrameStats> = Vec::new();
+    for _ in 0..frames.max(1) {
+        frame = pool.install(run)?;
+        stats.push(frame.stats);
+    }
+    let mut ms: Vec<f64> = stats.iter().map(|s| s.ms).collect();
+    ms.sort_by(f64::total_cmp);
+    let best = stats
+        .iter()
+        .min_by(|a, b| a.ms.total_cmp(&b.ms))
+        .copied()
+        .unwrap_or_default();
+    let doc = RenderDoc {
+        scene: loaded.name.clone(),
+        method,
+        tracer: t.name(),
+        width: opts.width,
+        height: opts.height,
+        threads: pool.current_num_threads(),
+        frames: frames.max(1),
+        best_ms: best.ms,
+        median_ms: ms[ms.len() / 2],
+        mrays_per_s: best.mrays_per_s(),
+        tets_per_ray: best.tets_visited as f64 / best.rays.max(1) as f64,
+        rays: best.rays,
+        hits: best.hits,
+        failures: best.failures,
+        shadow_rays: best.shadow_rays,
+        setup_s,
+        hot_bytes,
+        target_features: target_features(),
+    };
+    Ok((doc, frame))
+}
+
+/// `tet-bench render`.
+pub fn run(args: &RenderArgs, json: bool) -> Result<()> {
+    let loaded = load(&args.scene, &args.build, json)?;
+    require_tets(&loaded)?;
+    let opts = RenderOptions {
+        width: args.width,
+        height: args.height,
+        shadows: args.shadows,
+        ..RenderOptions::default()
+    };
+    let pool = pool(args.threads)?;
+    let (doc, frame) = time_method(&loaded, args.method, &opts, args.frames, &pool)?;
+    if let Some(path) = &args.output {
+        frame.save_png(path)?;
+    }
+    if let Some(path) = &args.heatmap {
+        frame.save_heatmap(path, None)?;
+    }
+    if json {
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+    } else {
+        println!(
+            "{} {} ({}) {}x{} {} threads: best {:.1} ms, median {:.1} ms, {:.2} Mrays/s, {:.1} tets/ray, {} hits, {} failures",
+            doc.scene,
+            doc.method.name(),
+            doc.tracer,
+            doc.width,
+            doc.height,
+            doc.threads,
+            doc.best_ms,
+            doc.median_ms,
+            doc.mrays_per_s,
+            doc.tets_per_ray,
+            doc.hits,
+            doc.failures
+        );
+    }
+    Ok(())
+}

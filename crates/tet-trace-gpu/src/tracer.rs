@@ -1,0 +1,879 @@
+//! The walk kernels on the GPU (Tet20, Tet32, Tet16): mesh upload, batch
+//! tracing, camera rendering and per-dispatch statistics. See the crate docs for the decisions ported
+//! from the CPU walk and where results may differ.
+
+use std::sync::mpsc;
+use std::time::Instant;
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DVec3, Vec3};
+use tet_core::layout::{Tet16Mesh, Tet20Mesh, Tet32Mesh};
+use tet_core::scene::Camera;
+use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
+use tet_trace_cpu::render::PinholeCamera;
+use tet_trace_cpu::walk::{start_exit_face, step_cap};
+use tet_trace_cpu::{DuffF32, Failure, Hit, Ray, Start, TraceOutcome};
+use wgpu::util::DeviceExt;
+
+use crate::{GpuContext, GpuError};
+
+/// WGSL source of the layout-independent walk.
+const WALK: &str = include_str!("walk.wgsl");
+
+/// The compact layout a [`GpuTracer`] uploads and walks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum GpuLayout {
+    /// Seed 000 Tet20: `VX` + four rank-ordered links (20 bytes, Algorithm 5).
+    Tet20,
+    /// Seed 000 Tet32: three ids, `VX`, four slot-ordered links (32 bytes,
+    /// Algorithm 3).
+    Tet32,
+    /// Seed 000 Tet16: `VX` + three link xor-differences (16 bytes,
+    /// Algorithm 7; the entry link is carried along the walk).
+    Tet16,
+}
+
+impl GpuLayout {
+    /// All layouts with a GPU kernel.
+    pub const ALL: [GpuLayout; 3] = [GpuLayout::Tet20, GpuLayout::Tet32, GpuLayout::Tet16];
+
+    /// Layout name (`"tet20"`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            GpuLayout::Tet20 => "tet20",
+            GpuLayout::Tet32 => "tet32",
+            GpuLayout::Tet16 => "tet16",
+        }
+    }
+
+    /// Method name for reports and `tet-bench` (`"gpu-tet20"`, ...).
+    pub fn method(self) -> &'static str {
+        match self {
+            GpuLayout::Tet20 => "gpu-tet20",
+            GpuLayout::Tet32 => "gpu-tet32",
+            GpuLayout::Tet16 => "gpu-tet16",
+        }
+    }
+
+    /// Bytes per tet record.
+    pub fn record_bytes(self) -> usize {
+        match self {
+            GpuLayout::Tet20 => 20,
+            GpuLayout::Tet32 => 32,
+            GpuLayout::Tet16 => 16,
+        }
+    }
+
+    /// The WGSL of `layout_vx(t)` (paper `VX^t`) and `layout_exit(t, d,
+    /// e)` (the raw link of tet `t` across the face opposite vertex `e`,
+    /// with `s_ids` the entry face and `d` the fourth vertex): the ports of
+    /// the CPU `Topology` implementations.
+    fn snippet(self) -> &'static str {
+        match self {
+            // Algorithm 5: links in the rank order of their opposite vertex.
+            GpuLayout::Tet20 => {
+                "fn layout_vx(t: u32) -> u32 { return tets[5u * t]; }
+fn layout_exit(t: u32, d: u32, e: u32) -> u32 {
+    return tets[5u * t + 1u + rank_of(e, s_ids[0], s_ids[1], s_ids[2], d)];
+}
+"
+            }
+            // Algorithm 3: v0 v1 v2 vx n0 n1 n2 n3, links in slot order.
+            GpuLayout::Tet32 => {
+                "fn layout_vx(t: u32) -> u32 { return tets[8u * t + 3u]; }
+fn layout_exit(t: u32, d: u32, e: u32) -> u32 {
+    let b = 8u * t;
+    if (e == tets[b]) { return tets[b + 4u]; }
+    if (e == tets[b + 1u]) { return tets[b + 5u]; }
+    if (e == tets[b + 2u]) { return tets[b + 6u]; }
+    return tets[b + 7u];
+}
+"
+            }
+            // Algorithm 7: N_want = N_entry ^ NX_rank(entry) ^ NX_rank(want),
+            // NX_3 = 0; the entry face is opposite d.
+            GpuLayout::Tet16 => {
+                "fn layout_vx(t: u32) -> u32 { return tets[4u * t]; }
+fn tet16_nx(t: u32, r: u32) -> u32 { return select(tets[4u * t + 1u + min(r, 2u)], 0u, r == 3u); }
+fn layout_exit(t: u32, d: u32, e: u32) -> u32 {
+    let rd = rank_of(d, s_ids[0], s_ids[1], s_ids[2], d);
+    let re = rank_of(e, s_ids[0], s_ids[1], s_ids[2], d);
+    return s_entry ^ tet16_nx(t, rd) ^ tet16_nx(t, re);
+}
+"
+            }
+        }
+    }
+
+    /// The layout's tet records as 32-bit words (validates the mesh).
+    fn encode(self, mesh: &TetMesh) -> Result<Vec<u32>, GpuError> {
+        Ok(match self {
+            GpuLayout::Tet20 => bytemuck::cast_slice(&Tet20Mesh::from_mesh(mesh)?.tets).to_vec(),
+            GpuLayout::Tet32 => bytemuck::cast_slice(&Tet32Mesh::from_mesh(mesh)?.tets).to_vec(),
+            GpuLayout::Tet16 => bytemuck::cast_slice(&Tet16Mesh::from_mesh(mesh)?.tets).to_vec(),
+        })
+    }
+}
+/// Invocations per workgroup (must equal `@workgroup_size` in the shader).
+const WORKGROUP: u32 = 64;
+/// Largest number of rays per dispatch (bounds host staging memory).
+const MAX_RAYS_PER_DISPATCH: u64 = 1 << 22;
+
+// Outcome codes and start modes shared with the shader.
+const ST_HIT: u32 = 0;
+const ST_MISS: u32 = 1;
+const ST_STEP_CAP: u32 = 2;
+const ST_INVALID: u32 = 3;
+const ST_LOST: u32 = 4;
+const START_EXIT: u32 = 0;
+const START_ENTER: u32 = 1;
+const START_DONE: u32 = 2;
+
+/// Uniform parameters (layout of the shader's `Params`, 144 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct Params {
+    ray_count: u32,
+    first_ray: u32,
+    step_cap: u32,
+    camera_mode: u32,
+    width: u32,
+    height: u32,
+    point_count: u32,
+    cam_tet: u32,
+    cam_ids: [u32; 4],
+    cam_links: [u32; 4],
+    eye: [f32; 4],
+    forward: [f32; 4],
+    right: [f32; 4],
+    up: [f32; 4],
+    lens: [f32; 4],
+}
+const _: () = assert!(size_of::<Params>() == 144);
+
+/// One batch ray: origin + `t_min`, direction + `t_max`, projection basis.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct RayRec {
+    o: [f32; 4],
+    d: [f32; 4],
+    u: [f32; 4],
+    v: [f32; 4],
+}
+
+/// Where a batch ray's walk starts (computed on the host, see crate docs).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct StartRec {
+    mode: u32,
+    ids: [u32; 3],
+    tet: u32,
+    link: u32,
+    visited: u32,
+    next: u32,
+}
+
+/// One result record as written by the shader (40 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct HitRec {
+    status: u32,
+    triangle: u32,
+    face: u32,
+    t: f32,
+    bary: [f32; 3],
+    tet: u32,
+    far_tet: u32,
+    visited: u32,
+}
+const _: () = assert!(size_of::<HitRec>() == 40);
+
+impl HitRec {
+    fn outcome(&self) -> TraceOutcome {
+        let failed = |failure| TraceOutcome::Failed {
+            failure,
+            tets_visited: self.visited,
+        };
+        match self.status {
+            ST_HIT => TraceOutcome::Hit(Hit {
+                triangle: self.triangle,
+                face: self.face,
+                t: self.t,
+                barycentrics: self.bary,
+                tet: self.tet,
+                far_tet: self.far_tet,
+                tets_visited: self.visited,
+            }),
+            ST_MISS => TraceOutcome::Miss {
+                tets_visited: self.visited,
+            },
+            ST_STEP_CAP => failed(Failure::StepCap),
+            ST_INVALID => failed(Failure::InvalidRay),
+            _ => failed(Failure::Lost),
+        }
+    }
+}
+
+/// Duff et al.'s basis exactly as `tet_trace_cpu::walk` builds it (f64, then
+/// rounded to f32 by the caller), so batch rays project like on the CPU.
+fn duff_basis(n: DVec3) -> (DVec3, DVec3) {
+    let sign = 1.0f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    let u = DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    let v = DVec3::new(b, sign + n.y * n.y * a, -n.y);
+    if u.cross(v).dot(n) >= 0.0 {
+        (u, v)
+    } else {
+        (v, u)
+    }
+}
+
+/// Bytes of the mesh arrays resident on the GPU.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GpuMemory {
+    /// Layout name.
+    pub layout: &'static str,
+    /// Tet records (20 bytes each for Tet20).
+    pub tets: u64,
+    /// Points (12 bytes each).
+    pub points: u64,
+    /// Constrained-face records (24 bytes each).
+    pub constrained: u64,
+}
+
+impl GpuMemory {
+    /// Sum of all arrays.
+    pub fn total(&self) -> u64 {
+        self.tets + self.points + self.constrained
+    }
+}
+
+/// Statistics of one batch or frame, with the fields of the CPU renderer's
+/// `FrameStats` (so `tet-bench` can report GPU methods the same way).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DispatchStats {
+    /// Method name (`"gpu-tet20"`, ...).
+    pub method: String,
+    /// Adapter, from [`GpuContext::device_name`].
+    pub device: String,
+    /// Summed GPU time of the kernel dispatches (timestamp queries), ms;
+    /// `None` when the adapter has no timestamp queries.
+    pub gpu_ms: Option<f64>,
+    /// Wall time from the first submit to the last result on the host
+    /// (includes uploads of per-ray data and read-back), ms.
+    pub wall_ms: f64,
+    /// Number of dispatches.
+    pub dispatches: u32,
+    /// Rays traced.
+    pub rays: u64,
+    /// Rays that hit a constrained face.
+    pub hits: u64,
+    /// Rays that failed (step cap, lost, invalid).
+    pub failures: u64,
+    /// Tets visited by all rays.
+    pub tets_visited: u64,
+}
+
+impl DispatchStats {
+    /// The time to report: GPU time when measured, wall time otherwise (ms).
+    pub fn ms(&self) -> f64 {
+        self.gpu_ms.unwrap_or(self.wall_ms)
+    }
+
+    /// Million rays per second over [`DispatchStats::ms`].
+    pub fn mrays_per_s(&self) -> f64 {
+        self.rays as f64 / (self.ms() * 1e3)
+    }
+
+    fn count(&mut self, outcomes: &[TraceOutcome]) {
+        self.rays += outcomes.len() as u64;
+        for o in outcomes {
+            self.hits += o.hit().is_some() as u64;
+            self.failures += o.is_failure() as u64;
+            self.tets_visited += o.tets_visited() as u64;
+        }
+    }
+}
+
+/// A camera frame traced on the GPU.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GpuFrame {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Outcome per pixel, row-major from the top.
+    pub outcomes: Vec<TraceOutcome>,
+    /// Statistics of the whole frame (re-traced rays included).
+    pub stats: DispatchStats,
+    /// Rays whose origin lay on the start tet's boundary so that the GPU
+    /// start failed; they were re-traced through [`GpuTracer::trace_batch`].
+    pub retraced: u64,
+}
+
+impl GpuFrame {
+    /// Hit triangle per pixel (`u32::MAX` for none), as in the CPU `Frame`.
+    pub fn triangles(&self) -> Vec<u32> {
+        self.outcomes
+            .iter()
+            .map(|o| o.hit().map_or(u32::MAX, |h| h.triangle))
+            .collect()
+    }
+}
+
+/// A mesh uploaded in one compact layout, with its compiled kernel.
+pub struct GpuTracer<'a> {
+    ctx: &'a GpuContext,
+    layout: GpuLayout,
+    mesh: &'a TetMesh,
+    pipeline: wgpu::ComputePipeline,
+    points: wgpu::Buffer,
+    tets: wgpu::Buffer,
+    faces: wgpu::Buffer,
+    dummy: wgpu::Buffer,
+    memory: GpuMemory,
+    cap: u32,
+}
+
+impl<'a> GpuTracer<'a> {
+    /// Encodes `mesh` (validated) in `layout` and uploads it. Fails with
+    /// [`GpuError::TooLarge`] when an array exceeds a device limit.
+    pub fn new(
+        ctx: &'a GpuContext,
+        mesh: &'a TetMesh,
+        layout: GpuLayout,
+    ) -> Result<Self, GpuError> {
+        let tets = layout.encode(mesh)?;
+        let points: Vec<f32> = mesh.points.iter().flat_map(|p| p.to_array()).collect();
+        let faces: Vec<u32> = mesh
+            .constrained
+            .iter()
+            .flat_map(|cf| {
+                [
+                    cf.triangle,
+                    cf.front.tet,
+                    cf.back.tet,
+                    cf.vertices[0],
+                    cf.vertices[1],
+                    cf.vertices[2],
+                ]
+            })
+            .collect();
+        let memory = GpuMemory {
+            layout: layout.name(),
+            tets: (tets.len() * 4) as u64,
+            points: (points.len() * 4) as u64,
+            constrained: (faces.len() * 4) as u64,
+        };
+        ctx.check_size("tet records", memory.tets)?;
+        ctx.check_size("points", memory.points)?;
+        ctx.check_size("constrained faces", memory.constrained)?;
+        if mesh.points.len() > (u32::MAX / 3) as usize {
+            return Err(GpuError::TooMany {
+                what: "points",
+                count: mesh.points.len(),
+                limit: (u32::MAX / 3) as usize,
+            });
+        }
+        let device = &ctx.device;
+        let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let val = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let storage = |label: &str, data: &[u8]| {
+            // Zero-sized bindings are invalid: pad empty arrays.
+            let pad = [0u8; 32];
+            let contents = if data.is_empty() { &pad[..] } else { data };
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let points_buf = storage("points", bytemuck::cast_slice(&points));
+        let tets_buf = storage(layout.name(), bytemuck::cast_slice(&tets));
+        let faces_buf = storage("constrained", bytemuck::cast_slice(&faces));
+        let dummy = storage("dummy", &[0u8; 64]);
+        let source = format!("{WALK}\n{}", layout.snippet());
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(layout.method()),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(layout.method()),
+            layout: None,
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        scope_result("mesh upload / pipeline creation", val, oom)?;
+        Ok(GpuTracer {
+            ctx,
+            layout,
+            mesh,
+            pipeline,
+            points: points_buf,
+            tets: tets_buf,
+            faces: faces_buf,
+            dummy,
+            memory,
+            cap: step_cap(mesh),
+        })
+    }
+
+    /// Replaces the step cap (tets visited before a walk reports
+    /// [`Failure::StepCap`]); the default is the CPU's
+    /// `tet_trace_cpu::walk::step_cap`.
+    pub fn with_step_cap(mut self, cap: u32) -> Self {
+        self.cap = cap;
+        self
+    }
+
+    /// The step cap in use.
+    pub fn step_cap(&self) -> u32 {
+        self.cap
+    }
+
+    /// The layout walked.
+    pub fn layout(&self) -> GpuLayout {
+        self.layout
+    }
+
+    /// Bytes of the mesh on the GPU.
+    pub fn memory(&self) -> GpuMemory {
+        self.memory
+    }
+
+    /// The mesh (cold data: attributes, constrained-face table).
+    pub fn mesh(&self) -> &TetMesh {
+        self.mesh
+    }
+
+    /// Host-side start of one batch ray: the CPU walk's exact start logic.
+    fn start_record(&self, ray: &Ray, start: Start) -> StartRec {
+        let done = |status| StartRec {
+            mode: START_DONE,
+            ids: [0; 3],
+            tet: NO_TET,
+            link: status,
+            visited: 0,
+            next: 0,
+        };
+        if !ray.is_valid() {
+            return done(ST_INVALID);
+        }
+        let mesh = self.mesh;
+        match start {
+            Start::Tet(t) => {
+                if t as usize >= mesh.tets.len() {
+                    return done(ST_LOST);
+                }
+                match start_exit_face::<DuffF32>(mesh, ray, t) {
+                    Some((tet, k)) => StartRec {
+                        mode: START_EXIT,
+                        ids: mesh.face_vertices(tet, k),
+                        tet,
+                        link: mesh.neighbors[tet as usize][k].0,
+                        visited: 1,
+                        next: 0,
+                    },
+                    None => done(ST_LOST),
+                }
+            }
+            Start::Face { face, tet } => {
+                let side = mesh
+                    .constrained
+                    .get(face as usize)
+                    .and_then(|cf| cf.side_of(tet))
+                    .filter(|_| (tet as usize) < mesh.tets.len());
+                let Some(side) = side else {
+                    return done(ST_LOST);
+                };
+                let v = mesh.tets[tet as usize];
+                let [a, b, c] = FACE_VERTICES[(side.face & 3) as usize];
+                StartRec {
+                    mode: START_ENTER,
+                    ids: [v[a], v[c], v[b]],
+                    tet: NO_TET,
+                    link: Link::constrained(face).0,
+                    visited: 0,
+                    next: tet,
+                }
+            }
+        }
+    }
+
+    /// Traces arbitrary rays, ray `i` from `starts[i]` (a tet containing its
+    /// origin, or a constrained face for secondary rays), like the CPU
+    /// `Tracer::trace`. Large batches are split into several dispatches.
+    pub fn trace_batch(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+    ) -> Result<(Vec<TraceOutcome>, DispatchStats), GpuError> {
+        if rays.len() != starts.len() {
+            return Err(GpuError::LengthMismatch {
+                rays: rays.len(),
+                starts: starts.len(),
+            });
+        }
+        let mut stats = self.new_stats();
+        let t0 = Instant::now();
+        let per = self.rays_per_dispatch(size_of::<RayRec>() as u64)?;
+        let mut out = Vec::with_capacity(rays.len());
+        for (rc, sc) in rays.chunks(per).zip(starts.chunks(per)) {
+            let recs: Vec<RayRec> = rc
+                .iter()
+                .map(|r| {
+                    let (u, v) = if r.is_valid() {
+                        duff_basis(r.direction.as_dvec3().normalize())
+                    } else {
+                        (DVec3::X, DVec3::Y)
+                    };
+                    let (u, v) = (u.as_vec3(), v.as_vec3());
+                    RayRec {
+                        o: r.origin.extend(r.t_min).to_array(),
+                        d: r.direction.extend(r.t_max).to_array(),
+                        u: u.extend(0.0).to_array(),
+                        v: v.extend(0.0).to_array(),
+                    }
+                })
+                .collect();
+            let st: Vec<StartRec> = rc
+                .iter()
+                .zip(sc)
+                .map(|(r, &s)| self.start_record(r, s))
+                .collect();
+            let device = &self.ctx.device;
+            let rays_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("rays"),
+                contents: bytemuck::cast_slice(&recs),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let starts_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("starts"),
+                contents: bytemuck::cast_slice(&st),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let params = Params {
+                ray_count: rc.len() as u32,
+                ..self.base_params()
+            };
+            let (hits, gpu_ms) = self.dispatch(&params, &rays_buf, &starts_buf)?;
+            add_gpu_ms(&mut stats, gpu_ms);
+            out.extend(hits.iter().map(HitRec::outcome));
+        }
+        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        stats.count(&out);
+        Ok((out, stats))
+    }
+
+    /// Traces the primary rays of a `width × height` image, generated on the
+    /// GPU with the conventions of `scenes.json` (see
+    /// `tet_trace_cpu::render::PinholeCamera`), all starting in `start_tet`
+    /// (a tet containing the eye, e.g. from `tet_trace_cpu::locate`).
+    pub fn render(
+        &self,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        pixel_centers: bool,
+        start_tet: u32,
+    ) -> Result<GpuFrame, GpuError> {
+        let mesh = self.mesh;
+        let pixels = width as u64 * height as u64;
+        if width == 0 || height == 0 || pixels > u32::MAX as u64 {
+            return Err(GpuError::Camera {
+                detail: format!("image size {width}x{height} is empty or too large"),
+            });
+        }
+        if start_tet as usize >= mesh.tets.len() {
+            return Err(GpuError::Camera {
+                detail: format!(
+                    "start tet {start_tet} is out of bounds ({} tets)",
+                    mesh.tets.len()
+                ),
+            });
+        }
+        let forward = (camera.target - camera.position).normalize();
+        let right = -camera.up.cross(forward).normalize();
+        let up = -forward.cross(right);
+        if !(camera.position.is_finite() && forward.is_finite() && right.is_finite()) {
+            return Err(GpuError::Camera {
+                detail: format!("degenerate camera {camera:?}"),
+            });
+        }
+        let half_h = (camera.vfov_deg.to_radians() * 0.5).tan();
+        let aspect = width as f32 / height as f32;
+        let offset = if pixel_centers { 0.5 } else { 0.0 };
+        let v4 = |v: Vec3| v.extend(0.0).to_array();
+        let base = Params {
+            camera_mode: 1,
+            width,
+            height,
+            cam_tet: start_tet,
+            cam_ids: mesh.tets[start_tet as usize],
+            cam_links: mesh.neighbors[start_tet as usize].map(|l| l.0),
+            eye: v4(camera.position),
+            forward: v4(forward),
+            right: v4(right),
+            up: v4(up),
+            lens: [half_h, aspect, offset, 0.0],
+            ..self.base_params()
+        };
+        let mut stats = self.new_stats();
+        let t0 = Instant::now();
+        let per = self.rays_per_dispatch(0)? as u64;
+        let mut outcomes = Vec::with_capacity(pixels as usize);
+        let mut first = 0u64;
+        while first < pixels {
+            let n = per.min(pixels - first);
+            let params = Params {
+                ray_count: n as u32,
+                first_ray: first as u32,
+                ..base
+            };
+            let (hits, gpu_ms) = self.dispatch(&params, &self.dummy, &self.dummy)?;
+            add_gpu_ms(&mut stats, gpu_ms);
+            outcomes.extend(hits.iter().map(HitRec::outcome));
+            first += n;
+        }
+        // Rays the GPU could not start (origin on the start tet's boundary):
+        // re-trace them with the CPU's full start logic.
+        let lost: Vec<usize> = outcomes
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| {
+                matches!(
+                    o,
+                    TraceOutcome::Failed {
+                        failure: Failure::Lost,
+                        tets_visited: 0
+                    }
+                )
+            })
+            .map(|(i, _)| i)
+            .collect();
+        if !lost.is_empty() {
+            let cam = PinholeCamera::new(camera, width, height, pixel_centers);
+            let rays: Vec<Ray> = lost
+                .iter()
+                .map(|&i| cam.ray(i as u32 % width, i as u32 / width))
+                .collect();
+            let starts = vec![Start::Tet(start_tet); rays.len()];
+            let (re, s) = self.trace_batch(&rays, &starts)?;
+            stats.dispatches += s.dispatches;
+            if let (Some(a), Some(b)) = (stats.gpu_ms, s.gpu_ms) {
+                stats.gpu_ms = Some(a + b);
+            }
+            for (&i, o) in lost.iter().zip(re) {
+                outcomes[i] = o;
+            }
+        }
+        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        stats.count(&outcomes);
+        Ok(GpuFrame {
+            width,
+            height,
+            outcomes,
+            stats,
+            retraced: lost.len() as u64,
+        })
+    }
+
+    fn new_stats(&self) -> DispatchStats {
+        DispatchStats {
+            method: self.layout.method().into(),
+            device: self.ctx.device_name(),
+            gpu_ms: self.ctx.timestamps.then_some(0.0),
+            ..Default::default()
+        }
+    }
+
+    fn base_params(&self) -> Params {
+        Params {
+            step_cap: self.cap,
+            point_count: self.mesh.points.len() as u32,
+            ..Params::zeroed()
+        }
+    }
+
+    /// Rays per dispatch so that every per-ray buffer fits the limits.
+    fn rays_per_dispatch(&self, input_bytes: u64) -> Result<usize, GpuError> {
+        let per_ray = (size_of::<HitRec>() as u64).max(input_bytes);
+        let lim = self.ctx.max_binding_bytes() / per_ray;
+        let wg = self.ctx.max_workgroups as u64;
+        let n = lim
+            .min(MAX_RAYS_PER_DISPATCH)
+            .min(wg * wg * WORKGROUP as u64);
+        if n == 0 {
+            return Err(GpuError::TooLarge {
+                buffer: "per-ray records",
+                bytes: per_ray,
+                limit: "max_storage_buffer_binding_size",
+                value: self.ctx.max_binding_bytes(),
+            });
+        }
+        Ok(n as usize)
+    }
+
+    /// One dispatch of `params.ray_count` rays; returns the records and the
+    /// GPU time when timestamps are enabled.
+    fn dispatch(
+        &self,
+        params: &Params,
+        rays: &wgpu::Buffer,
+        starts: &wgpu::Buffer,
+    ) -> Result<(Vec<HitRec>, Option<f64>), GpuError> {
+        let n = params.ray_count;
+        if n == 0 {
+            return Ok((Vec::new(), None));
+        }
+        let device = &self.ctx.device;
+        let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let val = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let out_bytes = n as u64 * size_of::<HitRec>() as u64;
+        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("params"),
+            contents: bytemuck::bytes_of(params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let out = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("hits"),
+            size: out_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("hits readback"),
+            size: out_bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("walk"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &[
+                entry(0, &self.points),
+                entry(1, &self.tets),
+                entry(2, &self.faces),
+                entry(3, &uniform),
+                entry(4, rays),
+                entry(5, starts),
+                entry(6, &out),
+            ],
+        });
+        let timing = self.ctx.timestamps.then(|| {
+            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("walk timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            });
+            let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamps"),
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let read = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamps readback"),
+                size: 16,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            (set, resolve, read)
+        });
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("walk"),
+        });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("walk"),
+                timestamp_writes: timing.as_ref().map(|(set, _, _)| {
+                    wgpu::ComputePassTimestampWrites {
+                        query_set: set,
+                        beginning_of_pass_write_index: Some(0),
+                        end_of_pass_write_index: Some(1),
+                    }
+                }),
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            let groups = n.div_ceil(WORKGROUP);
+            let x = groups.min(self.ctx.max_workgroups);
+            pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
+        }
+        enc.copy_buffer_to_buffer(&out, 0, &readback, 0, out_bytes);
+        if let Some((set, resolve, read)) = &timing {
+            enc.resolve_query_set(set, 0..2, resolve, 0);
+            enc.copy_buffer_to_buffer(resolve, 0, read, 0, 16);
+        }
+        self.ctx.queue.submit([enc.finish()]);
+        let hits: Vec<HitRec> = read_buffer(device, &readback)?;
+        let gpu_ms = match &timing {
+            Some((_, _, read)) => {
+                let ts: Vec<u64> = read_buffer(device, read)?;
+                let ticks = ts[1].saturating_sub(ts[0]);
+                Some(ticks as f64 * self.ctx.queue.get_timestamp_period() as f64 / 1e6)
+            }
+            None => None,
+        };
+        scope_result("dispatch", val, oom)?;
+        Ok((hits, gpu_ms))
+    }
+}
+
+fn add_gpu_ms(stats: &mut DispatchStats, gpu_ms: Option<f64>) {
+    stats.dispatches += 1;
+    if let (Some(a), Some(b)) = (stats.gpu_ms, gpu_ms) {
+        stats.gpu_ms = Some(a + b);
+    }
+}
+
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}
+
+/// Pops the two error scopes pushed by the caller (validation innermost).
+fn scope_result(
+    during: &'static str,
+    val: wgpu::ErrorScopeGuard,
+    oom: wgpu::ErrorScopeGuard,
+) -> Result<(), GpuError> {
+    let v = pollster::block_on(val.pop());
+    let o = pollster::block_on(oom.pop());
+    match v.or(o) {
+        Some(e) => Err(GpuError::Wgpu {
+            during,
+            message: e.to_string(),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Maps a `MAP_READ` buffer after the queue finished and copies it out.
+fn read_buffer<T: Pod>(device: &wgpu::Device, buf: &wgpu::Buffer) -> Result<Vec<T>, GpuError> {
+    let err = |message: String| GpuError::Wgpu {
+        during: "read-back",
+        message,
+    };
+    let slice = buf.slice(..);
+    let (tx, rx) = mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| err(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| err(e.to_string()))?
+        .map_err(|e| err(e.to_string()))?;
+    let data = slice.get_mapped_range().map_err(|e| err(e.to_string()))?;
+    let out = bytemuck::pod_collect_to_vec(&data);
+    drop(data);
+    buf.unmap();
+    Ok(out)
+}

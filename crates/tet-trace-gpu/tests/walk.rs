@@ -1,0 +1,512 @@
+//! GPU walk kernels (Tet20, Tet32, Tet16) against the CPU kernels of the
+//! same layout and an f64 brute-force reference on procedural meshes (`tet_core::synthetic::kuhn_grid`).
+//!
+//! Runs on any wgpu adapter; without a GPU, install lavapipe
+//! (`apt-get install -y mesa-vulkan-drivers`). When no adapter is found the
+//! tests print a skip message, unless `TET_GPU_REQUIRED=1` is set (CI), which
+//! turns that into a failure.
+//!
+//! Tolerance: a ray is *grazing* when its line passes within [`GRAZE`] of an
+//! edge of some constrained face (`reference::grazes_an_edge`); only there may
+//! the hit triangle legitimately depend on rounding. Every other ray must hit
+//! the same triangle as the brute force, and the GPU walk must equal the CPU
+//! walk (same face, same tets visited).
+
+use glam::Vec3;
+use tet_core::TetMesh;
+use tet_core::scene::Camera;
+use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
+use tet_trace_cpu::reference::{Aim, axis_ray, closest_hit, grazes_an_edge, random_ray};
+use tet_trace_cpu::render::PinholeCamera;
+use tet_trace_cpu::tet16::Tet16Tracer;
+use tet_trace_cpu::tet20::Tet20Tracer;
+use tet_trace_cpu::tet32::Tet32Tracer;
+use tet_trace_cpu::{Failure, Ray, Start, TraceOutcome, Tracer, locate};
+use tet_trace_gpu::{
+    GpuContext, GpuError, GpuFrame, GpuLayout, GpuOptions, GpuTracer, REQUIRE_ADAPTER_ENV,
+};
+
+/// Distance to a constrained-face edge below which a ray counts as grazing
+/// (meshes have unit cells).
+const GRAZE: f64 = 1e-4;
+
+fn required() -> bool {
+    std::env::var(REQUIRE_ADAPTER_ENV).is_ok_and(|v| !v.is_empty() && v != "0")
+}
+
+/// The adapter, or `None` (with a printed skip message) when there is none.
+fn gpu_with(opts: &GpuOptions) -> Option<GpuContext> {
+    match GpuContext::with_options(opts) {
+        Ok(c) => {
+            eprintln!("adapter: {}", c.device_name());
+            Some(c)
+        }
+        Err(e) => {
+            assert!(
+                !required(),
+                "{REQUIRE_ADAPTER_ENV} is set but no GPU adapter is available: {e}"
+            );
+            eprintln!(
+                "SKIPPED: no wgpu adapter ({e}). Install a Vulkan driver (lavapipe: \
+                 apt-get install -y mesa-vulkan-drivers) or set {REQUIRE_ADAPTER_ENV}=1 \
+                 to make this a failure."
+            );
+            None
+        }
+    }
+}
+
+fn gpu() -> Option<GpuContext> {
+    gpu_with(&GpuOptions::default())
+}
+
+/// Same walk: same outcome kind, face and tets visited (t and barycentrics
+/// may differ in the last bits: f32 on the GPU, f64 on the CPU).
+fn same_walk(a: &TraceOutcome, b: &TraceOutcome) -> bool {
+    match (a, b) {
+        (TraceOutcome::Hit(x), TraceOutcome::Hit(y)) => {
+            x.face == y.face
+                && x.triangle == y.triangle
+                && x.tet == y.tet
+                && x.far_tet == y.far_tet
+                && x.tets_visited == y.tets_visited
+        }
+        _ => a == b,
+    }
+}
+
+fn triangle_of(o: &TraceOutcome) -> Option<u32> {
+    o.hit().map(|h| h.triangle)
+}
+
+/// Compares GPU outcomes with the CPU kernel and the brute force; returns
+/// (rays compared, grazing rays, walks differing from the CPU).
+fn check(mesh: &TetMesh, rays: &[Ray], gpu: &[TraceOutcome], cpu: &[TraceOutcome]) -> usize {
+    let mut grazing = 0;
+    let mut differ = 0;
+    let mut bits_differ = 0;
+    for (i, ((ray, g), c)) in rays.iter().zip(gpu).zip(cpu).enumerate() {
+        assert!(!g.is_failure(), "ray {i} {ray:?}: GPU failed: {g:?}");
+        let graze = grazes_an_edge(mesh, ray, GRAZE);
+        grazing += graze as usize;
+        if !same_walk(g, c) {
+            differ += 1;
+            assert!(graze, "ray {i} {ray:?}: GPU {g:?} != CPU {c:?}");
+            continue;
+        }
+        if g != c {
+            bits_differ += 1;
+        }
+        if graze {
+            continue;
+        }
+        let r = closest_hit(mesh, ray);
+        assert_eq!(
+            triangle_of(g),
+            r.map(|h| h.triangle),
+            "ray {i} {ray:?}: GPU {g:?} vs brute force {r:?}"
+        );
+        if let (Some(h), Some(r)) = (g.hit(), r) {
+            let scale = ray.direction.length() as f64;
+            assert!(
+                (h.t as f64 - r.t).abs() * scale < 1e-4 * (1.0 + r.t * scale),
+                "ray {i}: t {} vs {}",
+                h.t,
+                r.t
+            );
+            for k in 0..3 {
+                assert!(
+                    (h.barycentrics[k] as f64 - r.barycentrics[k]).abs() < 1e-3,
+                    "ray {i}: barycentrics {:?} vs {:?}",
+                    h.barycentrics,
+                    r.barycentrics
+                );
+            }
+        }
+    }
+    eprintln!(
+        "{} rays: {grazing} grazing, {differ} walks differ from the CPU (all grazing), \
+         {bits_differ} same walks with different t/barycentric bits",
+        rays.len()
+    );
+    differ
+}
+
+fn random_rays(mesh: &TetMesh, n: usize, seed: u64) -> (Vec<Ray>, Vec<Start>) {
+    let mut rng = SplitMix64(seed);
+    let aims = [
+        Aim::Random,
+        Aim::Vertex,
+        Aim::EdgeMidpoint,
+        Aim::FaceCentroid,
+    ];
+    (0..n)
+        .map(|i| {
+            let (r, t) = random_ray(mesh, &mut rng, aims[i % 4]);
+            (r, Start::Tet(t))
+        })
+        .unzip()
+}
+
+/// The CPU kernel of the same layout (f32 Duff projection).
+fn cpu_tracer(mesh: &TetMesh, layout: GpuLayout, cap: Option<u32>) -> Box<dyn Tracer + '_> {
+    let cap = cap.unwrap_or(tet_trace_cpu::walk::step_cap(mesh));
+    match layout {
+        GpuLayout::Tet20 => {
+            let t: Tet20Tracer = Tet20Tracer::new(mesh).unwrap();
+            Box::new(t.with_step_cap(cap))
+        }
+        GpuLayout::Tet32 => {
+            let t: Tet32Tracer = Tet32Tracer::new(mesh).unwrap();
+            Box::new(t.with_step_cap(cap))
+        }
+        GpuLayout::Tet16 => {
+            let t: Tet16Tracer = Tet16Tracer::new(mesh).unwrap();
+            Box::new(t.with_step_cap(cap))
+        }
+    }
+}
+
+fn cpu_trace(
+    mesh: &TetMesh,
+    layout: GpuLayout,
+    rays: &[Ray],
+    starts: &[Start],
+    cap: Option<u32>,
+) -> Vec<TraceOutcome> {
+    let cpu = cpu_tracer(mesh, layout, cap);
+    rays.iter()
+        .zip(starts)
+        .map(|(r, &s)| cpu.trace(r, s))
+        .collect()
+}
+
+#[test]
+fn random_faces_agree_with_cpu_and_brute_force() {
+    let Some(ctx) = gpu() else { return };
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [5, 5, 5],
+        jitter: 0.12,
+        constrained_fraction: 0.15,
+        seed: 11,
+        ..Default::default()
+    });
+    for layout in GpuLayout::ALL {
+        eprintln!("layout {layout:?}");
+        random_faces_case(&ctx, &mesh, layout);
+    }
+}
+
+fn random_faces_case(ctx: &GpuContext, mesh: &TetMesh, layout: GpuLayout) {
+    let gpu = GpuTracer::new(ctx, mesh, layout).unwrap();
+    let (mut rays, mut starts) = random_rays(mesh, 2000, 5);
+    // An invalid ray and an out-of-range start tet: reported, not traced.
+    rays.push(Ray::new(Vec3::splat(1.0), Vec3::new(f32::NAN, 0.0, 1.0)));
+    starts.push(Start::Tet(0));
+    rays.push(Ray::new(Vec3::splat(1.0), Vec3::X));
+    starts.push(Start::Tet(u32::MAX - 1));
+    let (out, stats) = gpu.trace_batch(&rays, &starts).unwrap();
+    let cpu = cpu_trace(mesh, layout, &rays, &starts, None);
+    let n = rays.len();
+    assert_eq!(out[n - 2], cpu[n - 2]);
+    assert!(matches!(
+        out[n - 2],
+        TraceOutcome::Failed {
+            failure: Failure::InvalidRay,
+            ..
+        }
+    ));
+    assert!(matches!(
+        out[n - 1],
+        TraceOutcome::Failed {
+            failure: Failure::Lost,
+            ..
+        }
+    ));
+    check(mesh, &rays[..n - 2], &out[..n - 2], &cpu[..n - 2]);
+    assert_eq!(stats.rays, n as u64);
+    assert_eq!(stats.failures, 2);
+    assert_eq!(
+        stats.hits,
+        out.iter().filter(|o| o.hit().is_some()).count() as u64
+    );
+    assert!(stats.hits > 500, "too few hits to be a test: {stats:?}");
+    eprintln!("{stats:?}, memory {:?}", gpu.memory());
+
+    // Secondary rays: continue every hit with a far side through its face.
+    let (mut rays2, mut starts2) = (Vec::new(), Vec::new());
+    for (r, o) in rays.iter().zip(&out) {
+        if let Some(h) = o.hit()
+            && h.has_far_side()
+        {
+            rays2.push(Ray::new(r.at(h.t), r.direction));
+            starts2.push(Start::Face {
+                face: h.face,
+                tet: h.far_tet,
+            });
+        }
+    }
+    let (out2, _) = gpu.trace_batch(&rays2, &starts2).unwrap();
+    let cpu2 = cpu_trace(mesh, layout, &rays2, &starts2, None);
+    let mut differ = 0;
+    for (i, (g, c)) in out2.iter().zip(&cpu2).enumerate() {
+        assert!(
+            !g.is_failure() || grazes_an_edge(mesh, &rays2[i], GRAZE),
+            "secondary ray {i} {:?}: GPU {g:?}, CPU {c:?}",
+            rays2[i]
+        );
+        if !same_walk(g, c) {
+            differ += 1;
+            assert!(
+                grazes_an_edge(mesh, &rays2[i], GRAZE),
+                "secondary ray {i} {:?}: GPU {g:?} != CPU {c:?}",
+                rays2[i]
+            );
+        }
+    }
+    eprintln!("{} secondary rays, {differ} differ (grazing)", rays2.len());
+}
+
+#[test]
+fn closed_shell_is_watertight() {
+    let Some(ctx) = gpu() else { return };
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [5, 5, 5],
+        jitter: 0.1,
+        shell: Some(([1, 1, 1], [4, 4, 4])),
+        seed: 3,
+        ..Default::default()
+    });
+    let (rays, starts) = random_rays(&mesh, 1500, 9);
+    for layout in GpuLayout::ALL {
+        let gpu = GpuTracer::new(&ctx, &mesh, layout).unwrap();
+        let (out, _) = gpu.trace_batch(&rays, &starts).unwrap();
+        let cpu = cpu_trace(&mesh, layout, &rays, &starts, None);
+        check(&mesh, &rays, &out, &cpu);
+        shell_rays_hit(&rays, &out);
+    }
+}
+
+fn shell_rays_hit(rays: &[Ray], out: &[TraceOutcome]) {
+    // Jitter moves shell vertices by at most 0.15: an origin in
+    // [1.2, 3.8]^3 is strictly inside the shell, so every such ray must hit
+    // it, grazing or not.
+    let mut inside = 0;
+    for (r, o) in rays.iter().zip(out) {
+        if r.origin.cmpgt(Vec3::splat(1.2)).all() && r.origin.cmplt(Vec3::splat(3.8)).all() {
+            inside += 1;
+            assert!(o.hit().is_some(), "ray {r:?} escaped the shell: {o:?}");
+        }
+    }
+    assert!(inside > 100, "only {inside} rays inside the shell");
+}
+
+#[test]
+fn exact_ties_on_an_unjittered_grid_match_the_cpu() {
+    // Axis-aligned rays through vertices, along edges and in face planes:
+    // every decision is a tie-rule decision.
+    let Some(ctx) = gpu() else { return };
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [4, 4, 4],
+        jitter: 0.0,
+        constrained_fraction: 0.3,
+        seed: 5,
+        ..Default::default()
+    });
+    let mut rng = SplitMix64(21);
+    let rays: Vec<Ray> = (0..600)
+        .map(|_| axis_ray(&mut rng, Vec3::ZERO, Vec3::splat(4.0)))
+        .collect();
+    let starts: Vec<Start> = rays
+        .iter()
+        .map(|r| Start::Tet(locate(&mesh, r.origin, 0).unwrap()))
+        .collect();
+    for layout in GpuLayout::ALL {
+        let gpu = GpuTracer::new(&ctx, &mesh, layout).unwrap();
+        let (out, _) = gpu.trace_batch(&rays, &starts).unwrap();
+        let cpu = cpu_trace(&mesh, layout, &rays, &starts, None);
+        let mut differ = 0;
+        for (i, (g, c)) in out.iter().zip(&cpu).enumerate() {
+            assert!(!g.is_failure(), "{layout:?} ray {i} {:?}: {g:?}", rays[i]);
+            differ += !same_walk(g, c) as usize;
+        }
+        eprintln!(
+            "{layout:?}: {} tie-rule rays, {differ} walks differ from the CPU",
+            rays.len()
+        );
+        assert_eq!(differ, 0, "{layout:?}: tie decisions differ from the CPU");
+    }
+}
+
+/// Renders `camera` on the GPU and compares every pixel with the CPU Tet20
+/// kernel on the CPU camera's ray; returns the frame.
+fn camera_case(ctx: &GpuContext, mesh: &TetMesh, camera: &Camera, w: u32, h: u32) -> GpuFrame {
+    let start = locate(mesh, camera.position, 0).unwrap();
+    let gpu = GpuTracer::new(ctx, mesh, GpuLayout::Tet20).unwrap();
+    let frame = gpu.render(camera, w, h, false, start).unwrap();
+    assert_eq!(frame.outcomes.len(), (w * h) as usize);
+    let cam = PinholeCamera::new(camera, w, h, false);
+    let cpu: Tet20Tracer = Tet20Tracer::new(mesh).unwrap();
+    let mut grazing = 0;
+    let mut differ = 0;
+    for j in 0..h {
+        for i in 0..w {
+            let ray = cam.ray(i, j);
+            let g = &frame.outcomes[(j * w + i) as usize];
+            let c = cpu.trace(&ray, Start::Tet(start));
+            assert!(!g.is_failure(), "pixel ({i}, {j}): {g:?}");
+            let graze = grazes_an_edge(mesh, &ray, GRAZE);
+            grazing += graze as usize;
+            if !same_walk(g, &c) {
+                differ += 1;
+                assert!(graze, "pixel ({i}, {j}) {ray:?}: GPU {g:?} != CPU {c:?}");
+            }
+        }
+    }
+    let hits = frame.outcomes.iter().filter(|o| o.hit().is_some()).count();
+    assert_eq!(frame.stats.hits, hits as u64);
+    assert_eq!(frame.stats.rays, (w * h) as u64);
+    assert_eq!(frame.stats.failures, 0);
+    eprintln!(
+        "camera {w}x{h}: {grazing} grazing, {differ} differ, {} re-traced, {:?}",
+        frame.retraced, frame.stats
+    );
+    frame
+}
+
+#[test]
+fn camera_rays_generated_on_the_gpu_match_the_cpu_camera() {
+    let Some(ctx) = gpu() else { return };
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [6, 6, 6],
+        jitter: 0.1,
+        constrained_fraction: 0.02,
+        shell: Some(([2, 2, 2], [4, 4, 4])),
+        seed: 17,
+        ..Default::default()
+    });
+    let camera = Camera {
+        position: Vec3::new(0.55, 4.3, 0.8),
+        target: Vec3::new(3.0, 3.0, 3.0),
+        up: Vec3::Y,
+        vfov_deg: 45.0,
+    };
+    let frame = camera_case(&ctx, &mesh, &camera, 40, 30);
+    let hits = frame.outcomes.iter().filter(|o| o.hit().is_some()).count();
+    assert!(
+        hits > 200,
+        "the shell should fill much of the image: {hits}"
+    );
+}
+
+#[test]
+fn camera_on_a_mesh_vertex_retraces_lost_starts() {
+    // The eye sits exactly on a grid vertex: for most directions no face of
+    // the located tet winds around it, so the GPU start fails and those rays
+    // go through the batch path (the CPU's start over the vertex star).
+    let Some(ctx) = gpu() else { return };
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [4, 4, 4],
+        jitter: 0.0,
+        shell: Some(([2, 1, 1], [3, 3, 3])),
+        seed: 6,
+        ..Default::default()
+    });
+    let camera = Camera {
+        position: Vec3::new(1.0, 2.0, 1.0),
+        target: Vec3::new(2.5, 2.0, 2.0),
+        up: Vec3::Y,
+        vfov_deg: 45.0,
+    };
+    let frame = camera_case(&ctx, &mesh, &camera, 16, 12);
+    assert!(frame.retraced > 0, "no ray needed the batch start");
+}
+
+#[test]
+fn step_cap_is_reported_like_the_cpu() {
+    let Some(ctx) = gpu() else { return };
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [6, 6, 6],
+        jitter: 0.1,
+        seed: 2,
+        ..Default::default()
+    });
+    let cap = 4;
+    let (rays, starts) = random_rays(&mesh, 400, 13);
+    for layout in GpuLayout::ALL {
+        let gpu = GpuTracer::new(&ctx, &mesh, layout)
+            .unwrap()
+            .with_step_cap(cap);
+        let (out, stats) = gpu.trace_batch(&rays, &starts).unwrap();
+        let cpu = cpu_trace(&mesh, layout, &rays, &starts, Some(cap));
+        step_cap_case(cap, &out, &cpu, stats.failures);
+    }
+}
+
+fn step_cap_case(cap: u32, out: &[TraceOutcome], cpu: &[TraceOutcome], failures: u64) {
+    let mut capped = 0;
+    for (i, (g, c)) in out.iter().zip(cpu).enumerate() {
+        if let TraceOutcome::Failed {
+            failure,
+            tets_visited,
+        } = g
+        {
+            assert_eq!(*failure, Failure::StepCap, "ray {i}");
+            assert_eq!(*tets_visited, cap, "ray {i}");
+            capped += 1;
+        }
+        // Without constrained faces there is nothing to graze: every walk
+        // must match the CPU.
+        assert!(same_walk(g, c), "ray {i}: GPU {g:?} != CPU {c:?}");
+    }
+    assert!(capped > 100, "only {capped} rays reached the cap");
+    assert_eq!(failures, capped as u64);
+}
+
+#[test]
+fn limits_give_typed_errors_and_split_batches() {
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [3, 3, 3],
+        jitter: 0.1,
+        constrained_fraction: 0.2,
+        seed: 4,
+        ..Default::default()
+    });
+    // 162 tets × 20 B = 3240 B of Tet20 records: over a 2 KiB cap.
+    let Some(tiny) = gpu_with(&GpuOptions {
+        max_buffer_bytes: Some(2048),
+        ..Default::default()
+    }) else {
+        return;
+    };
+    match GpuTracer::new(&tiny, &mesh, GpuLayout::Tet20) {
+        Err(GpuError::TooLarge {
+            buffer,
+            bytes,
+            limit,
+            value,
+        }) => {
+            assert_eq!(buffer, "tet records");
+            assert_eq!(bytes, 20 * mesh.tets.len() as u64);
+            assert_eq!(limit, "max_storage_buffer_binding_size");
+            assert_eq!(value, 2048);
+        }
+        Err(e) => panic!("wrong error: {e}"),
+        Ok(_) => panic!("a mesh over the limit was accepted"),
+    }
+    // A 16 KiB cap holds the mesh but only 256 rays (64 B each) per dispatch.
+    let small = gpu_with(&GpuOptions {
+        max_buffer_bytes: Some(16384),
+        ..Default::default()
+    })
+    .unwrap();
+    let split = GpuTracer::new(&small, &mesh, GpuLayout::Tet20).unwrap();
+    let (rays, starts) = random_rays(&mesh, 1000, 8);
+    let (a, sa) = split.trace_batch(&rays, &starts).unwrap();
+    assert_eq!(sa.dispatches, 4);
+    let Some(full_ctx) = gpu() else { return };
+    let full = GpuTracer::new(&full_ctx, &mesh, GpuLayout::Tet20).unwrap();
+    let (b, sb) = full.trace_batch(&rays, &starts).unwrap();
+    assert_eq!(sb.dispatches, 1);
+    assert_eq!(a, b);
+}
