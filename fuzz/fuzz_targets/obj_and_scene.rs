@@ -13,4 +13,6 @@ mod obj_and_scene {
     include!("../targets_common/obj_and_scene.rs");
 }
 
-fuzz_target!(|data: &[u8]| obj_and_scene::check(data));
+fuzz_target!(|data: &[u8]| {
+    obj_and_scene::check(data);
+});

@@ -84,4 +84,3 @@ pub fn peak_bytes<R>(f: impl FnOnce() -> R) -> (R, usize) {
     let peak = PEAK.with(Cell::get) - base;
     (r, peak.max(0) as usize)
 }
-

@@ -117,4 +117,3 @@ pub fn relabel(mesh: &TetMesh, seed: u64, extra: usize) -> TetMesh {
     }
     out
 }
-

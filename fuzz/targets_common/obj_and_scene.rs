@@ -21,7 +21,8 @@ use tet_build::scene::scenes_json::ScenesFile;
 use tet_build::scene::{MeshData, ObjectPlacement, Scene, SceneError, Transform};
 
 /// A tetrahedron surface, positions only.
-pub const TET_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+pub const TET_OBJ: &str =
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
 /// A quad (fan-triangulated) with normals and texture coordinates, CRLF.
 pub const QUAD_OBJ: &str = "# quad\r\nv -1 -1 0\r\nv 1 -1 0\r\nv 1 1 0\r\nv -1 1 0\r\nvn 0 0 1\r\nvt 0 0\r\nvt 1 0\r\nvt 1 1\r\nvt 0 1\r\nf 1/1/1 2/2/1 3/3/1 4/4/1\r\n";
 
@@ -53,11 +54,10 @@ pub fn known_crash(data: &[u8]) -> bool {
         let mut words = line.split_whitespace();
         words.next() == Some("f")
             && words.flat_map(|w| w.split('/')).any(|i| {
-                i.trim_start_matches(['-', '+'])
-                    .parse::<u128>()
-                    .map_or(i.len() > 10 && i.bytes().skip(1).all(|b| b.is_ascii_digit()), |x| {
-                        x >= 1 << 31
-                    })
+                i.trim_start_matches(['-', '+']).parse::<u128>().map_or(
+                    i.len() > 10 && i.bytes().skip(1).all(|b| b.is_ascii_digit()),
+                    |x| x >= 1 << 31,
+                )
             })
     })
 }
@@ -165,9 +165,15 @@ fn named(e: &SceneError, what: &str) {
 fn check_mesh(mesh: &MeshData) {
     let n = mesh.positions.len();
     assert!(!mesh.triangles.is_empty(), "Ok without triangles");
-    assert!(mesh.positions.iter().all(|p| p.is_finite()), "non-finite position");
+    assert!(
+        mesh.positions.iter().all(|p| p.is_finite()),
+        "non-finite position"
+    );
     for t in &mesh.triangles {
-        assert!(t.iter().all(|&v| (v as usize) < n), "triangle {t:?}, {n} positions");
+        assert!(
+            t.iter().all(|&v| (v as usize) < n),
+            "triangle {t:?}, {n} positions"
+        );
     }
     if let Some((values, idx)) = &mesh.normals {
         assert_eq!(idx.len(), mesh.triangles.len());
@@ -204,9 +210,15 @@ fn check_mesh(mesh: &MeshData) {
 /// Invariants of an assembled scene.
 fn check_scene(scene: &Scene) {
     let n = scene.vertices.len();
-    assert!(scene.vertices.iter().all(|p| p.is_finite()), "non-finite vertex");
+    assert!(
+        scene.vertices.iter().all(|p| p.is_finite()),
+        "non-finite vertex"
+    );
     for t in &scene.triangles {
-        assert!(t.iter().all(|&v| (v as usize) < n), "triangle {t:?}, {n} vertices");
+        assert!(
+            t.iter().all(|&v| (v as usize) < n),
+            "triangle {t:?}, {n} vertices"
+        );
     }
     if let Some(v) = &scene.normals {
         assert_eq!(v.len(), n);
@@ -225,7 +237,9 @@ fn check_scene(scene: &Scene) {
     assert_eq!(next_triangle, scene.triangles.len() as u64);
     assert_eq!(next_vertex, n as u64);
     for t in 0..scene.triangles.len() as u32 {
-        let o = scene.object_of_triangle(t).expect("every triangle has an object");
+        let o = scene
+            .object_of_triangle(t)
+            .expect("every triangle has an object");
         let obj = &scene.objects[o];
         assert!(obj.first_triangle <= t && t - obj.first_triangle < obj.triangle_count);
     }

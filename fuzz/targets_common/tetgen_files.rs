@@ -84,7 +84,9 @@ pub fn known_crash(data: &[u8]) -> bool {
             .lines()
             .map(|l| l.split('#').next().unwrap_or(""))
             .find_map(|l| l.split_whitespace().next());
-        first.and_then(|c| c.parse::<u128>().ok()).is_some_and(|c| c > 100_000)
+        first
+            .and_then(|c| c.parse::<u128>().ok())
+            .is_some_and(|c| c > 100_000)
     })
 }
 
@@ -146,7 +148,11 @@ fn check_files(files: &TetgenFiles, has_face: bool, has_neigh: bool) {
     if let Some(rows) = &files.neighbors {
         assert_eq!(rows.len(), files.tets.len());
         let nt = files.tets.len() as i64;
-        assert!(rows.iter().flatten().all(|&x| x == -1 || (0..nt).contains(&i64::from(x))));
+        assert!(
+            rows.iter()
+                .flatten()
+                .all(|&x| x == -1 || (0..nt).contains(&i64::from(x)))
+        );
     }
 }
 
@@ -179,11 +185,17 @@ fn check_mesh(files: &TetgenFiles, base: &Path) -> bool {
                 assert_eq!(a, b, "tet changed its vertices");
             }
             let markers = files.face_markers.as_deref().unwrap_or(&[]);
-            assert_eq!(mesh.constrained.len(), markers.iter().filter(|&&m| m > 0).count());
+            assert_eq!(
+                mesh.constrained.len(),
+                markers.iter().filter(|&&m| m > 0).count()
+            );
             let back = tetgen_files::from_tet_mesh(&mesh);
             let again = tetgen_files::to_tet_mesh(&back, base, Some(mesh.triangle_count))
                 .expect("an exported mesh imports");
-            assert!(again == mesh, "from_tet_mesh/to_tet_mesh round trip differs");
+            assert!(
+                again == mesh,
+                "from_tet_mesh/to_tet_mesh round trip differs"
+            );
             true
         }
         Err(e) => {

@@ -49,7 +49,11 @@ pub fn check(data: &[u8]) -> usize {
         let tracers: Vec<Box<dyn Tracer + '_>> = vec![
             Box::new(SctpTracer::new(&mesh).expect("sctp").with_step_cap(cap)),
             Box::new(Tet32Tracer::new(&mesh).expect("tet32").with_step_cap(cap)),
-            Box::new(Tet32TracerF64::new(&mesh).expect("tet32/f64").with_step_cap(cap)),
+            Box::new(
+                Tet32TracerF64::new(&mesh)
+                    .expect("tet32/f64")
+                    .with_step_cap(cap),
+            ),
             Box::new(Tet20Tracer::new(&mesh).expect("tet20").with_step_cap(cap)),
             Box::new(Tet16Tracer::new(&mesh).expect("tet16").with_step_cap(cap)),
             Box::new(Tet80Tracer::new(&mesh).expect("tet80").with_step_cap(cap)),
@@ -89,7 +93,11 @@ fn check_outcome(
 ) {
     let name = tracer.name();
     let ctx = || format!("{name}: {ray:?} from {start:?}, cap {cap}: {out:?}");
-    assert!(out.tets_visited() <= cap, "visited more than the cap: {}", ctx());
+    assert!(
+        out.tets_visited() <= cap,
+        "visited more than the cap: {}",
+        ctx()
+    );
     if !ray.is_valid() {
         assert!(
             matches!(
@@ -129,7 +137,11 @@ fn check_outcome(
             assert!(h.far_tet == NO_TET || (h.far_tet as usize) < mesh.tets.len());
             let _ = side;
             assert!(h.barycentrics.iter().all(|w| w.is_finite()), "{}", ctx());
-            assert!(h.t >= ray.t_min && h.t <= ray.t_max, "t out of range: {}", ctx());
+            assert!(
+                h.t >= ray.t_min && h.t <= ray.t_max,
+                "t out of range: {}",
+                ctx()
+            );
             assert!(h.tets_visited >= 1, "{}", ctx());
         }
     }
@@ -203,7 +215,16 @@ fn ray_from(mesh: &TetMesh, b: &mut Bytes) -> (Ray, Start) {
                 .iter()
                 .enumerate()
                 .filter(|(_, c)| c.front.exists() && c.back.exists())
-                .map(|(i, c)| (i as u32, if b.u8() & 1 == 0 { c.front.tet } else { c.back.tet }))
+                .map(|(i, c)| {
+                    (
+                        i as u32,
+                        if b.u8() & 1 == 0 {
+                            c.front.tet
+                        } else {
+                            c.back.tet
+                        },
+                    )
+                })
                 .collect();
             match two_sided.get(b.below(two_sided.len().max(1) as u32) as usize) {
                 Some(&(face, tet)) => Start::Face { face, tet },

@@ -46,13 +46,25 @@ fn check_round_trips(mesh: &TetMesh) {
         panic!("canonical slot order of a valid mesh is invalid: {e}");
     }
     let t32 = Tet32Mesh::from_mesh(mesh).expect("tet32 encodes a valid mesh");
-    assert!(t32.to_mesh().expect("tet32 decodes") == *mesh, "tet32 round trip");
+    assert!(
+        t32.to_mesh().expect("tet32 decodes") == *mesh,
+        "tet32 round trip"
+    );
     let t20 = Tet20Mesh::from_mesh(mesh).expect("tet20 encodes a valid mesh");
-    assert!(t20.to_mesh().expect("tet20 decodes") == canon, "tet20 round trip");
+    assert!(
+        t20.to_mesh().expect("tet20 decodes") == canon,
+        "tet20 round trip"
+    );
     let t16 = Tet16Mesh::from_mesh(mesh).expect("tet16 encodes a valid mesh");
-    assert!(t16.to_mesh().expect("tet16 decodes") == canon, "tet16 round trip");
+    assert!(
+        t16.to_mesh().expect("tet16 decodes") == canon,
+        "tet16 round trip"
+    );
     let t80 = Tet80Mesh::from_mesh(mesh).expect("tet80 encodes a valid mesh");
-    assert!(t80.to_mesh().expect("tet80 decodes") == *mesh, "tet80 round trip");
+    assert!(
+        t80.to_mesh().expect("tet80 decodes") == *mesh,
+        "tet80 round trip"
+    );
     // Re-encoding the canonical form gives the same xor records.
     assert!(Tet20Mesh::from_mesh(&canon).expect("tet20").tets == t20.tets);
     assert!(Tet16Mesh::from_mesh(&canon).expect("tet16").tets == t16.tets);
@@ -89,12 +101,20 @@ fn check_records(mesh: &TetMesh) {
                 assert_eq!(r32.neighbor_opposite(ids[exit]), want, "tet32 {t}");
                 assert_eq!(r20.neighbor_opposite(ids[exit], ids), want, "tet20 {t}");
                 let want_rank = rank_of(ids[exit], ids);
-                assert_eq!(r16.neighbor(entry_link, entry_rank, want_rank), want, "tet16 {t}");
+                assert_eq!(
+                    r16.neighbor(entry_link, entry_rank, want_rank),
+                    want,
+                    "tet16 {t}"
+                );
             }
         }
         for k in 0..4 {
             let f = r80.f[k];
-            assert_eq!(r80.vertex(k), mesh.points[ids[k] as usize], "tet80 {t} vertex {k}");
+            assert_eq!(
+                r80.vertex(k),
+                mesh.points[ids[k] as usize],
+                "tet80 {t} vertex {k}"
+            );
             match links[k].kind() {
                 LinkKind::Constrained(c) => assert_eq!(f.occlusion, c),
                 _ => assert_eq!(f.occlusion, Tet80Face::NON_OCCLUSIVE),
@@ -130,7 +150,10 @@ fn check_single_records(b: &mut Bytes) {
             for exit in 0..4 {
                 assert_eq!(r20.neighbor_opposite(ids[exit], ids), links[exit]);
                 let want_rank = rank_of(ids[exit], ids);
-                assert_eq!(r16.neighbor(links[entry], entry_rank, want_rank), links[exit]);
+                assert_eq!(
+                    r16.neighbor(links[entry], entry_rank, want_rank),
+                    links[exit]
+                );
             }
         }
     }

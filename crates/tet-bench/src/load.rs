@@ -205,7 +205,9 @@ pub fn build_scene(scene: &Scene, _: &BuildFlags, _: bool) -> Result<(TetMesh, B
     )
 }
 
-/// A camera looking at the mesh's bounding box from +z, framing it.
+/// A camera for a mesh without a scene: just inside the +z side of the
+/// mesh's bounding box (inside the enclosing box a build adds), looking at
+/// the centre, so that walks can start in the tet containing it.
 pub fn framing_camera(mesh: &TetMesh) -> Camera {
     let (min, max) = mesh
         .points
@@ -215,12 +217,12 @@ pub fn framing_camera(mesh: &TetMesh) -> Camera {
         return Camera::default();
     }
     let center = (min + max) * 0.5;
-    let radius = (max - min).length() * 0.5;
+    let position = Vec3::new(center.x, center.y, max.z - 0.02 * (max.z - min.z));
     Camera {
-        position: center + Vec3::new(0.0, 0.0, radius * 2.6),
+        position,
         target: center,
         up: Vec3::Y,
-        vfov_deg: 45.0,
+        vfov_deg: 60.0,
     }
 }
 

@@ -66,8 +66,9 @@ pub enum FilesError {
     /// The files do not form a valid mesh.
     #[error("{0}")]
     Mesh(#[from] MeshError),
-    /// A tet becomes flat or inverted when coordinates are rounded to f32.
-    #[error("tet {tet} (from {path}) is flat or inverted after rounding its points to f32")]
+    /// A tet is flat in the file's own f64 coordinates, or becomes flat or
+    /// inverted when they are rounded to f32.
+    #[error("tet {tet} (from {path}) is flat, or flat/inverted after rounding its points to f32")]
     RoundingFlattens {
         /// The `.ele` file.
         path: PathBuf,
@@ -132,7 +133,8 @@ fn records<'t>(
     min_fields: usize,
 ) -> Result<(i64, Vec<Record<'t>>), FilesError> {
     let mut base = 0i64;
-    let mut out = Vec::with_capacity(count);
+    // The header count is untrusted: never preallocate by it.
+    let mut out = Vec::with_capacity(count.min(1 << 16));
     for k in 0..count {
         let (line, fields) = lines
             .next()

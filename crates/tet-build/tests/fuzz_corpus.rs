@@ -304,7 +304,10 @@ fn obj_known_crash_regressions() {
     assert!(inputs.len() >= 2);
     for (name, bytes) in &inputs {
         assert!(obj_and_scene::known_crash(bytes), "{name}");
-        assert!(!obj_and_scene::check_obj(bytes), "{name}: out-of-range index parsed");
+        assert!(
+            !obj_and_scene::check_obj(bytes),
+            "{name}: out-of-range index parsed"
+        );
     }
 }
 
@@ -327,7 +330,9 @@ fn tetgen_files_known_crash_guard_is_narrow() {
     }
     let at_limit = tetgen_files_target::join("100000 3 0 0\n", "0 4 0\n", None, None);
     assert!(!tetgen_files_target::known_crash(&at_limit));
-    assert!(!bounded("at limit", &at_limit, || tetgen_files_target::check(&at_limit)));
+    assert!(!bounded("at limit", &at_limit, || {
+        tetgen_files_target::check(&at_limit)
+    }));
 }
 
 /// Tokens that break naive parsers: huge and negative counts and indices,
@@ -387,7 +392,10 @@ fn mutate_text(rng: &mut SplitMix64, text: &[u8]) -> Vec<u8> {
             }
             3 | 4 => {
                 // Delete (3) or duplicate (4) the line around `pos`.
-                let s = b[..pos].iter().rposition(|&c| c == b'\n').map_or(0, |i| i + 1);
+                let s = b[..pos]
+                    .iter()
+                    .rposition(|&c| c == b'\n')
+                    .map_or(0, |i| i + 1);
                 let e = b[pos..]
                     .iter()
                     .position(|&c| c == b'\n')

@@ -119,6 +119,19 @@ fn errors_name_file_and_line() {
         }
         other => panic!("{other:?}"),
     }
+    // A huge header count with no records: a parse error, not an allocation.
+    std::fs::write(dir.path().join("bad.ele"), "4000000000000 4 0\n0 0 1 2 0\n").unwrap();
+    match read(&base) {
+        Err(FilesError::Parse {
+            line: 0, message, ..
+        }) => {
+            assert!(
+                message.contains("expected 4000000000000 records, found 1"),
+                "{message}"
+            )
+        }
+        other => panic!("{other:?}"),
+    }
     std::fs::remove_file(dir.path().join("bad.ele")).unwrap();
     assert!(matches!(read(&base), Err(FilesError::Io { .. })));
     // A flat tet is refused when converting.

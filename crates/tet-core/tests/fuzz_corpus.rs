@@ -125,7 +125,10 @@ fn sample_meshes() -> Vec<(&'static str, TetMesh)> {
         ("empty", TetMesh::default()),
         ("cube", grid([1, 1, 1], 0.0, None, 1)),
         ("cube_constrained", grid([1, 1, 1], 0.6, None, 2)),
-        ("shell", grid([2, 2, 1], 0.0, Some(([0, 0, 0], [1, 1, 1])), 3)),
+        (
+            "shell",
+            grid([2, 2, 1], 0.0, Some(([0, 0, 0], [1, 1, 1])), 3),
+        ),
         ("attributes", with_attributes),
     ]
 }
@@ -202,7 +205,10 @@ fn mesh_file_every_truncation_is_a_typed_error() {
             let cut = &bytes[..len];
             let (result, peak) = peak_bytes(|| format::from_bytes(cut));
             assert!(result.is_err(), "{name}: prefix of {len} bytes loaded");
-            assert!(peak <= mesh_file_budget(len), "{name}: prefix {len}: {peak} bytes");
+            assert!(
+                peak <= mesh_file_budget(len),
+                "{name}: prefix {len}: {peak} bytes"
+            );
             check_mesh_file(cut);
         }
     }

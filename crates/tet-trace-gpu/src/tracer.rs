@@ -7,18 +7,23 @@ use std::time::Instant;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3};
-use tet_core::layout::{Tet16Mesh, Tet20Mesh, Tet32Mesh};
+use tet_core::layout::{Tet16Mesh, Tet20Mesh, Tet32Mesh, Tet80Mesh};
 use tet_core::scene::Camera;
 use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
 use tet_trace_cpu::render::PinholeCamera;
+use tet_trace_cpu::tet80::EXIT;
 use tet_trace_cpu::walk::{start_exit_face, step_cap};
-use tet_trace_cpu::{DuffF32, Failure, Hit, Ray, Start, TraceOutcome};
+use tet_trace_cpu::{DuffF32, Failure, Hit, Ray, Start, TraceOutcome, TripleF32};
 use wgpu::util::DeviceExt;
 
 use crate::{GpuContext, GpuError};
 
 /// WGSL source of the layout-independent walk.
 const WALK: &str = include_str!("walk.wgsl");
+/// WGSL shared by the kernels (records, bindings, camera rays, hit point).
+const COMMON: &str = include_str!("common.wgsl");
+/// WGSL of the Tet80 Plücker walk.
+const TET80: &str = include_str!("tet80.wgsl");
 
 /// The compact layout a [`GpuTracer`] uploads and walks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -31,11 +36,19 @@ pub enum GpuLayout {
     /// Seed 000 Tet16: `VX` + three link xor-differences (16 bytes,
     /// Algorithm 7; the entry link is carried along the walk).
     Tet16,
+    /// Seed 001 Tet80: four vertex positions + four faces (80 bytes), walked
+    /// with Plücker side products (not watertight by construction).
+    Tet80,
 }
 
 impl GpuLayout {
     /// All layouts with a GPU kernel.
-    pub const ALL: [GpuLayout; 3] = [GpuLayout::Tet20, GpuLayout::Tet32, GpuLayout::Tet16];
+    pub const ALL: [GpuLayout; 4] = [
+        GpuLayout::Tet20,
+        GpuLayout::Tet32,
+        GpuLayout::Tet16,
+        GpuLayout::Tet80,
+    ];
 
     /// Layout name (`"tet20"`, ...).
     pub fn name(self) -> &'static str {
@@ -43,6 +56,7 @@ impl GpuLayout {
             GpuLayout::Tet20 => "tet20",
             GpuLayout::Tet32 => "tet32",
             GpuLayout::Tet16 => "tet16",
+            GpuLayout::Tet80 => "tet80",
         }
     }
 
@@ -52,6 +66,7 @@ impl GpuLayout {
             GpuLayout::Tet20 => "gpu-tet20",
             GpuLayout::Tet32 => "gpu-tet32",
             GpuLayout::Tet16 => "gpu-tet16",
+            GpuLayout::Tet80 => "gpu-tet80",
         }
     }
 
@@ -61,6 +76,28 @@ impl GpuLayout {
             GpuLayout::Tet20 => 20,
             GpuLayout::Tet32 => 32,
             GpuLayout::Tet16 => 16,
+            GpuLayout::Tet80 => 80,
+        }
+    }
+
+    /// The complete WGSL source of the layout's kernel.
+    fn source(self) -> String {
+        if self == GpuLayout::Tet80 {
+            let (mut exit, mut second, mut first) = (0u32, 0u32, 0u32);
+            for e in 0..4 {
+                for j in 0..4 {
+                    exit |= (EXIT[e][j] as u32) << (2 * (4 * e + j));
+                }
+                let [a, b, c] = FACE_VERTICES[e];
+                second |= (b as u32) << (2 * (2 * e)) | (c as u32) << (2 * (2 * e + 1));
+                first |= (a as u32) << (2 * e);
+            }
+            format!(
+                "{COMMON}\nconst EXIT80: u32 = {exit}u;\nconst SECOND80: u32 = {second}u;\n\
+                 const FIRST80: u32 = {first}u;\n{TET80}"
+            )
+        } else {
+            format!("{COMMON}\n{WALK}\n{}", self.snippet())
         }
     }
 
@@ -70,6 +107,7 @@ impl GpuLayout {
     /// the CPU `Topology` implementations.
     fn snippet(self) -> &'static str {
         match self {
+            GpuLayout::Tet80 => "",
             // Algorithm 5: links in the rank order of their opposite vertex.
             GpuLayout::Tet20 => {
                 "fn layout_vx(t: u32) -> u32 { return tets[5u * t]; }
@@ -111,6 +149,7 @@ fn layout_exit(t: u32, d: u32, e: u32) -> u32 {
             GpuLayout::Tet20 => bytemuck::cast_slice(&Tet20Mesh::from_mesh(mesh)?.tets).to_vec(),
             GpuLayout::Tet32 => bytemuck::cast_slice(&Tet32Mesh::from_mesh(mesh)?.tets).to_vec(),
             GpuLayout::Tet16 => bytemuck::cast_slice(&Tet16Mesh::from_mesh(mesh)?.tets).to_vec(),
+            GpuLayout::Tet80 => bytemuck::cast_slice(&Tet80Mesh::from_mesh(mesh)?.tets).to_vec(),
         })
     }
 }
@@ -393,7 +432,7 @@ impl<'a> GpuTracer<'a> {
         let tets_buf = storage(layout.name(), bytemuck::cast_slice(&tets));
         let faces_buf = storage("constrained", bytemuck::cast_slice(&faces));
         let dummy = storage("dummy", &[0u8; 64]);
-        let source = format!("{WALK}\n{}", layout.snippet());
+        let source = layout.source();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(layout.method()),
             source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -463,6 +502,9 @@ impl<'a> GpuTracer<'a> {
             return done(ST_INVALID);
         }
         let mesh = self.mesh;
+        if self.layout == GpuLayout::Tet80 {
+            return self.start_record_tet80(ray, start);
+        }
         match start {
             Start::Tet(t) => {
                 if t as usize >= mesh.tets.len() {
@@ -498,6 +540,44 @@ impl<'a> GpuTracer<'a> {
                     link: Link::constrained(face).0,
                     visited: 0,
                     next: tet,
+                }
+            }
+        }
+    }
+
+    /// Start of a Tet80 walk, as `Tet80Tracer::trace` (triple-product start,
+    /// then `leave` through the exit face; or entering through a face).
+    fn start_record_tet80(&self, ray: &Ray, start: Start) -> StartRec {
+        let mesh = self.mesh;
+        let rec = |mode, tet, face, visited| StartRec {
+            mode,
+            ids: [face, 0, 0],
+            tet,
+            link: 0,
+            visited,
+            next: 0,
+        };
+        let done = |status, visited| StartRec {
+            link: status,
+            ..rec(START_DONE, NO_TET, 0, visited)
+        };
+        match start {
+            Start::Tet(t) if (t as usize) < mesh.tets.len() => {
+                match start_exit_face::<TripleF32>(mesh, ray, t) {
+                    Some((t, k)) => rec(START_EXIT, t, k as u32, 1),
+                    None => done(ST_LOST, 1),
+                }
+            }
+            Start::Tet(_) => done(ST_LOST, 0),
+            Start::Face { face, tet } => {
+                match mesh
+                    .constrained
+                    .get(face as usize)
+                    .and_then(|cf| cf.side_of(tet))
+                    .filter(|_| (tet as usize) < mesh.tets.len())
+                {
+                    Some(s) => rec(START_ENTER, tet, s.face & 3, 0),
+                    None => done(ST_LOST, 0),
                 }
             }
         }

@@ -180,16 +180,16 @@ fn read_request<R: Read>(r: &mut R) -> io::Result<(TetgenInput, TetgenOptions)> 
     let options = parse_switches(&switches)
         .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidData, "bad switches"))?;
     let np = get_u32(r)? as usize;
-    let mut points = Vec::with_capacity(np.min(1 << 24));
+    let mut points = Vec::with_capacity(np.min(1 << 16));
     for _ in 0..np {
         points.push([get_f64(r)?, get_f64(r)?, get_f64(r)?]);
     }
     let nt = get_u32(r)? as usize;
-    let mut triangles = Vec::with_capacity(nt.min(1 << 24));
+    let mut triangles = Vec::with_capacity(nt.min(1 << 16));
     for _ in 0..nt {
         triangles.push([get_u32(r)?, get_u32(r)?, get_u32(r)?]);
     }
-    let mut markers = Vec::with_capacity(nt.min(1 << 24));
+    let mut markers = Vec::with_capacity(nt.min(1 << 16));
     for _ in 0..nt {
         markers.push(get_i32(r)?);
     }
