@@ -24,7 +24,7 @@ const PLACEMENTS: [(f32, [f32; 3]); 6] = [
 
 /// The valid mesh described by the front of `b` (see the module comment).
 pub fn mesh_from(b: &mut Bytes) -> TetMesh {
-    let cells = [1 + b.below(3), 1 + b.below(3), 1 + b.below(2)];
+    let cells = [1 + b.below(2), 1 + b.below(2), 1 + b.below(2)];
     let jitter = f32::from(b.u8()) / 255.0 * 0.15;
     let constrained_fraction = f64::from(b.u8()) / 255.0;
     let shell = if b.u8() & 1 == 1 {

@@ -34,35 +34,46 @@ use super::input::Bytes;
 pub fn check(data: &[u8]) {
     let mut b = Bytes::new(data);
     let mesh = mesh_from(&mut b);
-    check_round_trips(&mesh);
-    check_records(&mesh);
+    let layouts = Layouts {
+        t32: Tet32Mesh::from_mesh(&mesh).expect("tet32 encodes a valid mesh"),
+        t20: Tet20Mesh::from_mesh(&mesh).expect("tet20 encodes a valid mesh"),
+        t16: Tet16Mesh::from_mesh(&mesh).expect("tet16 encodes a valid mesh"),
+        t80: Tet80Mesh::from_mesh(&mesh).expect("tet80 encodes a valid mesh"),
+    };
+    check_round_trips(&mesh, &layouts);
+    check_records(&mesh, &layouts);
     check_single_records(&mut b);
-    check_corruption(&mesh, &mut b);
+    check_corruption(&mesh, layouts, &mut b);
 }
 
-fn check_round_trips(mesh: &TetMesh) {
+/// The four encodings of one mesh.
+struct Layouts {
+    t32: Tet32Mesh,
+    t20: Tet20Mesh,
+    t16: Tet16Mesh,
+    t80: Tet80Mesh,
+}
+
+fn check_round_trips(mesh: &TetMesh, l: &Layouts) {
     let canon = canonical_slot_order(mesh);
     if let Err(e) = canon.validate() {
         panic!("canonical slot order of a valid mesh is invalid: {e}");
     }
-    let t32 = Tet32Mesh::from_mesh(mesh).expect("tet32 encodes a valid mesh");
+    let (t20, t16) = (&l.t20, &l.t16);
     assert!(
-        t32.to_mesh().expect("tet32 decodes") == *mesh,
+        l.t32.to_mesh().expect("tet32 decodes") == *mesh,
         "tet32 round trip"
     );
-    let t20 = Tet20Mesh::from_mesh(mesh).expect("tet20 encodes a valid mesh");
     assert!(
         t20.to_mesh().expect("tet20 decodes") == canon,
         "tet20 round trip"
     );
-    let t16 = Tet16Mesh::from_mesh(mesh).expect("tet16 encodes a valid mesh");
     assert!(
         t16.to_mesh().expect("tet16 decodes") == canon,
         "tet16 round trip"
     );
-    let t80 = Tet80Mesh::from_mesh(mesh).expect("tet80 encodes a valid mesh");
     assert!(
-        t80.to_mesh().expect("tet80 decodes") == *mesh,
+        l.t80.to_mesh().expect("tet80 decodes") == *mesh,
         "tet80 round trip"
     );
     // Re-encoding the canonical form gives the same xor records.
@@ -71,11 +82,8 @@ fn check_round_trips(mesh: &TetMesh) {
 }
 
 /// Per-record decoding from every entry face, against the canonical mesh.
-fn check_records(mesh: &TetMesh) {
-    let t32 = Tet32Mesh::from_mesh(mesh).expect("tet32");
-    let t20 = Tet20Mesh::from_mesh(mesh).expect("tet20");
-    let t16 = Tet16Mesh::from_mesh(mesh).expect("tet16");
-    let t80 = Tet80Mesh::from_mesh(mesh).expect("tet80");
+fn check_records(mesh: &TetMesh, l: &Layouts) {
+    let (t32, t20, t16, t80) = (&l.t32, &l.t20, &l.t16, &l.t80);
     for (t, (&ids, &links)) in mesh.tets.iter().zip(&mesh.neighbors).enumerate() {
         let r32 = t32.tets[t];
         let (r20, r16, r80) = (t20.tets[t], t16.tets[t], t80.tets[t]);
@@ -181,12 +189,14 @@ fn decoded(result: Result<TetMesh, LayoutError>) {
     }
 }
 
-fn check_corruption(mesh: &TetMesh, b: &mut Bytes) {
+fn check_corruption(mesh: &TetMesh, l: Layouts, b: &mut Bytes) {
     let rounds = 1 + b.below(3);
-    let mut t32 = Tet32Mesh::from_mesh(mesh).expect("tet32");
-    let mut t20 = Tet20Mesh::from_mesh(mesh).expect("tet20");
-    let mut t16 = Tet16Mesh::from_mesh(mesh).expect("tet16");
-    let mut t80 = Tet80Mesh::from_mesh(mesh).expect("tet80");
+    let Layouts {
+        mut t32,
+        mut t20,
+        mut t16,
+        mut t80,
+    } = l;
     let mut bad = mesh.clone();
     for _ in 0..rounds {
         let (what, at, mask) = (b.u8() % 10, b.u32(), b.u32().max(1));

@@ -42,7 +42,11 @@ impl Tracer for Single<'_> {
     fn mesh(&self) -> &tet_core::TetMesh {
         self.0.mesh()
     }
-    fn trace(&self, ray: &tet_trace_cpu::Ray, start: tet_trace_cpu::Start) -> tet_trace_cpu::TraceOutcome {
+    fn trace(
+        &self,
+        ray: &tet_trace_cpu::Ray,
+        start: tet_trace_cpu::Start,
+    ) -> tet_trace_cpu::TraceOutcome {
         self.0.trace(ray, start)
     }
 }
@@ -114,13 +118,20 @@ fn main() {
     );
     let only = std::env::var("TT_ONLY").ok();
     for t in &tracers {
-        if only.as_ref().is_some_and(|o| !t.name().contains(o.as_str())) {
+        if only
+            .as_ref()
+            .is_some_and(|o| !t.name().contains(o.as_str()))
+        {
             continue;
         }
         let mut best = f64::MAX;
         let mut stats = None;
         let single = Single(t.as_ref());
-        let t: &dyn Tracer = if env("TT_SINGLE", 0) == 1 { &single } else { t.as_ref() };
+        let t: &dyn Tracer = if env("TT_SINGLE", 0) == 1 {
+            &single
+        } else {
+            t.as_ref()
+        };
         let c0 = cpu_ms();
         for _ in 0..frames {
             let f = render(t, &camera, &lights, &opts).unwrap();
@@ -129,7 +140,9 @@ fn main() {
                 stats = Some(f.stats);
             }
         }
-        let cpu = c0.zip(cpu_ms()).map_or(f64::NAN, |(a, b)| (b - a) / frames as f64);
+        let cpu = c0
+            .zip(cpu_ms())
+            .map_or(f64::NAN, |(a, b)| (b - a) / frames as f64);
         let s = stats.unwrap();
         println!(
             "{:>14}: {:7.2} Mrays/s wall (best {:6.1} ms)  {:7.2} Mrays per CPU-s  {:5.1} tets/ray  hits {}  failures {}",

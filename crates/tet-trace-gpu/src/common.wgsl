@@ -69,7 +69,9 @@ struct HitRec {
 };
 
 @group(0) @binding(0) var<storage, read> points: array<f32>;
-@group(0) @binding(1) var<storage, read> tets: array<u32>;
+// Binding 1 (and 7, 8, 9 when the tet records are split over several
+// bindings) holds the tet records; the host declares it together with
+// `tet_word(i)`, the accessor of record word `i`.
 @group(0) @binding(2) var<storage, read> faces: array<u32>;
 @group(0) @binding(3) var<uniform> params: Params;
 @group(0) @binding(4) var<storage, read> rays: array<RayRec>;

@@ -10,7 +10,7 @@
 //! * [`GpuContext`]: adapter + device, with the adapter's highest limits and
 //!   timestamp queries when available;
 //! * [`GpuTracer`]: a mesh uploaded in one compact layout ([`GpuLayout`]:
-//!   Tet20, Tet32, Tet16) with its kernel; [`GpuTracer::trace_batch`] traces
+//!   Tet20, Tet32, Tet16, Tet80) with its kernel; [`GpuTracer::trace_batch`] traces
 //!   arbitrary rays (secondary rays from the CPU side), [`GpuTracer::render`]
 //!   generates camera rays on the GPU;
 //! * results are [`tet_trace_cpu::TraceOutcome`]s (the CPU hit records, same
@@ -24,8 +24,16 @@
 //! `layout_vx` / `layout_exit` functions (ports of the CPU `Topology`
 //! implementations: Tet32 Algorithm 3 compares the exit vertex with the three
 //! stored ids, Tet20 Algorithm 5 indexes the rank-ordered links, Tet16
-//! Algorithm 7 xors the carried entry link with two `NX` differences). The
-//! Tet80 Plücker walk of Maria et al. has no GPU kernel yet.
+//! Algorithm 7 xors the carried entry link with two `NX` differences).
+//!
+//! `src/tet80.wgsl` ports `tet_trace_cpu::tet80::Tet80Tracer`, the Plücker
+//! walk of Maria et al. (seed 001 §3–4): per tet the apex `V_e` opposite the
+//! entry face `e`, `m = d × (V_e − o)`, two side products
+//! `(V_x − V_e) · m` and the CPU's `EXIT` table (packed into `u32` constants
+//! by the host, so the tables cannot drift apart). Like the CPU kernel it is
+//! not watertight (zero counts as "right", and each tet computes an edge's
+//! side product in its own frame), and its products are sums a driver may
+//! contract into FMAs, so near-zero side products may differ from the CPU.
 //!
 //! | paper (seed 000) | CPU (`tet-trace-cpu`) | WGSL |
 //! |---|---|---|
@@ -41,7 +49,8 @@
 //!
 //! GPU buffers: points (`12 B` each, `f32 x,y,z`), the layout's tet records
 //! (Tet20 `20 B`: `VX` + four links in rank order; Tet32 `32 B`; Tet16
-//! `16 B`), and a 24-byte constrained-face record
+//! `16 B`; Tet80 `80 B` with the vertex positions inline, the point array
+//! then only serves the hit computation), and a 24-byte constrained-face record
 //! (`triangle, front tet, back tet, v0, v1, v2`) that the kernel needs to
 //! report the triangle, to order the barycentrics like the CPU and to cross
 //! faces before `t_min` (secondary rays). Normals and other attributes stay
@@ -103,10 +112,12 @@
 #![deny(missing_docs)]
 
 mod context;
+mod layout;
 mod tracer;
 
 pub use context::{GpuContext, GpuOptions, REQUIRE_ADAPTER_ENV};
-pub use tracer::{DispatchStats, GpuFrame, GpuLayout, GpuMemory, GpuTracer};
+pub use layout::GpuLayout;
+pub use tracer::{DispatchStats, GpuFrame, GpuMemory, GpuTracer};
 
 use thiserror::Error;
 

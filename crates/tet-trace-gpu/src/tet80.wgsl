@@ -12,7 +12,7 @@ const NONE80: u32 = 0xFFFFFFFFu;
 
 fn vtx(t: u32, k: u32) -> vec3<f32> {
     let b = 20u * t + 3u * k;
-    return vec3<f32>(bitcast<f32>(tets[b]), bitcast<f32>(tets[b + 1u]), bitcast<f32>(tets[b + 2u]));
+    return vec3<f32>(bitcast<f32>(tet_word(b)), bitcast<f32>(tet_word(b + 1u)), bitcast<f32>(tet_word(b + 2u)));
 }
 
 // glam's scalar Vec3 cross and dot, in its operation order.
@@ -38,8 +38,8 @@ var<private> s_out: HitRec;
 // its entry face).
 fn leave(k: u32) {
     let b = 20u * s_tet + 12u + 2u * k;
-    let occl = tets[b];
-    let nb = tets[b + 1u];
+    let occl = tet_word(b);
+    let nb = tet_word(b + 1u);
     if (occl != NONE80) {
         let wt = face_hit(faces[6u * occl + 3u], faces[6u * occl + 4u], faces[6u * occl + 5u]);
         if (wt.w >= r_tmin) {

@@ -1,158 +1,21 @@
-//! The walk kernels on the GPU (Tet20, Tet32, Tet16): mesh upload, batch
-//! tracing, camera rendering and per-dispatch statistics. See the crate docs for the decisions ported
-//! from the CPU walk and where results may differ.
+//! The tracer: mesh upload, batch tracing, camera rendering and
+//! per-dispatch statistics, for every [`GpuLayout`]. See the crate docs for
+//! the decisions ported from the CPU kernels and where results may differ.
 
 use std::sync::mpsc;
 use std::time::Instant;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3};
-use tet_core::layout::{Tet16Mesh, Tet20Mesh, Tet32Mesh, Tet80Mesh};
 use tet_core::scene::Camera;
 use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
 use tet_trace_cpu::render::PinholeCamera;
-use tet_trace_cpu::tet80::EXIT;
 use tet_trace_cpu::walk::{start_exit_face, step_cap};
 use tet_trace_cpu::{DuffF32, Failure, Hit, Ray, Start, TraceOutcome, TripleF32};
 use wgpu::util::DeviceExt;
 
-use crate::{GpuContext, GpuError};
+use crate::{GpuContext, GpuError, GpuLayout};
 
-/// WGSL source of the layout-independent walk.
-const WALK: &str = include_str!("walk.wgsl");
-/// WGSL shared by the kernels (records, bindings, camera rays, hit point).
-const COMMON: &str = include_str!("common.wgsl");
-/// WGSL of the Tet80 Plücker walk.
-const TET80: &str = include_str!("tet80.wgsl");
-
-/// The compact layout a [`GpuTracer`] uploads and walks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum GpuLayout {
-    /// Seed 000 Tet20: `VX` + four rank-ordered links (20 bytes, Algorithm 5).
-    Tet20,
-    /// Seed 000 Tet32: three ids, `VX`, four slot-ordered links (32 bytes,
-    /// Algorithm 3).
-    Tet32,
-    /// Seed 000 Tet16: `VX` + three link xor-differences (16 bytes,
-    /// Algorithm 7; the entry link is carried along the walk).
-    Tet16,
-    /// Seed 001 Tet80: four vertex positions + four faces (80 bytes), walked
-    /// with Plücker side products (not watertight by construction).
-    Tet80,
-}
-
-impl GpuLayout {
-    /// All layouts with a GPU kernel.
-    pub const ALL: [GpuLayout; 4] = [
-        GpuLayout::Tet20,
-        GpuLayout::Tet32,
-        GpuLayout::Tet16,
-        GpuLayout::Tet80,
-    ];
-
-    /// Layout name (`"tet20"`, ...).
-    pub fn name(self) -> &'static str {
-        match self {
-            GpuLayout::Tet20 => "tet20",
-            GpuLayout::Tet32 => "tet32",
-            GpuLayout::Tet16 => "tet16",
-            GpuLayout::Tet80 => "tet80",
-        }
-    }
-
-    /// Method name for reports and `tet-bench` (`"gpu-tet20"`, ...).
-    pub fn method(self) -> &'static str {
-        match self {
-            GpuLayout::Tet20 => "gpu-tet20",
-            GpuLayout::Tet32 => "gpu-tet32",
-            GpuLayout::Tet16 => "gpu-tet16",
-            GpuLayout::Tet80 => "gpu-tet80",
-        }
-    }
-
-    /// Bytes per tet record.
-    pub fn record_bytes(self) -> usize {
-        match self {
-            GpuLayout::Tet20 => 20,
-            GpuLayout::Tet32 => 32,
-            GpuLayout::Tet16 => 16,
-            GpuLayout::Tet80 => 80,
-        }
-    }
-
-    /// The complete WGSL source of the layout's kernel.
-    fn source(self) -> String {
-        if self == GpuLayout::Tet80 {
-            let (mut exit, mut second, mut first) = (0u32, 0u32, 0u32);
-            for e in 0..4 {
-                for j in 0..4 {
-                    exit |= (EXIT[e][j] as u32) << (2 * (4 * e + j));
-                }
-                let [a, b, c] = FACE_VERTICES[e];
-                second |= (b as u32) << (2 * (2 * e)) | (c as u32) << (2 * (2 * e + 1));
-                first |= (a as u32) << (2 * e);
-            }
-            format!(
-                "{COMMON}\nconst EXIT80: u32 = {exit}u;\nconst SECOND80: u32 = {second}u;\n\
-                 const FIRST80: u32 = {first}u;\n{TET80}"
-            )
-        } else {
-            format!("{COMMON}\n{WALK}\n{}", self.snippet())
-        }
-    }
-
-    /// The WGSL of `layout_vx(t)` (paper `VX^t`) and `layout_exit(t, d,
-    /// e)` (the raw link of tet `t` across the face opposite vertex `e`,
-    /// with `s_ids` the entry face and `d` the fourth vertex): the ports of
-    /// the CPU `Topology` implementations.
-    fn snippet(self) -> &'static str {
-        match self {
-            GpuLayout::Tet80 => "",
-            // Algorithm 5: links in the rank order of their opposite vertex.
-            GpuLayout::Tet20 => {
-                "fn layout_vx(t: u32) -> u32 { return tets[5u * t]; }
-fn layout_exit(t: u32, d: u32, e: u32) -> u32 {
-    return tets[5u * t + 1u + rank_of(e, s_ids[0], s_ids[1], s_ids[2], d)];
-}
-"
-            }
-            // Algorithm 3: v0 v1 v2 vx n0 n1 n2 n3, links in slot order.
-            GpuLayout::Tet32 => {
-                "fn layout_vx(t: u32) -> u32 { return tets[8u * t + 3u]; }
-fn layout_exit(t: u32, d: u32, e: u32) -> u32 {
-    let b = 8u * t;
-    if (e == tets[b]) { return tets[b + 4u]; }
-    if (e == tets[b + 1u]) { return tets[b + 5u]; }
-    if (e == tets[b + 2u]) { return tets[b + 6u]; }
-    return tets[b + 7u];
-}
-"
-            }
-            // Algorithm 7: N_want = N_entry ^ NX_rank(entry) ^ NX_rank(want),
-            // NX_3 = 0; the entry face is opposite d.
-            GpuLayout::Tet16 => {
-                "fn layout_vx(t: u32) -> u32 { return tets[4u * t]; }
-fn tet16_nx(t: u32, r: u32) -> u32 { return select(tets[4u * t + 1u + min(r, 2u)], 0u, r == 3u); }
-fn layout_exit(t: u32, d: u32, e: u32) -> u32 {
-    let rd = rank_of(d, s_ids[0], s_ids[1], s_ids[2], d);
-    let re = rank_of(e, s_ids[0], s_ids[1], s_ids[2], d);
-    return s_entry ^ tet16_nx(t, rd) ^ tet16_nx(t, re);
-}
-"
-            }
-        }
-    }
-
-    /// The layout's tet records as 32-bit words (validates the mesh).
-    fn encode(self, mesh: &TetMesh) -> Result<Vec<u32>, GpuError> {
-        Ok(match self {
-            GpuLayout::Tet20 => bytemuck::cast_slice(&Tet20Mesh::from_mesh(mesh)?.tets).to_vec(),
-            GpuLayout::Tet32 => bytemuck::cast_slice(&Tet32Mesh::from_mesh(mesh)?.tets).to_vec(),
-            GpuLayout::Tet16 => bytemuck::cast_slice(&Tet16Mesh::from_mesh(mesh)?.tets).to_vec(),
-            GpuLayout::Tet80 => bytemuck::cast_slice(&Tet80Mesh::from_mesh(mesh)?.tets).to_vec(),
-        })
-    }
-}
 /// Invocations per workgroup (must equal `@workgroup_size` in the shader).
 const WORKGROUP: u32 = 64;
 /// Largest number of rays per dispatch (bounds host staging memory).
@@ -956,4 +819,49 @@ fn read_buffer<T: Pod>(device: &wgpu::Device, buf: &wgpu::Buffer) -> Result<Vec<
     drop(data);
     buf.unmap();
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hit_records_map_to_cpu_outcomes() {
+        let rec = |status| HitRec {
+            status,
+            triangle: 7,
+            face: 3,
+            t: 2.5,
+            bary: [0.25, 0.25, 0.5],
+            tet: 11,
+            far_tet: NO_TET,
+            visited: 9,
+        };
+        match rec(ST_HIT).outcome() {
+            TraceOutcome::Hit(h) => {
+                assert_eq!((h.triangle, h.face, h.tet, h.tets_visited), (7, 3, 11, 9));
+                assert_eq!((h.t, h.barycentrics), (2.5, [0.25, 0.25, 0.5]));
+                assert!(!h.has_far_side());
+            }
+            o => panic!("{o:?}"),
+        }
+        assert_eq!(
+            rec(ST_MISS).outcome(),
+            TraceOutcome::Miss { tets_visited: 9 }
+        );
+        for (st, f) in [
+            (ST_STEP_CAP, Failure::StepCap),
+            (ST_INVALID, Failure::InvalidRay),
+            (ST_LOST, Failure::Lost),
+            (99, Failure::Lost),
+        ] {
+            assert_eq!(
+                rec(st).outcome(),
+                TraceOutcome::Failed {
+                    failure: f,
+                    tets_visited: 9
+                }
+            );
+        }
+    }
 }

@@ -31,10 +31,11 @@ fn left(a: vec2<f32>, ia: u32, b: vec2<f32>, ib: u32) -> bool {
     return ia < ib;
 }
 
-// Algorithm 1 as the CPU's EXIT_SLOT table [0, 2, 0, 0, 1, 2, 1, 0].
+// Algorithm 1 as the CPU's EXIT_SLOT table, packed 4 bits per entry by the
+// host into EXIT_SLOT_PACKED (from `tet_trace_cpu::walk::EXIT_SLOT`).
 fn exit_slot(sa: bool, sb: bool, sc: bool) -> u32 {
     let i = select(0u, 1u, sa) | select(0u, 2u, sb) | select(0u, 4u, sc);
-    return (0x01210020u >> (4u * i)) & 0xFu;
+    return (EXIT_SLOT_PACKED >> (4u * i)) & 0xFu;
 }
 
 fn rank_of(v: u32, a: u32, b: u32, c: u32, d: u32) -> u32 {
@@ -138,10 +139,19 @@ fn step() {
     let sb = left(pd, d, s_p[1], s_ids[1]);
     let sc = left(pd, d, s_p[2], s_ids[2]);
     let slot = exit_slot(sa, sb, sc);
-    let exiting = s_ids[slot];
+    // Constant indices only (like the CPU's branch-free replacement), so the
+    // state can live in registers instead of indexed local memory.
+    let e0 = slot == 0u;
+    let e1 = slot == 1u;
+    let e2 = slot == 2u;
+    let exiting = select(select(s_ids[2], s_ids[1], e1), s_ids[0], e0);
     let raw = layout_exit(next, d, exiting);
-    s_ids[slot] = d;
-    s_p[slot] = pd;
+    s_ids[0] = select(s_ids[0], d, e0);
+    s_ids[1] = select(s_ids[1], d, e1);
+    s_ids[2] = select(s_ids[2], d, e2);
+    s_p[0] = select(s_p[0], pd, e0);
+    s_p[1] = select(s_p[1], pd, e1);
+    s_p[2] = select(s_p[2], pd, e2);
     s_tet = next;
     s_link = raw;
     s_visited += 1u;
