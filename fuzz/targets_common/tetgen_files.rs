@@ -67,39 +67,8 @@ pub fn join(node: &str, ele: &str, face: Option<&str>, neigh: Option<&str>) -> V
     out
 }
 
-/// KNOWN BUG, reported to the lead (issue 7): `tetgen_files::read` sizes a
-/// `Vec::with_capacity` by the record count of a file's header line before
-/// reading any record, so a header such as `99999999999999 4 0` aborts the
-/// process ("memory allocation of … bytes failed"), and one of `10000000` (10⁷)
-/// reserves hundreds of MB for a tiny file. Until that is fixed, inputs
-/// whose first data line in any file starts with a count above 10⁵ are
-/// skipped here so the rest of the reader can be fuzzed; the reproducers
-/// live in `fuzz/regressions/tetgen_files/` (test
-/// `tetgen_files_known_crash_regressions`, `#[ignore]`d until the fix).
-pub fn known_crash(data: &[u8]) -> bool {
-    let (texts, _, _) = split(data);
-    texts.iter().any(|t| {
-        let text = String::from_utf8_lossy(t);
-        let first = text
-            .lines()
-            .map(|l| l.split('#').next().unwrap_or(""))
-            .find_map(|l| l.split_whitespace().next());
-        first
-            .and_then(|c| c.parse::<u128>().ok())
-            .is_some_and(|c| c > 100_000)
-    })
-}
-
 /// Runs the property on `data`; returns whether a mesh was built.
 pub fn check(data: &[u8]) -> bool {
-    if known_crash(data) {
-        return false;
-    }
-    check_unguarded(data)
-}
-
-/// The property without the [`known_crash`] guard.
-pub fn check_unguarded(data: &[u8]) -> bool {
     let ([node, ele, face, neigh], has_face, has_neigh) = split(data);
     let base = scratch("in");
     let write = |ext: &str, text: Option<&[u8]>| {

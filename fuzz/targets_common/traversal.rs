@@ -191,7 +191,8 @@ fn component(b: &mut Bytes) -> f32 {
     }
 }
 
-fn ray_from(mesh: &TetMesh, b: &mut Bytes) -> (Ray, Start, bool) {
+/// One ray, its start, and whether the start satisfies `Start`'s precondition.
+pub fn ray_from(mesh: &TetMesh, b: &mut Bytes) -> (Ray, Start, bool) {
     let tet = b.below(mesh.tets.len() as u32);
     let p = mesh.tet_points(tet);
     let vertex = |b: &mut Bytes| p[b.below(4) as usize];

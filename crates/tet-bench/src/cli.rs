@@ -101,6 +101,14 @@ pub enum Method {
     Obvhs,
     /// f64 brute force over all triangles (reference; slow).
     Brute,
+    /// Tet20 walk as a wgpu compute shader (needs the `gpu` feature).
+    GpuTet20,
+    /// Tet32 on the GPU.
+    GpuTet32,
+    /// Tet16 on the GPU.
+    GpuTet16,
+    /// Tet80 (Plücker) on the GPU.
+    GpuTet80,
 }
 
 impl Method {
@@ -114,7 +122,19 @@ impl Method {
             Method::Tet16 => "tet16",
             Method::Obvhs => "obvhs",
             Method::Brute => "brute",
+            Method::GpuTet20 => "gpu-tet20",
+            Method::GpuTet32 => "gpu-tet32",
+            Method::GpuTet16 => "gpu-tet16",
+            Method::GpuTet80 => "gpu-tet80",
         }
+    }
+
+    /// True for the GPU methods.
+    pub fn is_gpu(self) -> bool {
+        matches!(
+            self,
+            Method::GpuTet20 | Method::GpuTet32 | Method::GpuTet16 | Method::GpuTet80
+        )
     }
 }
 

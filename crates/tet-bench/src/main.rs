@@ -7,6 +7,7 @@ mod brute;
 mod bvh;
 mod cli;
 mod extremes;
+mod gpu;
 mod info;
 mod load;
 mod methods;

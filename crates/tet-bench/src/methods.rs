@@ -26,6 +26,7 @@ pub fn tracer<'m>(method: Method, f64: bool, mesh: &'m TetMesh) -> Result<Box<dy
         (Method::Obvhs, false) => Box::new(BvhTracer::new(mesh)),
         (Method::Brute, _) => Box::new(crate::brute::BruteTracer { mesh }),
         (m, true) => bail!("method {} has no f64 variant", m.name()),
+        (m, false) => bail!("{} runs on the GPU: only `render` supports it", m.name()),
     })
 }
 

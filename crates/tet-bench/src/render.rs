@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::render::{Frame, FrameStats, RenderOptions, render};
@@ -25,7 +25,7 @@ pub struct RenderDoc {
     pub width: u32,
     /// Image height.
     pub height: u32,
-    /// Worker threads.
+    /// Worker threads (0 for GPU methods).
     pub threads: usize,
     /// Frames timed (after one untimed warm-up frame).
     pub frames: u32,
@@ -150,14 +150,22 @@ pub fn run(args: &RenderArgs, json: bool) -> Result<()> {
         shadows: args.shadows,
         ..RenderOptions::default()
     };
-    let pool = pool(args.threads)?;
-    let (doc, frame) = time_method(&loaded, args.method, &opts, args.frames, &pool)?;
-    if let Some(path) = &args.output {
-        frame.save_png(path)?;
-    }
-    if let Some(path) = &args.heatmap {
-        frame.save_heatmap(path, None)?;
-    }
+    let doc = if args.method.is_gpu() {
+        if args.output.is_some() || args.heatmap.is_some() || args.shadows {
+            bail!("GPU methods report timings only: use a CPU method for images and shadows");
+        }
+        crate::gpu::time_gpu(&loaded, args.method, args.width, args.height, args.frames)?
+    } else {
+        let pool = pool(args.threads)?;
+        let (doc, frame) = time_method(&loaded, args.method, &opts, args.frames, &pool)?;
+        if let Some(path) = &args.output {
+            frame.save_png(path)?;
+        }
+        if let Some(path) = &args.heatmap {
+            frame.save_heatmap(path, None)?;
+        }
+        doc
+    };
     if json {
         println!("{}", serde_json::to_string_pretty(&doc)?);
     } else {

@@ -274,20 +274,19 @@ fn tetgen_files_seed_corpus() {
     );
 }
 
-/// Inputs that crashed a target, kept as regression tests. Those of
-/// `fuzz/regressions/tetgen_files/` abort the process in
-/// `tetgen_files::read` (an allocation sized by a header count; reported to
-/// the lead): run with `--ignored` once that is fixed, then move the files
-/// into `fuzz/seeds/tetgen_files/` and drop the `known_crash` guard.
+/// Found by the fuzzer: a header count sized an allocation before any
+/// record was read, aborting the process on `99999999999999 4 0` (fixed in
+/// `tetgen_files.rs`). The reproducers are seeds named `regress-*`.
 #[test]
-#[ignore = "known crash in tet-build/src/tetgen_files.rs (Vec::with_capacity from a header count), reported in issue 7"]
-fn tetgen_files_known_crash_regressions() {
-    let inputs = read_seeds("../regressions/tetgen_files");
+fn tetgen_files_huge_counts_are_typed_errors() {
+    let inputs: Vec<_> = read_seeds("tetgen_files")
+        .into_iter()
+        .filter(|(n, _)| n.starts_with("regress-"))
+        .collect();
     assert!(inputs.len() >= 3);
     for (name, bytes) in &inputs {
-        assert!(tetgen_files_target::known_crash(bytes), "{name}");
         assert!(
-            !bounded(name, bytes, || tetgen_files_target::check_unguarded(bytes)),
+            !bounded(name, bytes, || tetgen_files_target::check(bytes)),
             "{name}: a file with a huge record count built a mesh"
         );
     }
@@ -316,23 +315,13 @@ fn obj_known_crash_guard_is_narrow() {
     for (name, bytes) in read_seeds("obj_and_scene") {
         assert!(!obj_and_scene::known_crash(&bytes), "{name}");
     }
-    let small = b"v 0 0 0\nf 1//2147483647 -2147483647 1/-1/1\n";
+    let small = b"v 0 0 0\nvt 0 0\nvn 0 0 1\nf 1//2147483647 -1//-1 1/-1/1 1/1/1\n";
     assert!(!obj_and_scene::known_crash(small));
-    assert!(obj_and_scene::known_crash(b"f 1 2 2147483648\n"));
-}
-
-#[test]
-fn tetgen_files_known_crash_guard_is_narrow() {
-    // The guard skips only inputs with a header count above 10^5: every
-    // seed (and a count of exactly 10^5) still runs.
-    for (name, bytes) in read_seeds("tetgen_files") {
-        assert!(!tetgen_files_target::known_crash(&bytes), "{name}");
-    }
-    let at_limit = tetgen_files_target::join("100000 3 0 0\n", "0 4 0\n", None, None);
-    assert!(!tetgen_files_target::known_crash(&at_limit));
-    assert!(!bounded("at limit", &at_limit, || {
-        tetgen_files_target::check(&at_limit)
-    }));
+    assert!(obj_and_scene::known_crash(b"vn 0 0 1\nf 1//2147483648\n"));
+    assert!(obj_and_scene::known_crash(b"vn 0 0 1\nf 1//1 2//1 3//-3\n"));
+    assert!(!obj_and_scene::known_crash(
+        b"vn 0 0 1\nvn 0 0 1\nf 1//1 2//1 3//-2\n"
+    ));
 }
 
 /// Tokens that break naive parsers: huge and negative counts and indices,
@@ -400,7 +389,7 @@ fn mutate_text(rng: &mut SplitMix64, text: &[u8]) -> Vec<u8> {
                     .iter()
                     .position(|&c| c == b'\n')
                     .map_or(b.len(), |i| pos + i + 1);
-                if rng.next_u64() % 2 == 0 {
+                if rng.next_u64().is_multiple_of(2) {
                     b.drain(s..e);
                 } else {
                     let line: Vec<u8> = b[s..e].to_vec();

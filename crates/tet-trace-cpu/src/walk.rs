@@ -50,7 +50,7 @@
 //! [`trace_interleaved`] walks several rays on one thread, one step each per
 //! round, so the out-of-order core overlaps their dependent
 //! load → project → decide → load chains; each ray's result is exactly that
-//! of [`trace`] (the same [`step`]). Measured gain on the shared 2-core
+//! of [`trace`] (the same `step` function). Measured gain on the shared 2-core
 //! build machine: about 20 % per CPU-second (see `benches/render_throughput.rs`).
 //!
 //! Each kernel's operation count is in its module docs. The engine is generic
@@ -415,7 +415,7 @@ pub fn start_exit_face<P: Projection>(mesh: &TetMesh, ray: &Ray, tet: u32) -> Op
 
 /// One ray in flight: its projection, walk state, the tet it enters next
 /// and the raw link it enters through.
-pub struct Lane<P: Projection> {
+pub(crate) struct Lane<P: Projection> {
     proj: P,
     st: State<P>,
     next: u32,
@@ -447,7 +447,7 @@ pub fn trace<P: Projection, T: Topology>(
 /// each round advances every lane by one tet, so the CPU overlaps the
 /// dependent load → project → decide → load chains of independent rays
 /// (memory-level parallelism without SIMD). Results are identical to
-/// [`trace`] ray by ray (same [`step`]). `out.len()` must equal `rays.len()`.
+/// [`trace`] ray by ray (same `step`). `out.len()` must equal `rays.len()`.
 pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
     mesh: &TetMesh,
     topo: &T,
@@ -647,7 +647,7 @@ pub fn face_hit(mesh: &TetMesh, ray: &Ray, ids: [u32; 3]) -> (f64, [f64; 3]) {
 /// (raw back-link `lane.entry_raw`), choose the exit face, follow its link.
 /// `Some` when the walk ended.
 #[inline(always)]
-pub fn step<P: Projection, T: Topology>(
+pub(crate) fn step<P: Projection, T: Topology>(
     mesh: &TetMesh,
     topo: &T,
     ray: &Ray,

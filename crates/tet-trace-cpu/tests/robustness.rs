@@ -128,7 +128,7 @@ fn tracers(mesh: &TetMesh) -> Vec<Box<dyn Tracer + '_>> {
 
 #[test]
 fn projected_kernels_never_fail_escape_or_disagree() {
-    for (name, c) in census(3, 300) {
+    for (name, c) in census(3, 1500) {
         if name.starts_with("tet") && !name.starts_with("tet80") {
             assert_eq!((c.failures, c.escapes, c.wrong), (0, 0, 0), "{name}: {c:?}");
         }

@@ -13,7 +13,8 @@ pub const REQUIRE_ADAPTER_ENV: &str = "TET_GPU_REQUIRED";
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct GpuOptions {
     /// Caps `max_storage_buffer_binding_size` and `max_buffer_size` below the
-    /// device's values (bytes); `None` keeps the device's.
+    /// device's values (bytes); `None` keeps the device's. Tests use it to
+    /// exercise splitting and the limit errors on any adapter.
     pub max_buffer_bytes: Option<u64>,
     /// Never use timestamp queries (wall time only).
     pub disable_timestamps: bool,
@@ -33,6 +34,8 @@ pub struct GpuContext {
     pub(crate) max_buffer: u64,
     /// `max_compute_workgroups_per_dimension`.
     pub(crate) max_workgroups: u32,
+    /// `max_storage_buffers_per_shader_stage`.
+    pub(crate) max_storage_buffers: u32,
     pub(crate) timestamps: bool,
 }
 
@@ -95,6 +98,7 @@ impl GpuContext {
             max_binding: limits.max_storage_buffer_binding_size.min(cap),
             max_buffer: limits.max_buffer_size.min(cap),
             max_workgroups: limits.max_compute_workgroups_per_dimension.max(1),
+            max_storage_buffers: limits.max_storage_buffers_per_shader_stage,
             device,
             queue,
             info,

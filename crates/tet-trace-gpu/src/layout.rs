@@ -195,7 +195,11 @@ impl Split {
     fn wgsl(&self) -> String {
         let mut s = String::new();
         for j in 0..self.count {
-            let name = if j == 0 { "tets".to_string() } else { format!("tets{j}") };
+            let name = if j == 0 {
+                "tets".to_string()
+            } else {
+                format!("tets{j}")
+            };
             s += &format!(
                 "@group(0) @binding({}) var<storage, read> {name}: array<u32>;\n",
                 Split::binding(j)
@@ -210,7 +214,11 @@ impl Split {
                 self.shift
             );
             for j in 0..self.count {
-                let name = if j == 0 { "tets".to_string() } else { format!("tets{j}") };
+                let name = if j == 0 {
+                    "tets".to_string()
+                } else {
+                    format!("tets{j}")
+                };
                 if j + 1 == self.count {
                     s += &format!("        default: {{ return {name}[o]; }}\n");
                 } else {
@@ -252,6 +260,26 @@ fn tet80_tables() -> [u32; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn split_parts_cover_the_records_within_the_limit() {
+        assert_eq!(Split::new(810, 4096, 4), Some(Split { count: 1, shift: 0 }));
+        assert_eq!(Split::new(810, 256, 4), None);
+        assert_eq!(Split::new(3240, 4096, 2), None);
+        for (words, max) in [(3240u64, 4096u64), (3240, 8000), (1000, 2000), (5, 16)] {
+            let s = Split::new(words, max, 4).unwrap();
+            let mut next = 0;
+            for j in 0..s.count {
+                let r = s.part(j, words as usize);
+                assert_eq!(r.start, next);
+                assert!(!r.is_empty() && (r.len() * 4) as u64 <= max);
+                // Word i of part j is global word (j << shift) + i.
+                assert_eq!(r.start, (j as usize) << s.shift);
+                next = r.end;
+            }
+            assert_eq!(next, words as usize);
+        }
+    }
 
     #[test]
     fn packed_exit_slot_decodes_to_algorithm_1() {

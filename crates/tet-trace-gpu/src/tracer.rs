@@ -14,6 +14,7 @@ use tet_trace_cpu::walk::{start_exit_face, step_cap};
 use tet_trace_cpu::{DuffF32, Failure, Hit, Ray, Start, TraceOutcome, TripleF32};
 use wgpu::util::DeviceExt;
 
+use crate::layout::Split;
 use crate::{GpuContext, GpuError, GpuLayout};
 
 /// Invocations per workgroup (must equal `@workgroup_size` in the shader).
@@ -231,7 +232,8 @@ pub struct GpuTracer<'a> {
     mesh: &'a TetMesh,
     pipeline: wgpu::ComputePipeline,
     points: wgpu::Buffer,
-    tets: wgpu::Buffer,
+    /// Tet records, one buffer per binding (see `Split`).
+    tets: Vec<wgpu::Buffer>,
     faces: wgpu::Buffer,
     dummy: wgpu::Buffer,
     memory: GpuMemory,
@@ -268,7 +270,19 @@ impl<'a> GpuTracer<'a> {
             points: (points.len() * 4) as u64,
             constrained: (faces.len() * 4) as u64,
         };
-        ctx.check_size("tet records", memory.tets)?;
+        // The records may be split over several bindings; each part must
+        // also fit `max_buffer_size`.
+        let split = Split::new(
+            tets.len() as u64,
+            ctx.max_binding_bytes(),
+            ctx.max_storage_buffers.saturating_sub(5),
+        )
+        .ok_or(GpuError::TooLarge {
+            buffer: "tet records",
+            bytes: memory.tets,
+            limit: "max_storage_buffer_binding_size (times the bindings available for tets)",
+            value: ctx.max_binding_bytes(),
+        })?;
         ctx.check_size("points", memory.points)?;
         ctx.check_size("constrained faces", memory.constrained)?;
         if mesh.points.len() > (u32::MAX / 3) as usize {
@@ -292,10 +306,17 @@ impl<'a> GpuTracer<'a> {
             })
         };
         let points_buf = storage("points", bytemuck::cast_slice(&points));
-        let tets_buf = storage(layout.name(), bytemuck::cast_slice(&tets));
+        let tets_bufs: Vec<wgpu::Buffer> = (0..split.count)
+            .map(|j| {
+                storage(
+                    layout.name(),
+                    bytemuck::cast_slice(&tets[split.part(j, tets.len())]),
+                )
+            })
+            .collect();
         let faces_buf = storage("constrained", bytemuck::cast_slice(&faces));
         let dummy = storage("dummy", &[0u8; 64]);
-        let source = layout.source();
+        let source = layout.source(split);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(layout.method()),
             source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -315,7 +336,7 @@ impl<'a> GpuTracer<'a> {
             mesh,
             pipeline,
             points: points_buf,
-            tets: tets_buf,
+            tets: tets_bufs,
             faces: faces_buf,
             dummy,
             memory,
@@ -339,6 +360,12 @@ impl<'a> GpuTracer<'a> {
     /// The layout walked.
     pub fn layout(&self) -> GpuLayout {
         self.layout
+    }
+
+    /// Number of storage bindings the tet records are split over (1 when
+    /// they fit one binding).
+    pub fn tet_bindings(&self) -> usize {
+        self.tets.len()
     }
 
     /// Bytes of the mesh on the GPU.
@@ -693,18 +720,21 @@ impl<'a> GpuTracer<'a> {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let mut entries = vec![
+            entry(0, &self.points),
+            entry(2, &self.faces),
+            entry(3, &uniform),
+            entry(4, rays),
+            entry(5, starts),
+            entry(6, &out),
+        ];
+        for (j, b) in self.tets.iter().enumerate() {
+            entries.push(entry(Split::binding(j as u32), b));
+        }
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("walk"),
             layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[
-                entry(0, &self.points),
-                entry(1, &self.tets),
-                entry(2, &self.faces),
-                entry(3, &uniform),
-                entry(4, rays),
-                entry(5, starts),
-                entry(6, &out),
-            ],
+            entries: &entries,
         });
         let timing = self.ctx.timestamps.then(|| {
             let set = device.create_query_set(&wgpu::QuerySetDescriptor {

@@ -3,7 +3,7 @@
 // with the `DuffF32` projection; see the Rust crate docs (`src/lib.rs`) for
 // the decisions, the tie rule and where the arithmetic may differ from the
 // CPU. The layout-specific part (`layout_vx`, `layout_exit`: Algorithms 3, 5,
-// 7) is appended by the host (`GpuLayout::snippet` in `tracer.rs`).
+// 7) is appended by the host (`GpuLayout::snippet` in `layout.rs`).
 
 // DuffF32::project: q = P - o; (u.q, v.q), sums left to right like glam.
 fn project(p: vec3<f32>) -> vec2<f32> {
