@@ -133,7 +133,7 @@ fn check_outcome(
         TraceOutcome::Failed {
             failure: Failure::StepCap,
             tets_visited,
-        } => assert_eq!(tets_visited, cap, "{}", ctx()),
+        } => assert_eq!(tets_visited, cap, "step cap reported early: {}", ctx()),
         TraceOutcome::Failed {
             failure: Failure::InvalidRay,
             ..
@@ -144,20 +144,28 @@ fn check_outcome(
                 .constrained
                 .get(h.face as usize)
                 .unwrap_or_else(|| panic!("hit names no constrained face: {}", ctx()));
-            assert_eq!(h.triangle, cf.triangle, "{}", ctx());
-            assert!((h.tet as usize) < mesh.tets.len(), "{}", ctx());
+            assert_eq!(h.triangle, cf.triangle, "wrong triangle id: {}", ctx());
+            assert!(
+                (h.tet as usize) < mesh.tets.len(),
+                "hit tet out of bounds: {}",
+                ctx()
+            );
             let side = cf
                 .side_of(h.tet)
                 .unwrap_or_else(|| panic!("hit tet is not on the hit face: {}", ctx()));
             let far = cf.other_side(h.tet).expect("two sides");
-            assert_eq!(h.far_tet, far.tet, "{}", ctx());
+            assert_eq!(h.far_tet, far.tet, "wrong far tet: {}", ctx());
             assert!(h.far_tet == NO_TET || (h.far_tet as usize) < mesh.tets.len());
             let _ = side;
-            assert!(h.tets_visited >= 1, "{}", ctx());
+            assert!(h.tets_visited >= 1, "hit visiting no tet: {}", ctx());
             if !exact {
                 return;
             }
-            assert!(h.barycentrics.iter().all(|w| w.is_finite()), "{}", ctx());
+            assert!(
+                h.barycentrics.iter().all(|w| w.is_finite()),
+                "non-finite barycentrics: {}",
+                ctx()
+            );
             assert!(
                 h.t >= ray.t_min && h.t <= ray.t_max,
                 "t out of range: {}",

@@ -75,7 +75,9 @@ pub fn tolerance(mesh: &TetMesh) -> f64 {
     let (lo, hi) = mesh
         .points
         .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(*p), b.max(*p)));
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
+            (a.min(*p), b.max(*p))
+        });
     let diag = (hi - lo).length() as f64;
     let mag = lo.abs().max(hi.abs()).max_element() as f64;
     (1e-5 * diag).max(4e-7 * mag)
@@ -97,7 +99,11 @@ impl<'m> Reference<'m> {
                 }
             })
             .collect();
-        let bvh = build_bvh2(&boxes, BvhBuildParams::medium_build(), &mut Duration::default());
+        let bvh = build_bvh2(
+            &boxes,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
         Reference { mesh, bvh, tol }
     }
 
@@ -149,7 +155,9 @@ impl<'m> Reference<'m> {
     fn near_edge(&self, face: u32, p: DVec3) -> bool {
         let cf = &self.mesh.constrained[face as usize];
         let v = cf.vertices.map(|k| self.mesh.points[k as usize].as_dvec3());
-        segment_distance(p, v[0], v[1]).min(segment_distance(p, v[1], v[2])).min(segment_distance(p, v[2], v[0]))
+        segment_distance(p, v[0], v[1])
+            .min(segment_distance(p, v[1], v[2]))
+            .min(segment_distance(p, v[2], v[0]))
             < self.tol
     }
 }
@@ -282,7 +290,9 @@ fn check(
                 Failure::Lost => m.lost += 1,
                 Failure::InvalidRay => m.invalid += 1,
             },
-            (TraceOutcome::Hit(h), _) if h.t.is_nan() || h.barycentrics.iter().any(|b| b.is_nan()) => {
+            (TraceOutcome::Hit(h), _)
+                if h.t.is_nan() || h.barycentrics.iter().any(|b| b.is_nan()) =>
+            {
                 m.nans += 1
             }
             (TraceOutcome::Hit(h), Some(r)) if h.triangle == r.triangle || h.face == r.face => {
@@ -346,7 +356,11 @@ pub fn run_case(
     let mesh = &loaded.mesh;
     let reference = Reference::new(mesh);
     let set = ray_set(loaded, mesh, side, n, seed)?;
-    let expected: Vec<Option<RefHit>> = set.rays.par_iter().map(|(r, _)| reference.closest(r)).collect();
+    let expected: Vec<Option<RefHit>> = set
+        .rays
+        .par_iter()
+        .map(|(r, _)| reference.closest(r))
+        .collect();
     let mut out = Vec::new();
     for &m in methods {
         if matches!(precision, Precision::F32 | Precision::Both) && m != Method::Brute {
@@ -363,7 +377,10 @@ pub fn run_case(
         tets: mesh.tets.len(),
         tolerance: reference.tol,
         rays: set.rays.len(),
-        reference_ambiguous: expected.iter().filter(|e| e.is_some_and(|e| e.ambiguous)).count(),
+        reference_ambiguous: expected
+            .iter()
+            .filter(|e| e.is_some_and(|e| e.ambiguous))
+            .count(),
         methods: out,
         skipped: None,
     })
@@ -389,7 +406,15 @@ pub fn run(args: &AccuracyArgs, json: bool) -> Result<()> {
     if args.extremes {
         for (name, result) in crate::extremes::cases(&loaded, &args.build, json) {
             cases.push(match result {
-                Ok(l) => run_case(&name, &l, &methods, args.precision, args.image, args.rays, args.seed)?,
+                Ok(l) => run_case(
+                    &name,
+                    &l,
+                    &methods,
+                    args.precision,
+                    args.image,
+                    args.rays,
+                    args.seed,
+                )?,
                 Err(e) => CaseAccuracy {
                     case: name,
                     tets: 0,
@@ -434,7 +459,17 @@ pub fn print_doc(doc: &AccuracyDoc) {
         );
         println!(
             "  {:<18} {:>9} {:>9} {:>7} {:>7} {:>7} {:>6} {:>6} {:>5} {:>9} {:>9}",
-            "method", "agree", "grazing", "wrong", "f.miss", "f.hit", "cap", "lost", "nan", "fail/1024²", "Mrays/s"
+            "method",
+            "agree",
+            "grazing",
+            "wrong",
+            "f.miss",
+            "f.hit",
+            "cap",
+            "lost",
+            "nan",
+            "fail/1024²",
+            "Mrays/s"
         );
         for m in &c.methods {
             println!(

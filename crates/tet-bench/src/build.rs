@@ -63,7 +63,9 @@ pub fn run(args: &BuildArgs, json: bool) -> Result<()> {
     let loaded = load(&args.scene, &args.build, json)?;
     tet_core::format::save(&args.output, &loaded.mesh)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
-    let file_bytes = std::fs::metadata(&args.output).map(|m| m.len()).unwrap_or(0);
+    let file_bytes = std::fs::metadata(&args.output)
+        .map(|m| m.len())
+        .unwrap_or(0);
     let doc = BuildDoc {
         name: loaded.name.clone(),
         output: args.output.display().to_string(),

@@ -103,7 +103,12 @@ impl Tracer for BvhTracer<'_> {
             Start::Face { face, .. } => face,
             Start::Tet(_) => u32::MAX,
         };
-        let mut r = BvhRay::new(a(ray.origin), a(ray.direction), ray.t_min.max(0.0), ray.t_max);
+        let mut r = BvhRay::new(
+            a(ray.origin),
+            a(ray.direction),
+            ray.t_min.max(0.0),
+            ray.t_max,
+        );
         r.tmin = ray.t_min;
         let mut hit = RayHit::none();
         let found = self.bvh.ray_traverse(r, &mut hit, |r, id| {

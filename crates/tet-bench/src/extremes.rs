@@ -27,13 +27,24 @@ fn apply(p: Vec3, scale: f32, shift: f32) -> Vec3 {
 pub fn cases(loaded: &Loaded, flags: &BuildFlags, quiet: bool) -> Vec<(String, Result<Loaded>)> {
     let mut out: Vec<(String, Result<Loaded>)> = TRANSFORMS
         .iter()
-        .map(|&(name, scale, shift)| (name.to_string(), transformed(loaded, flags, quiet, scale, shift)))
+        .map(|&(name, scale, shift)| {
+            (
+                name.to_string(),
+                transformed(loaded, flags, quiet, scale, shift),
+            )
+        })
         .collect();
     out.push(("kuhn-slivers".into(), Ok(slivers())));
     out
 }
 
-fn transformed(loaded: &Loaded, flags: &BuildFlags, quiet: bool, scale: f32, shift: f32) -> Result<Loaded> {
+fn transformed(
+    loaded: &Loaded,
+    flags: &BuildFlags,
+    quiet: bool,
+    scale: f32,
+    shift: f32,
+) -> Result<Loaded> {
     let camera = Camera {
         position: apply(loaded.camera.position, scale, shift),
         target: apply(loaded.camera.target, scale, shift),
@@ -62,7 +73,9 @@ fn transformed(loaded: &Loaded, flags: &BuildFlags, quiet: bool, scale: f32, shi
         *p = apply(*p, scale, shift);
     }
     if let Err(e) = mesh.validate() {
-        bail!("the transformed mesh file is invalid in f32 ({e}); pass a scene to rebuild it instead");
+        bail!(
+            "the transformed mesh file is invalid in f32 ({e}); pass a scene to rebuild it instead"
+        );
     }
     Ok(Loaded {
         name: loaded.name.clone(),

@@ -9,7 +9,13 @@ use crate::render::RenderDoc;
 
 /// Renders `frames` GPU frames (plus a warm-up) of `method`.
 #[cfg(feature = "gpu")]
-pub fn time_gpu(loaded: &Loaded, method: Method, width: u32, height: u32, frames: u32) -> Result<RenderDoc> {
+pub fn time_gpu(
+    loaded: &Loaded,
+    method: Method,
+    width: u32,
+    height: u32,
+    frames: u32,
+) -> Result<RenderDoc> {
     use std::time::Instant;
     use tet_trace_gpu::{GpuContext, GpuLayout, GpuTracer};
 

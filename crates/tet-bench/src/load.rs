@@ -125,8 +125,12 @@ fn enclosing_box(scene: &Scene) -> tet_build::bbox::BoxSpec {
     pts.extend(scene.lights.iter().map(|l| l.position));
     let (min, max) = pts
         .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(*p), b.max(*p)));
-    let margin = ((max - min).max_element() * 0.1).max(1e-3 * max.abs().max(min.abs()).max_element()).max(1e-6);
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
+            (a.min(*p), b.max(*p))
+        });
+    let margin = ((max - min).max_element() * 0.1)
+        .max(1e-3 * max.abs().max(min.abs()).max_element())
+        .max(1e-6);
     tet_build::bbox::BoxSpec::Fixed {
         min: min - Vec3::splat(margin),
         max: max + Vec3::splat(margin),
@@ -135,7 +139,11 @@ fn enclosing_box(scene: &Scene) -> tet_build::bbox::BoxSpec {
 
 /// Builds a scene's mesh (TetGen in a worker process), Hilbert-sorted unless `--no-sort`.
 #[cfg(feature = "tetgen")]
-pub fn build_scene(scene: &Scene, flags: &BuildFlags, quiet: bool) -> Result<(TetMesh, BuildSummary)> {
+pub fn build_scene(
+    scene: &Scene,
+    flags: &BuildFlags,
+    quiet: bool,
+) -> Result<(TetMesh, BuildSummary)> {
     use std::sync::Arc;
     use tet_build::pipeline::{BuildOptions, build};
     use tet_build::tetgen::{Isolation, WorkerCommand};
@@ -212,7 +220,9 @@ pub fn framing_camera(mesh: &TetMesh) -> Camera {
     let (min, max) = mesh
         .points
         .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(*p), b.max(*p)));
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
+            (a.min(*p), b.max(*p))
+        });
     if !min.is_finite() {
         return Camera::default();
     }

@@ -2,8 +2,8 @@
 //! See the README for every subcommand and the `--json` schema.
 
 mod accuracy;
-mod build;
 mod brute;
+mod build;
 mod bvh;
 mod cli;
 mod extremes;

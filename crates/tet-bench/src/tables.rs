@@ -133,7 +133,11 @@ fn measure_scene(
         eprintln!("  {spec}: rendering with {}", m.name());
         renders.push(time_method(&loaded, m, opts, frames, pool)?.0);
     }
-    let (side, rays) = if args.quick { (256, 20_000) } else { (1024, 100_000) };
+    let (side, rays) = if args.quick {
+        (256, 20_000)
+    } else {
+        (1024, 100_000)
+    };
     eprintln!("  {spec}: accuracy ({side}² camera rays + {rays} random rays)");
     let accuracy = run_case("as-is", &loaded, &METHODS, Precision::F32, side, rays, 1)?;
     eprintln!("  {spec}: unsorted mesh for Figure 8");
@@ -161,7 +165,11 @@ fn measure_scene(
 pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
     let start = Instant::now();
     let pool = pool(args.threads)?;
-    let (width, height, frames) = if args.quick { (640, 480, 3) } else { (1920, 1440, 5) };
+    let (width, height, frames) = if args.quick {
+        (640, 480, 3)
+    } else {
+        (1920, 1440, 5)
+    };
     let opts = RenderOptions {
         width,
         height,
@@ -222,7 +230,10 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 fn write_outputs(dir: &Path, doc: &TablesDoc, markdown: &str) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     write_atomic(&dir.join("tables.md"), markdown.as_bytes())?;
-    write_atomic(&dir.join("tables.json"), serde_json::to_string_pretty(doc)?.as_bytes())?;
+    write_atomic(
+        &dir.join("tables.json"),
+        serde_json::to_string_pretty(doc)?.as_bytes(),
+    )?;
     write_atomic(&dir.join("tables.csv"), csv(doc).as_bytes())?;
     Ok(())
 }
@@ -238,7 +249,9 @@ fn csv(doc: &TablesDoc) -> String {
                 .accuracy
                 .as_ref()
                 .and_then(|a| a.methods.iter().find(|m| m.method == r.tracer))
-                .map_or(String::new(), |m| format!("{:.3}", m.failures_per_1024_squared));
+                .map_or(String::new(), |m| {
+                    format!("{:.3}", m.failures_per_1024_squared)
+                });
             let _ = writeln!(
                 s,
                 "{},{},{},{},{},{},{:.3},{:.3},{:.4},{:.2},{},{:.4},{}",
@@ -288,7 +301,12 @@ pub fn markdown(doc: &TablesDoc) -> String {
         doc.total_s
     );
     for sc in doc.scenes.iter().filter(|sc| sc.error.is_some()) {
-        let _ = writeln!(m, "* `{}` failed: {}", sc.spec, sc.error.as_deref().unwrap_or(""));
+        let _ = writeln!(
+            m,
+            "* `{}` failed: {}",
+            sc.spec,
+            sc.error.as_deref().unwrap_or("")
+        );
     }
 
     let _ = writeln!(m, "\n## Construction (seed 000 Table 1, left half)\n");
@@ -318,7 +336,10 @@ pub fn markdown(doc: &TablesDoc) -> String {
         }
     }
 
-    let _ = writeln!(m, "\n## Render time per method (seed 000 Table 1, right half)\n");
+    let _ = writeln!(
+        m,
+        "\n## Render time per method (seed 000 Table 1, right half)\n"
+    );
     let _ = writeln!(
         m,
         "Ratio = method Mrays/s ÷ BVH (obvhs) Mrays/s in the same run. Paper ratio: neptun's CPU numbers on Torus Knots (1920×1440, 2 threads) ÷ its BVH (4.92 Mrays/s).\n"
@@ -361,7 +382,10 @@ pub fn markdown(doc: &TablesDoc) -> String {
         m,
         "Hot = tet records + point positions read by the walk; cold = constrained-face table, attributes, anchors. MB = 10⁶ bytes.\n"
     );
-    let _ = writeln!(m, "| scene | layout | hot MB | cold MB | total MB | hot B/tet |");
+    let _ = writeln!(
+        m,
+        "| scene | layout | hot MB | cold MB | total MB | hot B/tet |"
+    );
     let _ = writeln!(m, "|---|---|---:|---:|---:|---:|");
     for sc in &doc.scenes {
         if let Some(i) = &sc.info {
@@ -380,8 +404,14 @@ pub fn markdown(doc: &TablesDoc) -> String {
         }
     }
 
-    let _ = writeln!(m, "\n## Hilbert-sorted vs unsorted (seed 000 Figure 8), tet20\n");
-    let _ = writeln!(m, "| scene | sorted Mrays/s | unsorted Mrays/s | speed-up |");
+    let _ = writeln!(
+        m,
+        "\n## Hilbert-sorted vs unsorted (seed 000 Figure 8), tet20\n"
+    );
+    let _ = writeln!(
+        m,
+        "| scene | sorted Mrays/s | unsorted Mrays/s | speed-up |"
+    );
     let _ = writeln!(m, "|---|---:|---:|---:|");
     for sc in &doc.scenes {
         let sorted = sc.renders.iter().find(|r| r.method == Method::Tet20);
@@ -421,7 +451,9 @@ pub fn markdown(doc: &TablesDoc) -> String {
                 let _ = writeln!(
                     m,
                     "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} |",
-                    sc.info.as_ref().map_or(sc.spec.as_str(), |i| i.name.as_str()),
+                    sc.info
+                        .as_ref()
+                        .map_or(sc.spec.as_str(), |i| i.name.as_str()),
                     x.method,
                     x.rays,
                     x.ambiguous,

@@ -38,6 +38,4 @@ mod validate;
 
 pub use error::MeshError;
 pub use link::{Link, LinkKind, MAX_TETS};
-pub use mesh::{
-    Attributes, ConstrainedFace, FACE_VERTICES, FaceSide, NO_TET, TetMesh, face_key,
-};
+pub use mesh::{Attributes, ConstrainedFace, FACE_VERTICES, FaceSide, NO_TET, TetMesh, face_key};

@@ -27,7 +27,10 @@ pub struct FaceSide {
 
 impl FaceSide {
     /// The absent side of a constrained face on the mesh boundary.
-    pub const NONE: FaceSide = FaceSide { tet: NO_TET, face: 0 };
+    pub const NONE: FaceSide = FaceSide {
+        tet: NO_TET,
+        face: 0,
+    };
 
     /// True when a tet is on this side.
     pub fn exists(self) -> bool {
@@ -230,7 +233,11 @@ impl TetMesh {
         let mut faces: Vec<([u32; 3], u32, u8)> = Vec::with_capacity(tets.len() * 4);
         for (t, tet) in tets.iter().enumerate() {
             for (k, s) in FACE_VERTICES.iter().enumerate() {
-                faces.push((face_key([tet[s[0]], tet[s[1]], tet[s[2]]]), t as u32, k as u8));
+                faces.push((
+                    face_key([tet[s[0]], tet[s[1]], tet[s[2]]]),
+                    t as u32,
+                    k as u8,
+                ));
             }
         }
         faces.sort_unstable();

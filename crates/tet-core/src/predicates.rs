@@ -38,7 +38,10 @@ mod tests {
         let o = DVec3::ZERO;
         assert!(orient3d(o, DVec3::X, DVec3::Y, DVec3::Z) > 0.0);
         assert!(orient3d(o, DVec3::Y, DVec3::X, DVec3::Z) < 0.0);
-        assert_eq!(orient3d(o, DVec3::X, DVec3::Y, DVec3::new(3.0, 5.0, 0.0)), 0.0);
+        assert_eq!(
+            orient3d(o, DVec3::X, DVec3::Y, DVec3::new(3.0, 5.0, 0.0)),
+            0.0
+        );
     }
 
     #[test]

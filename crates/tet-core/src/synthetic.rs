@@ -85,7 +85,10 @@ const PERMUTATIONS: [[usize; 3]; 6] = [
 /// If a cell count is zero or the grid has more than 2³¹ tets.
 pub fn kuhn_grid(spec: &GridSpec) -> TetMesh {
     let [nx, ny, nz] = spec.cells;
-    assert!(nx > 0 && ny > 0 && nz > 0, "grid needs at least one cell per axis");
+    assert!(
+        nx > 0 && ny > 0 && nz > 0,
+        "grid needs at least one cell per axis"
+    );
     let dims = [nx + 1, ny + 1, nz + 1];
     let index = |c: [u32; 3]| c[0] + dims[0] * (c[1] + dims[1] * c[2]);
     let mut lattice = Vec::with_capacity((dims[0] * dims[1] * dims[2]) as usize);
@@ -202,7 +205,12 @@ mod tests {
         m.validate().unwrap();
         assert!(!m.constrained.is_empty());
         // Boundary faces: 2 triangles per unit square of the box surface.
-        let boundary = m.neighbors.iter().flatten().filter(|l| l.is_boundary()).count();
+        let boundary = m
+            .neighbors
+            .iter()
+            .flatten()
+            .filter(|l| l.is_boundary())
+            .count();
         let one_sided = m
             .constrained
             .iter()
@@ -221,6 +229,10 @@ mod tests {
         m.validate().unwrap();
         // Surface of a 2×2×2 box: 6 sides × 4 squares × 2 triangles.
         assert_eq!(m.constrained.len(), 48);
-        assert!(m.constrained.iter().all(|c| c.front.exists() && c.back.exists()));
+        assert!(
+            m.constrained
+                .iter()
+                .all(|c| c.front.exists() && c.back.exists())
+        );
     }
 }

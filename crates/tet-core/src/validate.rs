@@ -18,7 +18,10 @@ pub(crate) fn validate(m: &TetMesh) -> Result<(), MeshError> {
 }
 
 fn check_counts(m: &TetMesh) -> Result<(), MeshError> {
-    for (what, count) in [("tets", m.tets.len()), ("constrained faces", m.constrained.len())] {
+    for (what, count) in [
+        ("tets", m.tets.len()),
+        ("constrained faces", m.constrained.len()),
+    ] {
         if count >= MAX_TETS as usize {
             return Err(MeshError::TooMany {
                 what,
@@ -207,7 +210,11 @@ fn check_face_manifold(m: &TetMesh) -> Result<(), MeshError> {
     let mut faces: Vec<([u32; 3], u32, u8)> = Vec::with_capacity(m.tets.len() * 4);
     for (t, tet) in m.tets.iter().enumerate() {
         for (k, s) in FACE_VERTICES.iter().enumerate() {
-            faces.push((face_key([tet[s[0]], tet[s[1]], tet[s[2]]]), t as u32, k as u8));
+            faces.push((
+                face_key([tet[s[0]], tet[s[1]], tet[s[2]]]),
+                t as u32,
+                k as u8,
+            ));
         }
     }
     faces.sort_unstable();
@@ -243,7 +250,8 @@ fn check_face_manifold(m: &TetMesh) -> Result<(), MeshError> {
                 let (_, u, _) = faces[i + 1];
                 let linked = match link.kind() {
                     LinkKind::Tet(n) => n == u,
-                    LinkKind::Constrained(c) => m.constrained[c as usize].other_side(t)
+                    LinkKind::Constrained(c) => m.constrained[c as usize]
+                        .other_side(t)
                         .is_some_and(|s| s.tet == u),
                     LinkKind::Boundary => false,
                 };

@@ -7,6 +7,7 @@
 //! * [`ray`]: [`Ray`], [`Hit`], [`TraceOutcome`] (hit / miss / reported failure);
 //! * [`mod@locate`]: exact point location (seed 000 §4.2);
 //! * [`walk`]: the watertight traversal engine and its projections;
+//! * [`scaled`]: the scaled basis of Eq. 1–3, specialised per direction case;
 //! * kernels, one per method: [`sctp`], [`tet32`], [`tet20`], [`tet16`], [`tet80`];
 //! * [`mod@reference`]: f64 brute-force closest hit and ray generators for tests;
 //! * [`render`]: pinhole renderer, Lambert shading, PNG, heat maps, stats;
@@ -19,6 +20,7 @@ pub mod locate;
 pub mod ray;
 pub mod reference;
 pub mod render;
+pub mod scaled;
 pub mod sctp;
 pub mod secondary;
 pub mod tet16;

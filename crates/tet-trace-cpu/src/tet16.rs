@@ -13,12 +13,16 @@ use tet_core::TetMesh;
 use tet_core::layout::{LayoutError, Tet16Mesh, rank_of};
 
 use crate::kernel::WalkTracer;
-use crate::walk::{DuffF32, DuffF64, Projection, Topology};
+use crate::walk::{DuffF32, DuffF64, Projection, Topology, prefetch_index};
 
 impl Topology for Tet16Mesh {
     #[inline(always)]
     fn vx(&self, tet: u32) -> u32 {
         self.tets[tet as usize].vx
+    }
+    #[inline(always)]
+    fn prefetch(&self, tet: u32) {
+        prefetch_index(&self.tets, tet);
     }
     #[inline(always)]
     fn exit_link(&self, tet: u32, f: [u32; 3], d: u32, exiting: u32, entry: u32) -> u32 {

@@ -78,6 +78,18 @@ pub trait Projection: Copy + Send + Sync {
     /// i.e. `det(pa, pb) > 0` with the tie rule of the module docs.
     /// Exactly antisymmetric: `left(a, b) == !left(b, a)`.
     fn left(&self, a: Self::P, ia: u32, b: Self::P, ib: u32) -> bool;
+
+    /// The three edge tests of a step as a bit mask:
+    /// bit `i` = `left(pd, d, p[i], ids[i])` (the index of [`EXIT_SLOT`]).
+    /// Implementations may only change how the bits are computed, never
+    /// their values; the 2-D ones evaluate the three determinants
+    /// branch-free and take the tie rule only when one of them is zero.
+    #[inline(always)]
+    fn left_mask(&self, pd: Self::P, d: u32, p: &[Self::P; 3], ids: &[u32; 3]) -> usize {
+        self.left(pd, d, p[0], ids[0]) as usize
+            | (self.left(pd, d, p[1], ids[1]) as usize) << 1
+            | (self.left(pd, d, p[2], ids[2]) as usize) << 2
+    }
 }
 
 /// The tie rule of the module docs for 2-D points with an already computed
@@ -96,6 +108,66 @@ macro_rules! left_2d {
             $ia < $ib
         }
     }};
+}
+
+/// [`Projection::left_mask`] for 2-D points: the three determinants
+/// `det(pd, p[i])` are computed exactly as in `left_2d!` (same operands, same
+/// operation order, so bit-identical), their signs combined without a
+/// branch; only when one of them is zero is the full tie rule of `left_2d!` evaluated, edge by edge, out of line. The
+/// result is therefore identical to three `left` calls.
+macro_rules! left_mask_2d {
+    ($pd:expr, $d:expr, $p:expr, $ids:expr) => {{
+        let (pd, p, ids, d) = ($pd, $p, $ids, $d);
+        let d0 = pd.x * p[0].y - pd.y * p[0].x;
+        let d1 = pd.x * p[1].y - pd.y * p[1].x;
+        let d2 = pd.x * p[2].y - pd.y * p[2].x;
+        if (d0 != 0.0) & (d1 != 0.0) & (d2 != 0.0) {
+            (d0 > 0.0) as usize | ((d1 > 0.0) as usize) << 1 | ((d2 > 0.0) as usize) << 2
+        } else {
+            #[cold]
+            #[inline(never)]
+            fn ties<V: Copy + $crate::walk::LeftTie>(
+                pd: V,
+                d: u32,
+                p: &[V; 3],
+                ids: &[u32; 3],
+            ) -> usize {
+                V::left_tie(pd, d, p[0], ids[0]) as usize
+                    | (V::left_tie(pd, d, p[1], ids[1]) as usize) << 1
+                    | (V::left_tie(pd, d, p[2], ids[2]) as usize) << 2
+            }
+            ties(pd, d, p, ids)
+        }
+    }};
+}
+pub(crate) use left_mask_2d;
+
+/// The full 2-D edge test with the tie rule, per point type (the cold path
+/// of `left_mask_2d!`).
+pub(crate) trait LeftTie {
+    /// `left_2d!(a, ia, b, ib)`.
+    fn left_tie(a: Self, ia: u32, b: Self, ib: u32) -> bool;
+}
+
+impl LeftTie for Vec2 {
+    #[inline]
+    fn left_tie(a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
+        left_2d!(a, ia, b, ib)
+    }
+}
+
+impl LeftTie for DVec2 {
+    #[inline]
+    fn left_tie(a: DVec2, ia: u32, b: DVec2, ib: u32) -> bool {
+        left_2d!(a, ia, b, ib)
+    }
+}
+
+/// The tie rule of the module docs on f32 2-D points (shared by every f32
+/// 2-D projection).
+#[inline(always)]
+pub(crate) fn left_f32(a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
+    left_2d!(a, ia, b, ib)
 }
 
 /// Duff et al.'s orthonormal basis for a unit vector `n`, ordered so that
@@ -142,6 +214,10 @@ impl Projection for DuffF32 {
     fn left(&self, a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
         left_2d!(a, ia, b, ib)
     }
+    #[inline(always)]
+    fn left_mask(&self, pd: Vec2, d: u32, p: &[Vec2; 3], ids: &[u32; 3]) -> usize {
+        left_mask_2d!(pd, d, p, ids)
+    }
 }
 
 /// f32 projection with the projected ray origin of Eq. 4–5:
@@ -174,6 +250,10 @@ impl Projection for OriginF32 {
     fn left(&self, a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
         left_2d!(a, ia, b, ib)
     }
+    #[inline(always)]
+    fn left_mask(&self, pd: Vec2, d: u32, p: &[Vec2; 3], ids: &[u32; 3]) -> usize {
+        left_mask_2d!(pd, d, p, ids)
+    }
 }
 
 /// f64 variant of [`DuffF32`] (points converted exactly to f64).
@@ -203,6 +283,10 @@ impl Projection for DuffF64 {
     #[inline(always)]
     fn left(&self, a: DVec2, ia: u32, b: DVec2, ib: u32) -> bool {
         left_2d!(a, ia, b, ib)
+    }
+    #[inline(always)]
+    fn left_mask(&self, pd: DVec2, d: u32, p: &[DVec2; 3], ids: &[u32; 3]) -> usize {
+        left_mask_2d!(pd, d, p, ids)
     }
 }
 
@@ -263,6 +347,33 @@ pub trait Topology: Sync {
     /// `entry_raw` the raw link of `tet` across the entry face (the previous
     /// tet, or the constrained face crossed), which Tet16 needs.
     fn exit_link(&self, tet: u32, face: [u32; 3], d: u32, exiting: u32, entry_raw: u32) -> u32;
+    /// Hints that the record of `tet` (an index that may be out of range:
+    /// a prefetch never faults) will be read soon. Default: nothing.
+    #[inline(always)]
+    fn prefetch(&self, tet: u32) {
+        let _ = tet;
+    }
+}
+
+/// Prefetches the cache line holding `slice[index]` into all cache levels
+/// (x86-64 `prefetcht0`; nothing elsewhere). Never reads memory
+/// architecturally, so an out-of-range index is harmless: the address is
+/// formed with `wrapping_add` and never dereferenced.
+#[inline(always)]
+pub fn prefetch_index<X>(slice: &[X], index: u32) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let ptr = slice.as_ptr().wrapping_add(index as usize) as *const i8;
+        // SAFETY: `prefetcht0` is a hint; it never faults and has no
+        // architectural effect, whatever the address (SSE is part of the
+        // x86-64 baseline).
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(ptr) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = (slice, index);
+    }
 }
 
 /// Where a walk starts.
@@ -303,10 +414,7 @@ pub fn exit_slot<P: Projection>(
     pd: P::P,
     d: u32,
 ) -> usize {
-    let sa = proj.left(pd, d, p[0], ids[0]) as usize;
-    let sb = proj.left(pd, d, p[1], ids[1]) as usize;
-    let sc = proj.left(pd, d, p[2], ids[2]) as usize;
-    EXIT_SLOT[sa | (sb << 1) | (sc << 2)] as usize
+    EXIT_SLOT[proj.left_mask(pd, d, p, ids) & 7] as usize
 }
 
 /// Algorithm 1 as a table over `left(d→a) | left(d→b) << 1 | left(d→c) << 2`.
@@ -436,8 +544,12 @@ pub fn trace<P: Projection, T: Topology>(
         Ok(lane) => lane,
         Err(out) => return out,
     };
+    let points = &mesh.points[..];
     loop {
-        if let Some(out) = step(mesh, topo, ray, &mut lane, cap) {
+        let adv = advance(points, topo, &mut lane, cap);
+        if adv != Advance::Go
+            && let Some(out) = finish_step(mesh, ray, &mut lane, adv)
+        {
             return out;
         }
     }
@@ -446,8 +558,10 @@ pub fn trace<P: Projection, T: Topology>(
 /// Traces many rays from one start with `K` walks interleaved on one thread:
 /// each round advances every lane by one tet, so the CPU overlaps the
 /// dependent load → project → decide → load chains of independent rays
-/// (memory-level parallelism without SIMD). Results are identical to
-/// [`trace`] ray by ray (same `step`). `out.len()` must equal `rays.len()`.
+/// (memory-level parallelism without SIMD); each step also prefetches the
+/// record of the lane's next tet, which that lane reads `K − 1` steps later.
+/// Results are identical to [`trace`] ray by ray (same [`advance`] and
+/// `finish_step`). `out.len()` must equal `rays.len()`.
 pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
     mesh: &TetMesh,
     topo: &T,
@@ -457,33 +571,59 @@ pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
     out: &mut [TraceOutcome],
 ) {
     let n = rays.len().min(out.len());
-    let mut lanes: [Option<(usize, Lane<P>)>; K] = std::array::from_fn(|_| None);
+    let (rays, out) = (&rays[..n], &mut out[..n]);
+    let points = &mesh.points[..];
     let mut queued = 0;
-    loop {
-        let mut active = false;
-        for lane in lanes.iter_mut() {
-            while lane.is_none() && queued < n {
-                let i = queued;
-                queued += 1;
-                match begin::<P>(mesh, &rays[i], start) {
-                    Ok(l) => *lane = Some((i, l)),
-                    Err(o) => out[i] = o,
-                }
-            }
-            active |= lane.is_some();
-        }
-        if !active {
-            return;
-        }
-        for lane in lanes.iter_mut() {
-            if let Some((i, l)) = lane
-                && let Some(o) = step(mesh, topo, &rays[*i], l, cap)
-            {
-                out[*i] = o;
-                *lane = None;
-            }
+    // Lanes in flight, each with its ray index; a finished lane is replaced
+    // in place by the next ray, or removed when none is left.
+    let mut lanes: Vec<(usize, Lane<P>)> = Vec::with_capacity(K);
+    while lanes.len() < K {
+        match next_lane(mesh, rays, start, &mut queued, out) {
+            Some(l) => lanes.push(l),
+            None => break,
         }
     }
+    while !lanes.is_empty() {
+        let mut j = 0;
+        while j < lanes.len() {
+            let (i, lane) = &mut lanes[j];
+            let adv = advance(points, topo, lane, cap);
+            if adv != Advance::Go {
+                let i = *i;
+                if let Some(o) = finish_step(mesh, &rays[i], lane, adv) {
+                    out[i] = o;
+                    match next_lane(mesh, rays, start, &mut queued, out) {
+                        Some(l) => lanes[j] = l,
+                        None => {
+                            lanes.swap_remove(j);
+                            continue;
+                        }
+                    }
+                }
+            }
+            j += 1;
+        }
+    }
+}
+
+/// Starts the next queued ray that does not end in its start tet (those are
+/// written to `out` directly).
+fn next_lane<P: Projection>(
+    mesh: &TetMesh,
+    rays: &[Ray],
+    start: Start,
+    queued: &mut usize,
+    out: &mut [TraceOutcome],
+) -> Option<(usize, Lane<P>)> {
+    while *queued < rays.len() {
+        let i = *queued;
+        *queued += 1;
+        match begin::<P>(mesh, &rays[i], start) {
+            Ok(l) => return Some((i, l)),
+            Err(o) => out[i] = o,
+        }
+    }
+    None
 }
 
 /// Everything before the hot loop: ray checks, projection set-up, the start
@@ -643,57 +783,93 @@ pub fn face_hit(mesh: &TetMesh, ray: &Ray, ids: [u32; 3]) -> (f64, [f64; 3]) {
     (hit.dot(d) / d.length_squared(), w)
 }
 
+/// What one [`advance`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Advance {
+    /// Entered a tet and moved to its exit neighbour: keep walking.
+    Go,
+    /// The step cap was reached before the step (state unchanged).
+    Cap,
+    /// The new vertex id was out of range (state unchanged; impossible on a
+    /// valid layout, reported instead of panicking).
+    Lost,
+    /// Entered a tet whose exit link is not a tet (constrained face or
+    /// boundary): `finish_step` resolves it.
+    Face,
+}
+
 /// The hot loop body: enter `lane.next` through the face `lane.st.ids`
-/// (raw back-link `lane.entry_raw`), choose the exit face, follow its link.
-/// `Some` when the walk ended.
+/// (raw back-link `lane.entry_raw`), choose the exit face, follow its link
+/// when it is a tet. Everything rarer (a constrained face or the boundary,
+/// the step cap) is left to the out-of-line `finish_step`.
 #[inline(always)]
-pub(crate) fn step<P: Projection, T: Topology>(
-    mesh: &TetMesh,
+pub(crate) fn advance<P: Projection, T: Topology>(
+    points: &[Vec3],
     topo: &T,
-    ray: &Ray,
     lane: &mut Lane<P>,
     cap: u32,
-) -> Option<TraceOutcome> {
+) -> Advance {
     let st = &mut lane.st;
     if st.visited >= cap {
-        return Some(TraceOutcome::Failed {
-            failure: Failure::StepCap,
-            tets_visited: st.visited,
-        });
+        return Advance::Cap;
     }
     let next = lane.next;
     let d = st.ids[0] ^ st.ids[1] ^ st.ids[2] ^ topo.vx(next);
-    let Some(&pd3) = mesh.points.get(d as usize) else {
-        return Some(TraceOutcome::Failed {
-            failure: Failure::Lost,
-            tets_visited: st.visited,
-        });
+    let Some(&pd3) = points.get(d as usize) else {
+        return Advance::Lost;
     };
     let pd = lane.proj.project(pd3);
-    let slot = exit_slot(&lane.proj, &st.p, &st.ids, pd, d);
+    // `EXIT_SLOT` holds 0..=2, so `% 3` is the identity; it only lets the
+    // compiler drop the bounds checks of the two indexings below.
+    let slot = EXIT_SLOT[lane.proj.left_mask(pd, d, &st.p, &st.ids) & 7] as usize % 3;
     let exiting = st.ids[slot];
     let raw = topo.exit_link(next, st.ids, d, exiting, lane.entry_raw);
-    // Branch-free replacement (no variable-indexed store to the stack).
-    for k in 0..3 {
-        let hit = slot == k;
-        st.ids[k] = if hit { d } else { st.ids[k] };
-        st.p[k] = if hit { pd } else { st.p[k] };
-    }
+    // The lane state lives in memory (several lanes are in flight), so a
+    // variable-indexed store is one instruction per array.
+    st.ids[slot] = d;
+    st.p[slot] = pd;
     st.tet = next;
     st.link = raw;
     st.visited += 1;
     if raw < Link::BOUNDARY.0 {
+        topo.prefetch(raw);
         lane.entry_raw = next;
         lane.next = raw;
-        return None;
+        Advance::Go
+    } else {
+        Advance::Face
     }
-    match resolve_face(mesh, ray, st, Link(raw)) {
-        Resolved::Done(out) => Some(out),
-        Resolved::Cross(n) => {
-            lane.entry_raw = raw;
-            lane.next = n;
-            None
-        }
+}
+
+/// The rare outcomes of [`advance`]: `Some` when the walk ended, `None` when
+/// it crossed a constrained face before `t_min` and goes on.
+#[cold]
+#[inline(never)]
+fn finish_step<P: Projection>(
+    mesh: &TetMesh,
+    ray: &Ray,
+    lane: &mut Lane<P>,
+    adv: Advance,
+) -> Option<TraceOutcome> {
+    let st = &lane.st;
+    let failed = |failure| {
+        Some(TraceOutcome::Failed {
+            failure,
+            tets_visited: st.visited,
+        })
+    };
+    match adv {
+        Advance::Go => None,
+        Advance::Cap => failed(Failure::StepCap),
+        Advance::Lost => failed(Failure::Lost),
+        Advance::Face => match resolve_face(mesh, ray, st, Link(st.link)) {
+            Resolved::Done(out) => Some(out),
+            Resolved::Cross(n) => {
+                lane.entry_raw = st.link;
+                lane.next = n;
+                None
+            }
+        },
     }
 }
 

@@ -48,6 +48,7 @@ fn others(mesh: &TetMesh) -> Vec<Box<dyn Tracer + '_>> {
         Box::new(Tet16TracerF64::new(mesh).unwrap()),
         Box::new(Tet32TracerF64::new(mesh).unwrap()),
         Box::new(Tet20Tracer::<OriginF32>::new(mesh).unwrap()),
+        Box::new(tet_trace_cpu::scaled::ScaledTracer::tet20(mesh).unwrap()),
     ]
 }
 

@@ -127,7 +127,11 @@ fn vertex_normals_are_interpolated_and_face_normals_follow_winding() {
     assert_eq!(shading_normal(&mesh, &hit), n);
     // Per-vertex normals: a constant field comes back unchanged; a field
     // equal to each vertex's y coordinate direction mixes by barycentrics.
-    let normals: Vec<Vec3> = mesh.points.iter().map(|p| Vec3::new(0.0, p.y, 1.0)).collect();
+    let normals: Vec<Vec3> = mesh
+        .points
+        .iter()
+        .map(|p| Vec3::new(0.0, p.y, 1.0))
+        .collect();
     mesh.attributes.normals = Some(normals);
     let expected = {
         let b = hit.barycentrics;

@@ -118,6 +118,7 @@ fn tracers(mesh: &TetMesh) -> Vec<Box<dyn Tracer + '_>> {
     vec![
         Box::new(Tet20Tracer::<DuffF32>::new(mesh).unwrap()),
         Box::new(Tet20Tracer::<OriginF32>::new(mesh).unwrap()),
+        Box::new(tet_trace_cpu::scaled::ScaledTracer::tet20(mesh).unwrap()),
         Box::new(Tet20Tracer::<DuffF64>::new(mesh).unwrap()),
         Box::new(Tet16Tracer::<DuffF32>::new(mesh).unwrap()),
         Box::new(Tet32Tracer::<DuffF32>::new(mesh).unwrap()),
