@@ -422,7 +422,7 @@ pub fn run(args: &AccuracyArgs, json: bool) -> Result<()> {
                     rays: 0,
                     reference_ambiguous: 0,
                     methods: Vec::new(),
-                    skipped: Some(format!("{e:#}")),
+                    skipped: Some(crate::error_chain(&e)),
                 },
             });
         }

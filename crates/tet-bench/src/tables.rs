@@ -191,7 +191,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
         scenes.push(match measure_scene(&spec, args, &opts, frames, &pool) {
             Ok(r) => r,
             Err(e) => {
-                eprintln!("  {spec}: {e:#}");
+                eprintln!("  {spec}: {}", crate::error_chain(&e));
                 SceneResult {
                     spec: spec.clone(),
                     info: None,
@@ -199,7 +199,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
                     renders: Vec::new(),
                     unsorted_tet20: None,
                     accuracy: None,
-                    error: Some(format!("{e:#}")),
+                    error: Some(crate::error_chain(&e)),
                 }
             }
         });

@@ -43,6 +43,7 @@ use thiserror::Error;
 
 use crate::bbox::{BoxError, BoxSpec, EnclosingBox};
 use crate::clean::{CleanError, CleanReport, clean_scene};
+use crate::intersect::{IntersectingPair, find_self_intersections};
 use crate::scene::Scene;
 use crate::tetgen::worker::peak_memory_kib;
 use crate::tetgen::{Isolation, TetgenError, TetgenInput, TetgenOptions, tetrahedralize};
@@ -196,6 +197,18 @@ pub enum BuildError {
     /// TetGen failed.
     #[error("TetGen: {0}")]
     Tetgen(#[from] TetgenError),
+    /// The scene's triangles intersect each other (TetGen's code 3, with the
+    /// offending pairs found by the exact check of [`crate::intersect`]).
+    #[error(
+        "the scene self-intersects: {total} pairs of input triangles intersect, e.g. {}",
+        list_pairs(pairs)
+    )]
+    SelfIntersections {
+        /// Up to 20 pairs, by input triangle index.
+        pairs: Vec<IntersectingPair>,
+        /// Number of intersecting pairs.
+        total: usize,
+    },
     /// A scene triangle is not exactly one constrained face of the mesh.
     #[error(
         "scene triangle {triangle} (cleaned {cleaned}) is covered by {faces} constrained faces, expected exactly one with its own vertices"
@@ -238,6 +251,27 @@ pub enum BuildError {
     /// Assembly or validation failed (a bug in this pipeline or TetGen).
     #[error("mesh: {0}")]
     Mesh(#[from] MeshError),
+}
+
+fn list_pairs(pairs: &[IntersectingPair]) -> String {
+    pairs
+        .iter()
+        .map(|p| format!("{} × {} ({:?})", p.first, p.second, p.kind))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// TetGen reported a self-intersection: name the pairs by input index.
+fn self_intersection_error(scene: &Scene) -> BuildError {
+    let report = find_self_intersections(&scene.vertices, &scene.triangles);
+    if report.pairs.is_empty() {
+        // Only TetGen's own tolerance sees it (or it involves the box).
+        return BuildError::Tetgen(TetgenError::SelfIntersection);
+    }
+    BuildError::SelfIntersections {
+        total: report.pairs.len(),
+        pairs: report.pairs.into_iter().take(20).collect(),
+    }
 }
 
 /// Builds the constrained Delaunay tetrahedralization of `scene` (see the module docs).
@@ -313,6 +347,7 @@ pub fn build(scene: &Scene, options: &BuildOptions) -> Result<(TetMesh, BuildRep
                     rounds: round,
                 });
             }
+            Err(TetgenError::SelfIntersection) => return Err(self_intersection_error(scene)),
             Err(e) => return Err(e.into()),
         };
         report.times.tetgen += t.elapsed();

@@ -264,10 +264,15 @@ fn bad_scenes_are_typed_errors() {
         enclosing_box: Some(BoxSpec::default()),
         ..BuildOptions::default()
     };
-    assert!(matches!(
-        build(&crossing, &isolated),
-        Err(BuildError::Tetgen(TetgenError::SelfIntersection))
-    ));
+    // The error names the pairs by input index: only the added triangle (4)
+    // crosses the tet's faces (0..4).
+    match build(&crossing, &isolated) {
+        Err(BuildError::SelfIntersections { pairs, total }) => {
+            assert!(total >= 1 && total == pairs.len());
+            assert!(pairs.iter().all(|p| p.first < 4 && p.second == 4), "{pairs:?}");
+        }
+        other => panic!("expected SelfIntersections, got {other:?}"),
+    }
 }
 
 #[test]

@@ -139,6 +139,23 @@ pub fn face_key(mut v: [u32; 3]) -> [u32; 3] {
     v
 }
 
+/// `(sorted face vertices, tet, face)` for every face of every tet, sorted:
+/// faces shared by two tets are adjacent (neighbours by sorting, no hash map).
+pub(crate) fn sorted_faces(tets: &[[u32; 4]]) -> Vec<([u32; 3], u32, u8)> {
+    let mut faces = Vec::with_capacity(tets.len() * 4);
+    for (t, tet) in tets.iter().enumerate() {
+        for (k, s) in FACE_VERTICES.iter().enumerate() {
+            faces.push((
+                face_key([tet[s[0]], tet[s[1]], tet[s[2]]]),
+                t as u32,
+                k as u8,
+            ));
+        }
+    }
+    faces.sort_unstable();
+    faces
+}
+
 /// True when `b` is a cyclic rotation of `a` (same orientation).
 pub(crate) fn same_cyclic_order(a: [u32; 3], b: [u32; 3]) -> bool {
     a == b || a == [b[1], b[2], b[0]] || a == [b[2], b[0], b[1]]
@@ -229,35 +246,17 @@ impl TetMesh {
                 }
             }
         }
-        // (sorted face vertices, tet, face) for every tet face.
-        let mut faces: Vec<([u32; 3], u32, u8)> = Vec::with_capacity(tets.len() * 4);
-        for (t, tet) in tets.iter().enumerate() {
-            for (k, s) in FACE_VERTICES.iter().enumerate() {
-                faces.push((
-                    face_key([tet[s[0]], tet[s[1]], tet[s[2]]]),
-                    t as u32,
-                    k as u8,
-                ));
-            }
-        }
-        faces.sort_unstable();
+        let faces = sorted_faces(&tets);
         let mut neighbors = vec![[Link::BOUNDARY; 4]; tets.len()];
-        let mut i = 0;
-        while i < faces.len() {
-            let mut j = i + 1;
-            while j < faces.len() && faces[j].0 == faces[i].0 {
-                j += 1;
-            }
-            match j - i {
-                1 => {}
-                2 => {
-                    let (_, ta, fa) = faces[i];
-                    let (_, tb, fb) = faces[i + 1];
-                    neighbors[ta as usize][fa as usize] = Link::tet(tb);
-                    neighbors[tb as usize][fb as usize] = Link::tet(ta);
+        for run in faces.chunk_by(|a, b| a.0 == b.0) {
+            match run {
+                [_] => {}
+                [(_, ta, fa), (_, tb, fb)] => {
+                    neighbors[*ta as usize][*fa as usize] = Link::tet(*tb);
+                    neighbors[*tb as usize][*fb as usize] = Link::tet(*ta);
                 }
                 _ => {
-                    let (key, t, f) = faces[i];
+                    let (key, t, f) = run[0];
                     return Err(MeshError::FaceNotManifold {
                         tet: t,
                         face: f,
@@ -266,7 +265,6 @@ impl TetMesh {
                     });
                 }
             }
-            i = j;
         }
 
         let mut constrained = Vec::with_capacity(triangles.len());

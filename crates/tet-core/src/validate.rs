@@ -4,7 +4,7 @@
 
 use crate::error::MeshError;
 use crate::link::{LinkKind, MAX_TETS};
-use crate::mesh::{FACE_VERTICES, FaceSide, TetMesh, face_key, same_cyclic_order};
+use crate::mesh::{FaceSide, TetMesh, face_key, same_cyclic_order, sorted_faces};
 use crate::predicates::orient3d_f32;
 
 pub(crate) fn validate(m: &TetMesh) -> Result<(), MeshError> {
@@ -207,24 +207,9 @@ fn check_constrained_table(m: &TetMesh) -> Result<(), MeshError> {
 /// Each face key appears at most twice; twice only between linked tets (or
 /// across one constrained face); once only on the boundary.
 fn check_face_manifold(m: &TetMesh) -> Result<(), MeshError> {
-    let mut faces: Vec<([u32; 3], u32, u8)> = Vec::with_capacity(m.tets.len() * 4);
-    for (t, tet) in m.tets.iter().enumerate() {
-        for (k, s) in FACE_VERTICES.iter().enumerate() {
-            faces.push((
-                face_key([tet[s[0]], tet[s[1]], tet[s[2]]]),
-                t as u32,
-                k as u8,
-            ));
-        }
-    }
-    faces.sort_unstable();
-    let mut i = 0;
-    while i < faces.len() {
-        let mut j = i + 1;
-        while j < faces.len() && faces[j].0 == faces[i].0 {
-            j += 1;
-        }
-        let (key, t, f) = faces[i];
+    let faces = sorted_faces(&m.tets);
+    for run in faces.chunk_by(|a, b| a.0 == b.0) {
+        let (key, t, f) = run[0];
         let err = |detail| MeshError::FaceNotManifold {
             tet: t,
             face: f,
@@ -232,7 +217,7 @@ fn check_face_manifold(m: &TetMesh) -> Result<(), MeshError> {
             detail,
         };
         let link = m.neighbors[t as usize][f as usize];
-        match j - i {
+        match run.len() {
             1 => {
                 let one_sided = match link.kind() {
                     LinkKind::Boundary => true,
@@ -247,7 +232,7 @@ fn check_face_manifold(m: &TetMesh) -> Result<(), MeshError> {
                 }
             }
             2 => {
-                let (_, u, _) = faces[i + 1];
+                let (_, u, _) = run[1];
                 let linked = match link.kind() {
                     LinkKind::Tet(n) => n == u,
                     LinkKind::Constrained(c) => m.constrained[c as usize]
@@ -261,7 +246,6 @@ fn check_face_manifold(m: &TetMesh) -> Result<(), MeshError> {
             }
             _ => return Err(err("shared by more than two tets")),
         }
-        i = j;
     }
     Ok(())
 }

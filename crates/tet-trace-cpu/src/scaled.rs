@@ -106,6 +106,7 @@ impl<const MIN: usize, const MAX_IS_B: bool, const SWAP: bool> Projection
     for ScaledF32<MIN, MAX_IS_B, SWAP>
 {
     type P = Vec2;
+    crate::walk::simd_face!();
     const NAME: &'static str = "f32-scaled";
     fn setup(ray: &Ray) -> Self {
         let n = ray.direction.as_dvec3();
@@ -133,10 +134,6 @@ impl<const MIN: usize, const MAX_IS_B: bool, const SWAP: bool> Projection
     #[inline(always)]
     fn left(&self, a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
         crate::walk::left_f32(a, ia, b, ib)
-    }
-    #[inline(always)]
-    fn left_mask(&self, pd: Vec2, d: u32, p: &[Vec2; 3], ids: &[u32; 3]) -> usize {
-        crate::walk::left_mask_2d!(pd, d, p, ids)
     }
 }
 

@@ -58,7 +58,7 @@
 //! scalar triple products of [`crate::sctp`], which use the same decisions)
 //! and over the layout ([`Topology`]), and monomorphised per pair.
 
-use glam::{DVec2, DVec3, Vec2, Vec3};
+use glam::{DVec2, DVec3, Vec2, Vec3, Vec4};
 use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
 
 use crate::locate::star;
@@ -79,18 +79,126 @@ pub trait Projection: Copy + Send + Sync {
     /// Exactly antisymmetric: `left(a, b) == !left(b, a)`.
     fn left(&self, a: Self::P, ia: u32, b: Self::P, ib: u32) -> bool;
 
+    /// The entry face's three projected points as the walk stores them
+    /// (an array, or SoA vectors for the SIMD 2-D projections).
+    type Face: Copy;
+    /// Packs three projected points.
+    fn face(p: [Self::P; 3]) -> Self::Face;
+    /// Replaces point `slot` (0..=2) of a face.
+    fn set_point(face: &mut Self::Face, slot: usize, p: Self::P);
     /// The three edge tests of a step as a bit mask:
-    /// bit `i` = `left(pd, d, p[i], ids[i])` (the index of [`EXIT_SLOT`]).
-    /// Implementations may only change how the bits are computed, never
-    /// their values; the 2-D ones evaluate the three determinants
-    /// branch-free and take the tie rule only when one of them is zero.
+    /// bit `i` = `left(pd, d, pᵢ, ids[i])` for the points `pᵢ` of `face`
+    /// (the index of [`EXIT_SLOT`]). Implementations may only change how
+    /// the bits are computed, never their values: the 2-D ones evaluate the
+    /// three determinants at once, branch-free, and take the tie rule only
+    /// when one of them is zero.
+    fn left_mask(&self, pd: Self::P, d: u32, face: &Self::Face, ids: &[u32; 3]) -> usize;
+}
+
+/// [`Projection::Face`] for projections that store the face as an array:
+/// the three `left` calls of Algorithm 1, as written.
+macro_rules! array_face {
+    ($P:ty) => {
+        type Face = [$P; 3];
+        #[inline(always)]
+        fn face(p: [$P; 3]) -> [$P; 3] {
+            p
+        }
+        #[inline(always)]
+        fn set_point(face: &mut [$P; 3], slot: usize, p: $P) {
+            face[slot] = p;
+        }
+        #[inline(always)]
+        fn left_mask(&self, pd: $P, d: u32, f: &[$P; 3], ids: &[u32; 3]) -> usize {
+            self.left(pd, d, f[0], ids[0]) as usize
+                | (self.left(pd, d, f[1], ids[1]) as usize) << 1
+                | (self.left(pd, d, f[2], ids[2]) as usize) << 2
+        }
+    };
+}
+
+/// An entry face of 2-D f32 points in SoA form: `xs = (x₀, x₁, x₂, 0)`,
+/// `ys = (y₀, y₁, y₂, 0)`, so that the three determinants of a step
+/// `det(pd, pᵢ) = pd.x·yᵢ − pd.y·xᵢ` are one SIMD multiply–multiply–subtract
+/// (each lane computes exactly the scalar expression of `left_2d!`: same
+/// operands, same operations, no fusion, hence bit-identical).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub struct Face2 {
+    // Plain arrays (16-byte aligned): a replacement is one scalar store per
+    // array at a variable index, without branches; the determinants load
+    // them as vectors.
+    xs: [f32; 4],
+    ys: [f32; 4],
+}
+
+impl Face2 {
+    /// Packs three points.
     #[inline(always)]
-    fn left_mask(&self, pd: Self::P, d: u32, p: &[Self::P; 3], ids: &[u32; 3]) -> usize {
-        self.left(pd, d, p[0], ids[0]) as usize
-            | (self.left(pd, d, p[1], ids[1]) as usize) << 1
-            | (self.left(pd, d, p[2], ids[2]) as usize) << 2
+    pub fn new(p: [Vec2; 3]) -> Face2 {
+        Face2 {
+            xs: [p[0].x, p[1].x, p[2].x, 0.0],
+            ys: [p[0].y, p[1].y, p[2].y, 0.0],
+        }
+    }
+    /// Point `i` (0..=2).
+    #[inline(always)]
+    pub fn point(&self, i: usize) -> Vec2 {
+        Vec2::new(self.xs[i], self.ys[i])
+    }
+    /// Replaces point `slot` (0..=2; larger values panic).
+    #[inline(always)]
+    pub fn set(&mut self, slot: usize, p: Vec2) {
+        self.xs[slot] = p.x;
+        self.ys[slot] = p.y;
+    }
+    /// Bit `i` = `left_f32(pd, d, pᵢ, ids[i])`: the fast path when no
+    /// determinant is zero, the full tie rule otherwise.
+    #[inline(always)]
+    pub fn left_mask(&self, pd: Vec2, d: u32, ids: &[u32; 3]) -> usize {
+        let (xs, ys) = (Vec4::from_array(self.xs), Vec4::from_array(self.ys));
+        let det = Vec4::splat(pd.x) * ys - Vec4::splat(pd.y) * xs;
+        let nonzero = det.cmpne(Vec4::ZERO).bitmask() & 7;
+        if nonzero == 7 {
+            (det.cmpgt(Vec4::ZERO).bitmask() & 7) as usize
+        } else {
+            self.left_mask_ties(pd, d, ids)
+        }
+    }
+    #[cold]
+    #[inline(never)]
+    fn left_mask_ties(&self, pd: Vec2, d: u32, ids: &[u32; 3]) -> usize {
+        left_f32(pd, d, self.point(0), ids[0]) as usize
+            | (left_f32(pd, d, self.point(1), ids[1]) as usize) << 1
+            | (left_f32(pd, d, self.point(2), ids[2]) as usize) << 2
     }
 }
+
+/// [`Projection::Face`] = [`Face2`] for the 2-D f32 projections.
+macro_rules! simd_face {
+    () => {
+        type Face = $crate::walk::Face2;
+        #[inline(always)]
+        fn face(p: [Vec2; 3]) -> $crate::walk::Face2 {
+            $crate::walk::Face2::new(p)
+        }
+        #[inline(always)]
+        fn set_point(face: &mut $crate::walk::Face2, slot: usize, p: Vec2) {
+            face.set(slot, p);
+        }
+        #[inline(always)]
+        fn left_mask(
+            &self,
+            pd: Vec2,
+            d: u32,
+            f: &$crate::walk::Face2,
+            ids: &[u32; 3],
+        ) -> usize {
+            f.left_mask(pd, d, ids)
+        }
+    };
+}
+pub(crate) use simd_face;
 
 /// The tie rule of the module docs for 2-D points with an already computed
 /// determinant.
@@ -108,59 +216,6 @@ macro_rules! left_2d {
             $ia < $ib
         }
     }};
-}
-
-/// [`Projection::left_mask`] for 2-D points: the three determinants
-/// `det(pd, p[i])` are computed exactly as in `left_2d!` (same operands, same
-/// operation order, so bit-identical), their signs combined without a
-/// branch; only when one of them is zero is the full tie rule of `left_2d!` evaluated, edge by edge, out of line. The
-/// result is therefore identical to three `left` calls.
-macro_rules! left_mask_2d {
-    ($pd:expr, $d:expr, $p:expr, $ids:expr) => {{
-        let (pd, p, ids, d) = ($pd, $p, $ids, $d);
-        let d0 = pd.x * p[0].y - pd.y * p[0].x;
-        let d1 = pd.x * p[1].y - pd.y * p[1].x;
-        let d2 = pd.x * p[2].y - pd.y * p[2].x;
-        if (d0 != 0.0) & (d1 != 0.0) & (d2 != 0.0) {
-            (d0 > 0.0) as usize | ((d1 > 0.0) as usize) << 1 | ((d2 > 0.0) as usize) << 2
-        } else {
-            #[cold]
-            #[inline(never)]
-            fn ties<V: Copy + $crate::walk::LeftTie>(
-                pd: V,
-                d: u32,
-                p: &[V; 3],
-                ids: &[u32; 3],
-            ) -> usize {
-                V::left_tie(pd, d, p[0], ids[0]) as usize
-                    | (V::left_tie(pd, d, p[1], ids[1]) as usize) << 1
-                    | (V::left_tie(pd, d, p[2], ids[2]) as usize) << 2
-            }
-            ties(pd, d, p, ids)
-        }
-    }};
-}
-pub(crate) use left_mask_2d;
-
-/// The full 2-D edge test with the tie rule, per point type (the cold path
-/// of `left_mask_2d!`).
-pub(crate) trait LeftTie {
-    /// `left_2d!(a, ia, b, ib)`.
-    fn left_tie(a: Self, ia: u32, b: Self, ib: u32) -> bool;
-}
-
-impl LeftTie for Vec2 {
-    #[inline]
-    fn left_tie(a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
-        left_2d!(a, ia, b, ib)
-    }
-}
-
-impl LeftTie for DVec2 {
-    #[inline]
-    fn left_tie(a: DVec2, ia: u32, b: DVec2, ib: u32) -> bool {
-        left_2d!(a, ia, b, ib)
-    }
 }
 
 /// The tie rule of the module docs on f32 2-D points (shared by every f32
@@ -186,37 +241,43 @@ fn duff_basis(n: DVec3) -> (DVec3, DVec3) {
 }
 
 /// f32 projection `p = (u·(P−o), v·(P−o))` with Duff et al.'s basis
-/// (6 multiplications, 4 additions, 3 subtractions per vertex).
+/// (6 multiplications, 4 additions, 3 subtractions per vertex). Both dot
+/// products are evaluated at once in SIMD, column by column:
+/// `(u·q, v·q) = (uₓ, vₓ)·qₓ + (u_y, v_y)·q_y + (u_z, v_z)·q_z`, which is the
+/// scalar `(uₓqₓ + u_y q_y) + u_z q_z` lane by lane (bit-identical; any fixed
+/// formula keeps the walk watertight, this one also matches the scalar
+/// reference order).
 #[derive(Clone, Copy, Debug)]
 pub struct DuffF32 {
     o: Vec3,
-    u: Vec3,
-    v: Vec3,
+    cx: Vec4,
+    cy: Vec4,
+    cz: Vec4,
 }
 
 impl Projection for DuffF32 {
     type P = Vec2;
+    simd_face!();
     const NAME: &'static str = "f32";
     fn setup(ray: &Ray) -> Self {
         let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
+        let (u, v) = (u.as_vec3(), v.as_vec3());
         DuffF32 {
             o: ray.origin,
-            u: u.as_vec3(),
-            v: v.as_vec3(),
+            cx: Vec4::new(u.x, v.x, 0.0, 0.0),
+            cy: Vec4::new(u.y, v.y, 0.0, 0.0),
+            cz: Vec4::new(u.z, v.z, 0.0, 0.0),
         }
     }
     #[inline(always)]
     fn project(&self, p: Vec3) -> Vec2 {
         let q = p - self.o;
-        Vec2::new(self.u.dot(q), self.v.dot(q))
+        let r = self.cx * Vec4::splat(q.x) + self.cy * Vec4::splat(q.y) + self.cz * Vec4::splat(q.z);
+        Vec2::new(r.x, r.y)
     }
     #[inline(always)]
     fn left(&self, a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
         left_2d!(a, ia, b, ib)
-    }
-    #[inline(always)]
-    fn left_mask(&self, pd: Vec2, d: u32, p: &[Vec2; 3], ids: &[u32; 3]) -> usize {
-        left_mask_2d!(pd, d, p, ids)
     }
 }
 
@@ -232,6 +293,7 @@ pub struct OriginF32 {
 
 impl Projection for OriginF32 {
     type P = Vec2;
+    simd_face!();
     const NAME: &'static str = "f32-po";
     fn setup(ray: &Ray) -> Self {
         let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
@@ -250,10 +312,6 @@ impl Projection for OriginF32 {
     fn left(&self, a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
         left_2d!(a, ia, b, ib)
     }
-    #[inline(always)]
-    fn left_mask(&self, pd: Vec2, d: u32, p: &[Vec2; 3], ids: &[u32; 3]) -> usize {
-        left_mask_2d!(pd, d, p, ids)
-    }
 }
 
 /// f64 variant of [`DuffF32`] (points converted exactly to f64).
@@ -266,6 +324,7 @@ pub struct DuffF64 {
 
 impl Projection for DuffF64 {
     type P = DVec2;
+    array_face!(DVec2);
     const NAME: &'static str = "f64";
     fn setup(ray: &Ray) -> Self {
         let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
@@ -283,10 +342,6 @@ impl Projection for DuffF64 {
     #[inline(always)]
     fn left(&self, a: DVec2, ia: u32, b: DVec2, ib: u32) -> bool {
         left_2d!(a, ia, b, ib)
-    }
-    #[inline(always)]
-    fn left_mask(&self, pd: DVec2, d: u32, p: &[DVec2; 3], ids: &[u32; 3]) -> usize {
-        left_mask_2d!(pd, d, p, ids)
     }
 }
 
@@ -307,6 +362,7 @@ pub struct TripleF32 {
 
 impl Projection for TripleF32 {
     type P = Vec3;
+    array_face!(Vec3);
     const NAME: &'static str = "f32-stp";
     fn setup(ray: &Ray) -> Self {
         let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
@@ -414,7 +470,7 @@ pub fn exit_slot<P: Projection>(
     pd: P::P,
     d: u32,
 ) -> usize {
-    EXIT_SLOT[proj.left_mask(pd, d, p, ids) & 7] as usize
+    EXIT_SLOT[proj.left_mask(pd, d, &P::face(*p), ids) & 7] as usize
 }
 
 /// Algorithm 1 as a table over `left(d→a) | left(d→b) << 1 | left(d→c) << 2`.
@@ -424,7 +480,7 @@ pub const EXIT_SLOT: [u8; 8] = [0, 2, 0, 0, 1, 2, 1, 0];
 struct State<P: Projection> {
     tet: u32,
     ids: [u32; 3],
-    p: [P::P; 3],
+    p: P::Face,
     link: u32,
     visited: u32,
 }
@@ -439,7 +495,7 @@ fn start_in_tet<P: Projection>(mesh: &TetMesh, proj: &P, tet: u32) -> Option<Sta
         State {
             tet,
             ids: [v[a], v[b], v[c]],
-            p: [p[a], p[b], p[c]],
+            p: P::face([p[a], p[b], p[c]]),
             link: mesh.neighbors[tet as usize][k].0,
             visited: 1,
         }
@@ -478,7 +534,7 @@ fn start_fallback<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) 
     State {
         tet,
         ids,
-        p: ids.map(|i| proj.project(mesh.points[i as usize])),
+        p: P::face(ids.map(|i| proj.project(mesh.points[i as usize]))),
         link: mesh.neighbors[tet as usize][k].0,
         visited: 1,
     }
@@ -586,22 +642,47 @@ pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
     while !lanes.is_empty() {
         let mut j = 0;
         while j < lanes.len() {
-            let (i, lane) = &mut lanes[j];
-            let adv = advance(points, topo, lane, cap);
-            if adv != Advance::Go {
-                let i = *i;
-                if let Some(o) = finish_step(mesh, &rays[i], lane, adv) {
-                    out[i] = o;
-                    match next_lane(mesh, rays, start, &mut queued, out) {
-                        Some(l) => lanes[j] = l,
-                        None => {
-                            lanes.swap_remove(j);
-                            continue;
-                        }
-                    }
-                }
+            let adv = advance(points, topo, &mut lanes[j].1, cap);
+            if adv == Advance::Go
+                || lane_event(mesh, rays, start, &mut queued, out, &mut lanes, j, adv)
+            {
+                j += 1;
             }
-            j += 1;
+        }
+    }
+}
+
+/// The out-of-line part of [`trace_interleaved`]'s round: lane `j` stopped
+/// with `adv`; finish its step, and when its walk ended, store the outcome
+/// and refill or remove the lane. True when `lanes[j]` is (still) a live
+/// lane that already took its step this round.
+#[cold]
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn lane_event<P: Projection>(
+    mesh: &TetMesh,
+    rays: &[Ray],
+    start: Start,
+    queued: &mut usize,
+    out: &mut [TraceOutcome],
+    lanes: &mut Vec<(usize, Lane<P>)>,
+    j: usize,
+    adv: Advance,
+) -> bool {
+    let (i, lane) = &mut lanes[j];
+    let i = *i;
+    let Some(o) = finish_step(mesh, &rays[i], lane, adv) else {
+        return true;
+    };
+    out[i] = o;
+    match next_lane(mesh, rays, start, queued, out) {
+        Some(l) => {
+            lanes[j] = l;
+            true
+        }
+        None => {
+            lanes.swap_remove(j);
+            false
         }
     }
 }
@@ -677,7 +758,7 @@ fn begin<P: Projection>(mesh: &TetMesh, ray: &Ray, start: Start) -> Result<Lane<
             let ids = [v[a], v[c], v[b]];
             let st = State {
                 tet: NO_TET,
-                p: ids.map(|i| proj.project(points[i as usize])),
+                p: P::face(ids.map(|i| proj.project(points[i as usize]))),
                 ids,
                 link: Link::constrained(face).0,
                 visited: 0,
@@ -819,15 +900,15 @@ pub(crate) fn advance<P: Projection, T: Topology>(
         return Advance::Lost;
     };
     let pd = lane.proj.project(pd3);
-    // `EXIT_SLOT` holds 0..=2, so `% 3` is the identity; it only lets the
-    // compiler drop the bounds checks of the two indexings below.
-    let slot = EXIT_SLOT[lane.proj.left_mask(pd, d, &st.p, &st.ids) & 7] as usize % 3;
+    // `EXIT_SLOT` holds 0..=2, so `min(·, 2)` is the identity; it only lets
+    // the compiler drop the bounds checks of the indexings below.
+    let slot = usize::min(EXIT_SLOT[lane.proj.left_mask(pd, d, &st.p, &st.ids) & 7] as usize, 2);
     let exiting = st.ids[slot];
     let raw = topo.exit_link(next, st.ids, d, exiting, lane.entry_raw);
     // The lane state lives in memory (several lanes are in flight), so a
     // variable-indexed store is one instruction per array.
     st.ids[slot] = d;
-    st.p[slot] = pd;
+    P::set_point(&mut st.p, slot, pd);
     st.tet = next;
     st.link = raw;
     st.visited += 1;
