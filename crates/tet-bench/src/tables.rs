@@ -79,6 +79,11 @@ pub struct SceneResult {
     pub unsorted_tet20: Option<RenderDoc>,
     /// Accuracy against the f64 reference.
     pub accuracy: Option<CaseAccuracy>,
+    /// GPU methods (seed 000 Table 3), when built with `--features gpu` and
+    /// an adapter is present.
+    pub gpu_renders: Vec<RenderDoc>,
+    /// Why there are no GPU rows, if there are none.
+    pub gpu_note: Option<String>,
     /// Why the scene failed, if it did.
     pub error: Option<String>,
 }
@@ -150,7 +155,10 @@ fn measure_scene(
         quiet,
     )?;
     let unsorted_tet20 = Some(time_method(&unsorted, Method::Tet20, opts, frames, pool)?.0);
+    let (gpu_renders, gpu_note) = gpu_rows(&loaded, opts, frames);
     Ok(SceneResult {
+        gpu_renders,
+        gpu_note,
         spec: spec.into(),
         info: Some(info),
         bvh_build_s: Some(bvh_build_s),
@@ -159,6 +167,22 @@ fn measure_scene(
         accuracy: Some(accuracy),
         error: None,
     })
+}
+
+/// The GPU methods' rows, or why there are none.
+fn gpu_rows(loaded: &Loaded, opts: &RenderOptions, frames: u32) -> (Vec<RenderDoc>, Option<String>) {
+    if !cfg!(feature = "gpu") {
+        return (Vec::new(), Some("built without the `gpu` feature".into()));
+    }
+    let mut rows = Vec::new();
+    for m in [Method::GpuTet20, Method::GpuTet16, Method::GpuTet32, Method::GpuTet80] {
+        eprintln!("  {}: rendering with {}", loaded.name, m.name());
+        match crate::gpu::time_gpu(loaded, m, opts.width, opts.height, frames) {
+            Ok(doc) => rows.push(doc),
+            Err(e) => return (rows, Some(crate::error_chain(&e))),
+        }
+    }
+    (rows, None)
 }
 
 /// `tet-bench tables`.
@@ -199,6 +223,8 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
                     renders: Vec::new(),
                     unsorted_tet20: None,
                     accuracy: None,
+                    gpu_renders: Vec::new(),
+                    gpu_note: None,
                     error: Some(crate::error_chain(&e)),
                 }
             }
@@ -424,6 +450,25 @@ pub fn markdown(doc: &TablesDoc) -> String {
                 b.mrays_per_s,
                 a.mrays_per_s / b.mrays_per_s
             );
+        }
+    }
+
+    let _ = writeln!(m, "\n## GPU (seed 000 Table 3)\n");
+    let _ = writeln!(
+        m,
+        "| scene | method (device) | best ms | Mrays/s | tets/ray | GPU bytes (tets + points) | failures |"
+    );
+    let _ = writeln!(m, "|---|---|---:|---:|---:|---:|---:|");
+    for sc in &doc.scenes {
+        for r in &sc.gpu_renders {
+            let _ = writeln!(
+                m,
+                "| {} | {} | {:.2} | {:.2} | {:.1} | {} | {} |",
+                r.scene, r.tracer, r.best_ms, r.mrays_per_s, r.tets_per_ray, r.hot_bytes, r.failures
+            );
+        }
+        if let Some(note) = &sc.gpu_note {
+            let _ = writeln!(m, "| {} | no GPU rows: {note} | | | | | |", sc.spec);
         }
     }
 

@@ -614,8 +614,9 @@ pub fn trace<P: Projection, T: Topology>(
 /// Traces many rays from one start with `K` walks interleaved on one thread:
 /// each round advances every lane by one tet, so the CPU overlaps the
 /// dependent load → project → decide → load chains of independent rays
-/// (memory-level parallelism without SIMD); each step also prefetches the
-/// record of the lane's next tet, which that lane reads `K − 1` steps later.
+/// (memory-level parallelism without SIMD). Each step prefetches the record
+/// of the lane's next tet, which that lane reads a round later; each round
+/// starts with a pass that prefetches every lane's new vertex.
 /// Results are identical to [`trace`] ray by ray (same [`advance`] and
 /// `finish_step`). `out.len()` must equal `rays.len()`.
 pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
@@ -640,6 +641,12 @@ pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
         }
     }
     while !lanes.is_empty() {
+        if std::env::var_os("TT_PF2").is_some() {
+            for (_, lane) in lanes.iter() {
+                let ids = lane.st.ids;
+                prefetch_index(points, ids[0] ^ ids[1] ^ ids[2] ^ topo.vx(lane.next));
+            }
+        }
         let mut j = 0;
         while j < lanes.len() {
             let adv = advance(points, topo, &mut lanes[j].1, cap);
@@ -913,7 +920,9 @@ pub(crate) fn advance<P: Projection, T: Topology>(
     st.link = raw;
     st.visited += 1;
     if raw < Link::BOUNDARY.0 {
-        topo.prefetch(raw);
+        if PF.load(std::sync::atomic::Ordering::Relaxed) {
+            topo.prefetch(raw);
+        }
         lane.entry_raw = next;
         lane.next = raw;
         Advance::Go
@@ -1044,3 +1053,6 @@ mod tests {
         }
     }
 }
+
+/// TEMP experiment switch.
+pub static PF: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
