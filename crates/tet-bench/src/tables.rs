@@ -95,8 +95,22 @@ pub struct SceneResult {
     pub gpu_renders: Vec<RenderDoc>,
     /// Why there are no GPU rows, if there are none.
     pub gpu_note: Option<String>,
+    /// The build trade (full mode only): the same scene built with the
+    /// quality bound `-q5`, and tet20 on it.
+    pub quality5: Option<QualityTrade>,
     /// Why the scene failed, if it did.
     pub error: Option<String>,
+}
+
+/// A quality-refined build and its traversal speed.
+#[derive(Clone, Debug, Serialize)]
+pub struct QualityTrade {
+    /// Tets.
+    pub tets: usize,
+    /// Construction report.
+    pub build: Option<crate::load::BuildSummary>,
+    /// tet20 on the refined mesh.
+    pub tet20: RenderDoc,
 }
 
 /// The `tables` document (also written as `tables.json`).
@@ -167,7 +181,27 @@ fn measure_scene(
     )?;
     let unsorted_tet20 = Some(time_method(&unsorted, Method::Tet20, opts, frames, pool)?.0);
     let (gpu_renders, gpu_note) = gpu_rows(&loaded, opts, frames);
+    let quality5 = if args.quick {
+        None
+    } else {
+        eprintln!("  {spec}: quality-refined build (-q5)");
+        let refined = load(
+            spec,
+            &BuildFlags {
+                quality: Some(5.0),
+                max_steiner: Some(2_000_000),
+                ..flags
+            },
+            quiet,
+        )?;
+        Some(QualityTrade {
+            tets: refined.mesh.tets.len(),
+            build: refined.build.clone(),
+            tet20: time_method(&refined, Method::Tet20, opts, frames, pool)?.0,
+        })
+    };
     Ok(SceneResult {
+        quality5,
         gpu_renders,
         gpu_note,
         spec: spec.into(),
@@ -245,6 +279,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
                     accuracy: None,
                     gpu_renders: Vec::new(),
                     gpu_note: None,
+                    quality5: None,
                     error: Some(crate::error_chain(&e)),
                 }
             }
@@ -516,6 +551,37 @@ pub fn markdown(doc: &TablesDoc) -> String {
                     t.best_ms / b.best_ms
                 );
             }
+        }
+    }
+
+    if doc.scenes.iter().any(|sc| sc.quality5.is_some()) {
+        let _ = writeln!(
+            m,
+            "\n## Build trade: surface-preserving `-pY` vs quality `-pYq5`\n"
+        );
+        let _ = writeln!(
+            m,
+            "| scene | tets -pY | tets -q5 | build s -pY | build s -q5 | tet20 Mrays/s -pY | tet20 Mrays/s -q5 |"
+        );
+        let _ = writeln!(m, "|---|---:|---:|---:|---:|---:|---:|");
+        for sc in &doc.scenes {
+            let (Some(q), Some(i)) = (&sc.quality5, &sc.info) else {
+                continue;
+            };
+            let base = sc.renders.iter().find(|r| r.method == Method::Tet20);
+            let secs =
+                |b: &Option<crate::load::BuildSummary>| b.as_ref().map_or(f64::NAN, |b| b.total_s);
+            let _ = writeln!(
+                m,
+                "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} |",
+                i.name,
+                i.tets,
+                q.tets,
+                secs(&i.build),
+                secs(&q.build),
+                base.map_or(f64::NAN, |r| r.mrays_per_s),
+                q.tet20.mrays_per_s
+            );
         }
     }
 

@@ -7,6 +7,8 @@
 pub mod bbox;
 pub mod clean;
 pub mod intersect;
+#[cfg(feature = "tetgen")]
+pub mod outofcore;
 pub mod pipeline;
 pub mod procedural;
 pub mod quality;
