@@ -38,54 +38,9 @@ pub fn fixture_dir() -> &'static Path {
     })
 }
 
-/// KNOWN BUG, reported to the lead (issue 7): `tobj` 4.0.5 checks normal
-/// and texture-coordinate indices with `vn * 3 + 2 >= len` and
-/// `vt * 2 + 1 >= len`, which overflow when the index is huge, or when a
-/// relative (negative) index reaches before the first element (`count + x`
-/// wraps to a huge `usize`, e.g. `f 1//1 2//1 3//-3` with one `vn`): a panic
-/// with overflow checks on (debug builds and tests), and with them off
-/// (release) a wrapped bound check that can pass and return a misaligned
-/// normal or uv without error. `parse_obj_bytes` hands the text to `tobj`
-/// unchecked. Until it validates face indices first, OBJ inputs with such a
-/// texture or normal index (magnitude ≥ 2³¹, or negative beyond the number
-/// of `vt`/`vn` lines so far) are not given to the OBJ parser here; the
-/// reproducers live in `fuzz/regressions/obj_and_scene/` (test
-/// `obj_known_crash_regressions`, `#[ignore]`d until the fix).
-pub fn known_crash(data: &[u8]) -> bool {
-    let text = String::from_utf8_lossy(data);
-    // Defined so far: positions, texture coordinates, normals.
-    let mut count = [0i128; 3];
-    for line in text.lines() {
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => count[0] += 1,
-            Some("vt") => count[1] += 1,
-            Some("vn") => count[2] += 1,
-            Some("f") => {
-                for corner in words {
-                    for (k, i) in corner.split('/').enumerate().skip(1) {
-                        let Ok(x) = i.parse::<i128>() else {
-                            // tobj parses as isize: a longer number is
-                            // refused with an error, not a crash.
-                            continue;
-                        };
-                        if x.abs() >= 1 << 31 || (k < 3 && x < 0 && -x > count[k]) {
-                            return true;
-                        }
-                    }
-                }
-            }
-            _ => {}
-        }
-    }
-    false
-}
-
 /// Runs both properties on `data`.
 pub fn check(data: &[u8]) {
-    if !known_crash(data) {
-        check_obj(data);
-    }
+    check_obj(data);
     check_scenes_json(data);
 }
 

@@ -292,36 +292,26 @@ fn tetgen_files_huge_counts_are_typed_errors() {
     }
 }
 
-/// The OBJ reproducers of `fuzz/regressions/obj_and_scene/` panic inside
-/// `tobj` (index arithmetic overflow; reported to the lead): run with
-/// `--ignored` once `parse_obj_bytes` checks indices first, then move them
-/// into the seeds and drop the `known_crash` guard.
+/// Face indices that overflow inside `tobj` (huge, or relative ones reaching
+/// before the first element; found by the fuzzer): `parse_obj_bytes` checks
+/// indices before tobj sees them, so each is a typed error, not a panic.
 #[test]
-#[ignore = "known panic in tobj via tet-build/src/scene/obj.rs (face index overflow), reported in issue 7"]
-fn obj_known_crash_regressions() {
+fn obj_index_overflow_regressions() {
     let inputs = read_seeds("../regressions/obj_and_scene");
     assert!(inputs.len() >= 2);
     for (name, bytes) in &inputs {
-        assert!(obj_and_scene::known_crash(bytes), "{name}");
         assert!(
             !obj_and_scene::check_obj(bytes),
             "{name}: out-of-range index parsed"
         );
     }
-}
-
-#[test]
-fn obj_known_crash_guard_is_narrow() {
-    for (name, bytes) in read_seeds("obj_and_scene") {
-        assert!(!obj_and_scene::known_crash(&bytes), "{name}");
+    for bytes in [
+        &b"vn 0 0 1\nf 1//2147483648\n"[..],
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//-3\n",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -9223372036854775808\n",
+    ] {
+        assert!(!obj_and_scene::check_obj(bytes));
     }
-    let small = b"v 0 0 0\nvt 0 0\nvn 0 0 1\nf 1//2147483647 -1//-1 1/-1/1 1/1/1\n";
-    assert!(!obj_and_scene::known_crash(small));
-    assert!(obj_and_scene::known_crash(b"vn 0 0 1\nf 1//2147483648\n"));
-    assert!(obj_and_scene::known_crash(b"vn 0 0 1\nf 1//1 2//1 3//-3\n"));
-    assert!(!obj_and_scene::known_crash(
-        b"vn 0 0 1\nvn 0 0 1\nf 1//1 2//1 3//-2\n"
-    ));
 }
 
 /// Tokens that break naive parsers: huge and negative counts and indices,

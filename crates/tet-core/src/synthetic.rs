@@ -82,7 +82,8 @@ const PERMUTATIONS: [[usize; 3]; 6] = [
 /// Builds a valid jittered Kuhn grid mesh (see [`GridSpec`]).
 ///
 /// # Panics
-/// If a cell count is zero or the grid has more than 2³¹ tets.
+/// If a cell count is zero, the grid has more than 2³¹ tets, or `scale` and
+/// `offset` collapse the lattice in f32 (flat tets) — never loops.
 pub fn kuhn_grid(spec: &GridSpec) -> TetMesh {
     let [nx, ny, nz] = spec.cells;
     assert!(
@@ -151,7 +152,14 @@ pub fn kuhn_grid(spec: &GridSpec) -> TetMesh {
         if all_positive {
             break points;
         }
-        // Rounding after scaling/offset can flatten a tet: retry with less jitter.
+        // Rounding after scaling/offset can flatten a tet: retry with less
+        // jitter; without jitter there is nothing left to try.
+        assert!(
+            jitter > 0.0,
+            "kuhn_grid: the lattice collapses in f32 at scale {} and offset {} (flat tets)",
+            spec.scale,
+            spec.offset
+        );
         jitter *= 0.5;
         if jitter < 1e-6 {
             jitter = 0.0;
@@ -217,6 +225,17 @@ mod tests {
             .filter(|c| !(c.front.exists() && c.back.exists()))
             .count();
         assert_eq!(boundary + one_sided, 2 * 2 * (2 * 3 + 3 * 4 + 2 * 4));
+    }
+
+    #[test]
+    #[should_panic(expected = "collapses in f32")]
+    fn collapsed_lattice_panics_instead_of_looping() {
+        kuhn_grid(&GridSpec {
+            cells: [1, 1, 1],
+            scale: 1e-3,
+            offset: Vec3::splat(1e5),
+            ..Default::default()
+        });
     }
 
     #[test]

@@ -128,6 +128,9 @@ pub fn parse_obj_bytes(bytes: &[u8], path: &Path) -> Result<MeshData, SceneError
         ignore_points: true,
         ignore_lines: true,
     };
+    if let Some(e) = find_error(bytes, path) {
+        return Err(e);
+    }
     let mut reader = Cursor::new(bytes);
     let result = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
@@ -198,7 +201,21 @@ pub fn parse_obj_bytes(bytes: &[u8], path: &Path) -> Result<MeshData, SceneError
 }
 
 /// Find the first offending line of an OBJ text; `fallback` is tobj's message.
+/// The error to report for an OBJ text tobj rejected: the first problem the
+/// text check finds, else tobj's own message.
 fn diagnose(bytes: &[u8], path: &Path, fallback: Option<String>) -> SceneError {
+    find_error(bytes, path).unwrap_or_else(|| SceneError::ObjParse {
+        path: path.to_path_buf(),
+        line: None,
+        message: fallback.unwrap_or_else(|| "malformed OBJ".into()),
+    })
+}
+
+/// Checks the OBJ text line by line (numbers parse and are finite, every
+/// face index — absolute or relative — names an existing element) and
+/// returns the first problem with its line. Run before tobj, which does not
+/// check indices (an out-of-range relative index overflows inside it).
+fn find_error(bytes: &[u8], path: &Path) -> Option<SceneError> {
     let text = String::from_utf8_lossy(bytes);
     let path: PathBuf = path.to_path_buf();
     let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
@@ -218,35 +235,35 @@ fn diagnose(bytes: &[u8], path: &Path, fallback: Option<String>) -> SceneError {
         if want > 0 {
             let vals: Vec<&str> = words.collect();
             if vals.len() < want {
-                return SceneError::ObjParse {
+                return Some(SceneError::ObjParse {
                     path,
                     line: Some(line),
                     message: format!("`{tag}` needs {want} numbers, found {}", vals.len()),
-                };
+                });
             }
             for s in vals.iter().take(if tag == "vt" { 1 } else { 3 }) {
                 match s.parse::<f32>() {
                     Ok(x) if x.is_finite() => {}
                     Ok(_) if tag == "v" => {
-                        return SceneError::NonFiniteCoordinate {
+                        return Some(SceneError::NonFiniteCoordinate {
                             path,
                             line,
                             vertex: nv as u32,
-                        };
+                        });
                     }
                     Ok(_) => {
-                        return SceneError::ObjParse {
+                        return Some(SceneError::ObjParse {
                             path,
                             line: Some(line),
                             message: format!("non-finite `{tag}` value {s:?}"),
-                        };
+                        });
                     }
                     Err(_) => {
-                        return SceneError::ObjParse {
+                        return Some(SceneError::ObjParse {
                             path,
                             line: Some(line),
                             message: format!("cannot parse {s:?} as a number"),
-                        };
+                        });
                     }
                 }
             }
@@ -267,28 +284,28 @@ fn diagnose(bytes: &[u8], path: &Path, fallback: Option<String>) -> SceneError {
                     1 => ("texture coordinate", nt),
                     2 => ("normal", nn),
                     _ => {
-                        return SceneError::ObjParse {
+                        return Some(SceneError::ObjParse {
                             path,
                             line: Some(line),
                             message: format!("bad face corner {corner:?}"),
-                        };
+                        });
                     }
                 };
                 let Ok(i) = part.parse::<i64>() else {
-                    return SceneError::ObjParse {
+                    return Some(SceneError::ObjParse {
                         path,
                         line: Some(line),
                         message: format!("bad face corner {corner:?}"),
-                    };
+                    });
                 };
-                if i == 0 || (i < 0 && -i > count) {
-                    return SceneError::IndexOutOfRange {
+                if i == 0 || (i < 0 && i.unsigned_abs() > count as u64) {
+                    return Some(SceneError::IndexOutOfRange {
                         path,
                         line,
                         kind,
                         index: i,
                         count: count as usize,
-                    };
+                    });
                 }
                 if i > 0 {
                     forward.push((line, kind, i));
@@ -303,18 +320,14 @@ fn diagnose(bytes: &[u8], path: &Path, fallback: Option<String>) -> SceneError {
             _ => nn,
         };
         if i > count {
-            return SceneError::IndexOutOfRange {
+            return Some(SceneError::IndexOutOfRange {
                 path,
                 line,
                 kind,
                 index: i,
                 count: count as usize,
-            };
+            });
         }
     }
-    SceneError::ObjParse {
-        path,
-        line: None,
-        message: fallback.unwrap_or_else(|| "malformed OBJ".into()),
-    }
+    None
 }

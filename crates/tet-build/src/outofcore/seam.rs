@@ -1,0 +1,640 @@
+//! Exact seams: one cut plane, both halves tetrahedralized separately, and a
+//! merge by exact vertex triples (issue 8, item 3; replaces the paper's
+//! `CLIP`/`MERGE` with its vertex/edge repairs and centroid hashing, seed
+//! 003 §3.2–3.3).
+//!
+//! 1. **Cut** ([`cut_triangle`]): a scene triangle crossing the plane
+//!    `x[axis] = value` is clipped into a polygon per side (source winding
+//!    kept) and fanned into triangles. The crossing point of an edge is
+//!    computed in f64 from the edge's endpoints in a canonical order (so the
+//!    two triangles sharing the edge compute the same bits), rounded once to
+//!    f32, and its `axis` coordinate set to `value` exactly — it lies on the
+//!    plane, and both halves use bit-identical coordinates. Vertices exactly
+//!    on the plane are used as they are (no new point).
+//! 2. **Seam** ([`seam_triangulation`]): one planar constrained Delaunay
+//!    triangulation (`spade`) of the section of the box by the plane, with
+//!    every cut segment, every scene edge lying in the plane and every
+//!    scene vertex on the plane as constraints. Its triangles lying inside a
+//!    scene triangle that lies in the plane carry that triangle; the others
+//!    are seam-only faces.
+//! 3. **Halves**: each half's PLC is its pieces + all seam triangles + the
+//!    other five faces of its half box; every facet has its own marker, and
+//!    TetGen with `-pY` keeps every facet as exactly one face (checked), so
+//!    both halves have the very same seam faces.
+//! 4. **Merge**: points are deduplicated by their exact f32 bits, tets are
+//!    concatenated, and [`TetMesh::assemble`] pairs the two halves' seam
+//!    faces by vertex triple. Seam-only faces become ordinary interior
+//!    faces; pieces of a cut scene triangle are constrained faces carrying
+//!    the source triangle id (a scene triangle may then be several faces).
+//!
+//! TetGen's Steiner points (interior only, with `-Y`) are rounded to f32;
+//! a tet flattened by that rounding is reported as
+//! [`SeamError::RoundingFlattens`] (the in-core pipeline's snapping repair
+//! is not applied here yet).
+
+use std::collections::HashMap;
+
+use glam::{DVec2, DVec3, Vec3};
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+use tet_core::{MeshError, TetMesh, face_key};
+use thiserror::Error;
+
+use super::split::{Side, SplitPlane};
+use crate::bbox::{BoxError, BoxSpec, EnclosingBox};
+use crate::clean::{CleanError, clean_scene};
+use crate::procedural::BOX_TRIANGLES;
+use crate::scene::Scene;
+use crate::tetgen::{Isolation, TetgenError, TetgenInput, TetgenOptions, tetrahedralize};
+
+/// A failure of [`build_split_once`].
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SeamError {
+    /// Cleaning rejected the scene.
+    #[error("cleaning: {0}")]
+    Clean(#[from] CleanError),
+    /// The scene has no triangles after cleaning.
+    #[error("the scene has no triangles")]
+    EmptyScene,
+    /// The enclosing box could not be built.
+    #[error("enclosing box: {0}")]
+    Box(#[from] BoxError),
+    /// The plane does not cross the box's interior.
+    #[error("plane {plane:?} does not cross the box {min:?}..{max:?}")]
+    PlaneOutsideBox {
+        /// The plane.
+        plane: SplitPlane,
+        /// Box lower corner.
+        min: Vec3,
+        /// Box upper corner.
+        max: Vec3,
+    },
+    /// A scene vertex lies off the plane but closer to it than TetGen's
+    /// tolerance (its crossing points would be merged with it by TetGen).
+    #[error("scene vertex {vertex} {point:?} is {distance:e} off the plane {plane:?}; move the plane")]
+    PlaneNearVertex {
+        /// The plane.
+        plane: SplitPlane,
+        /// Input scene vertex index (after cleaning).
+        vertex: u32,
+        /// Its position.
+        point: Vec3,
+        /// Its distance to the plane.
+        distance: f64,
+    },
+    /// Two seam constraints cross (the scene self-intersects on the plane,
+    /// or rounding of crossing points made two segments cross).
+    #[error("seam constraint {from:?}–{to:?} crosses another seam constraint")]
+    SeamConstraintsCross {
+        /// Segment start.
+        from: Vec3,
+        /// Segment end.
+        to: Vec3,
+    },
+    /// spade refused a seam point.
+    #[error("seam triangulation: point {point:?}: {message}")]
+    SeamPoint {
+        /// The point.
+        point: Vec3,
+        /// spade's error.
+        message: String,
+    },
+    /// TetGen failed on one half.
+    #[error("TetGen on half {half}: {source}")]
+    Tetgen {
+        /// 0 = below, 1 = above.
+        half: usize,
+        /// TetGen's error.
+        source: TetgenError,
+    },
+    /// A facet of a half did not come back as exactly one face.
+    #[error("half {half}: facet {facet} came back as {faces} faces, expected exactly one")]
+    FacetNotPreserved {
+        /// 0 = below, 1 = above.
+        half: usize,
+        /// Facet index in the half's PLC.
+        facet: usize,
+        /// Faces carrying its marker.
+        faces: usize,
+    },
+    /// TetGen moved or dropped an input point.
+    #[error("half {half}: TetGen moved or dropped input point {point}")]
+    InputPointChanged {
+        /// 0 = below, 1 = above.
+        half: usize,
+        /// Point index.
+        point: usize,
+    },
+    /// Rounding Steiner points to f32 flattened or inverted tets.
+    #[error("half {half}: {count} tets are flat or inverted after rounding to f32")]
+    RoundingFlattens {
+        /// 0 = below, 1 = above.
+        half: usize,
+        /// How many.
+        count: usize,
+    },
+    /// Assembly or validation of the merged mesh failed.
+    #[error("merged mesh: {0}")]
+    Mesh(#[from] MeshError),
+}
+
+/// What [`build_split_once`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SeamReport {
+    /// Scene triangles (after cleaning) strictly crossing the plane.
+    pub triangles_cut: usize,
+    /// Scene triangles lying in the plane.
+    pub triangles_in_plane: usize,
+    /// Vertices of the seam triangulation (including the 4 section corners).
+    pub seam_vertices: usize,
+    /// Triangles of the seam triangulation.
+    pub seam_triangles: usize,
+    /// Input points / triangles / output tets of each half.
+    pub half_points: [usize; 2],
+    /// Facets of each half's PLC.
+    pub half_triangles: [usize; 2],
+    /// Tets of each half.
+    pub half_tets: [usize; 2],
+    /// Peak memory of each half's worker (KiB), when isolated.
+    pub half_peak_kib: [Option<u64>; 2],
+}
+
+/// Options of [`build_split_once`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SeamOptions {
+    /// Box around the scene (the whole mesh's boundary).
+    pub enclosing_box: BoxSpec,
+    /// TetGen switches (`-Y` is required and forced on).
+    pub tetgen: TetgenOptions,
+    /// Where TetGen runs.
+    pub isolation: Isolation,
+}
+
+/// One scene-triangle piece: three vertices in the source winding and the
+/// (cleaned) source triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Piece {
+    /// Vertices.
+    pub v: [Vec3; 3],
+    /// Cleaned scene triangle index.
+    pub source: u32,
+}
+
+/// Exact bits of a point (−0 folded into +0).
+fn key(p: Vec3) -> [u32; 3] {
+    [(p.x + 0.0).to_bits(), (p.y + 0.0).to_bits(), (p.z + 0.0).to_bits()]
+}
+
+/// The crossing point of edge `p q` with the plane (endpoints strictly on
+/// opposite sides), computed from the endpoints in canonical order.
+pub fn crossing_point(p: Vec3, q: Vec3, plane: SplitPlane) -> Vec3 {
+    let (p, q) = if key(p) <= key(q) { (p, q) } else { (q, p) };
+    let (pd, qd) = (p.as_dvec3(), q.as_dvec3());
+    let a = plane.axis;
+    let t = (plane.value as f64 - pd[a]) / (qd[a] - pd[a]);
+    let x = pd + t * (qd - pd);
+    let mut r = Vec3::new(x.x as f32, x.y as f32, x.z as f32);
+    // Rounding a value between two f32 values stays between them; clamp
+    // anyway against t's own rounding.
+    r = r.clamp(p.min(q), p.max(q));
+    r[a] = plane.value;
+    r
+}
+
+/// Exact: do three points span a proper triangle?
+fn non_degenerate(t: [Vec3; 3]) -> bool {
+    let proj = |p: Vec3, i: usize, j: usize| robust::Coord {
+        x: p[i] as f64,
+        y: p[j] as f64,
+    };
+    [(0, 1), (1, 2), (2, 0)]
+        .iter()
+        .any(|&(i, j)| robust::orient2d(proj(t[0], i, j), proj(t[1], i, j), proj(t[2], i, j)) != 0.0)
+}
+
+/// Fans a convex polygon (3 or 4 vertices, source winding) into proper
+/// triangles, trying each start vertex until no piece is degenerate.
+fn fan(poly: &[Vec3]) -> Vec<[Vec3; 3]> {
+    let n = poly.len();
+    for s in 0..n {
+        let tris: Vec<[Vec3; 3]> = (1..n - 1)
+            .map(|i| [poly[s], poly[(s + i) % n], poly[(s + i + 1) % n]])
+            .collect();
+        if tris.iter().all(|&t| non_degenerate(t)) {
+            return tris;
+        }
+    }
+    // Some piece is degenerate whatever the start (rounding collapsed a
+    // sliver): keep the proper ones.
+    (1..n - 1)
+        .map(|i| [poly[0], poly[i], poly[i + 1]])
+        .filter(|&t| non_degenerate(t))
+        .collect()
+}
+
+/// Clips a triangle crossing the plane into (below pieces, above pieces,
+/// the seam segment). Source winding is kept in every piece.
+pub fn cut_triangle(tri: [Vec3; 3], plane: SplitPlane) -> (Vec<[Vec3; 3]>, Vec<[Vec3; 3]>, [Vec3; 2]) {
+    let a = plane.axis;
+    let side = |p: Vec3| p[a].partial_cmp(&plane.value).unwrap_or(std::cmp::Ordering::Equal);
+    let (mut lo, mut hi, mut on) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..3 {
+        let (p, q) = (tri[i], tri[(i + 1) % 3]);
+        let (sp, sq) = (side(p), side(q));
+        if sp.is_le() {
+            lo.push(p);
+        }
+        if sp.is_ge() {
+            hi.push(p);
+        }
+        if sp.is_eq() {
+            on.push(p);
+        }
+        if (sp.is_lt() && sq.is_gt()) || (sp.is_gt() && sq.is_lt()) {
+            let x = crossing_point(p, q, plane);
+            lo.push(x);
+            hi.push(x);
+            on.push(x);
+        }
+    }
+    debug_assert_eq!(on.len(), 2);
+    (fan(&lo), fan(&hi), [on[0], on[1]])
+}
+
+/// The seam: triangles in the plane, each with the in-plane scene triangle
+/// it lies in (cleaned index), if any.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Seam {
+    /// Triangles (oriented as their scene triangle where they have one).
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Scene triangle each lies in.
+    pub source: Vec<Option<u32>>,
+    /// Number of distinct seam vertices.
+    pub vertices: usize,
+}
+
+/// Builds the seam triangulation of the rectangle `corners` (on the plane)
+/// with `segments` and `points` as constraints and the in-plane scene
+/// triangles `in_plane` (vertices, cleaned index) as constraint edges and
+/// face labels.
+pub fn seam_triangulation(
+    plane: SplitPlane,
+    corners: [Vec3; 4],
+    segments: &[[Vec3; 2]],
+    points: &[Vec3],
+    in_plane: &[([Vec3; 3], u32)],
+) -> Result<Seam, SeamError> {
+    let (u, v) = ((plane.axis + 1) % 3, (plane.axis + 2) % 3);
+    let to2 = |p: Vec3| Point2::new(p[u] as f64, p[v] as f64);
+    let to3 = |p: Point2<f64>| {
+        let mut r = Vec3::ZERO;
+        r[plane.axis] = plane.value;
+        r[u] = p.x as f32;
+        r[v] = p.y as f32;
+        r
+    };
+    let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
+        ConstrainedDelaunayTriangulation::new();
+    let mut handles = HashMap::new();
+    let mut insert = |cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>, p: Vec3| {
+        if let Some(&h) = handles.get(&key(p)) {
+            return Ok::<_, SeamError>(h);
+        }
+        let h = cdt.insert(to2(p)).map_err(|e| SeamError::SeamPoint {
+            point: p,
+            message: format!("{e:?}"),
+        })?;
+        handles.insert(key(p), h);
+        Ok(h)
+    };
+    for &c in &corners {
+        insert(&mut cdt, c)?;
+    }
+    for &p in points {
+        insert(&mut cdt, p)?;
+    }
+    let mut edges: Vec<[Vec3; 2]> = segments.to_vec();
+    for (t, _) in in_plane {
+        for i in 0..3 {
+            edges.push([t[i], t[(i + 1) % 3]]);
+        }
+    }
+    for e in &edges {
+        insert(&mut cdt, e[0])?;
+        insert(&mut cdt, e[1])?;
+    }
+    for e in &edges {
+        let (h0, h1) = (insert(&mut cdt, e[0])?, insert(&mut cdt, e[1])?);
+        if h0 == h1 || cdt.exists_constraint(h0, h1) {
+            continue;
+        }
+        if !cdt.can_add_constraint(h0, h1) {
+            return Err(SeamError::SeamConstraintsCross {
+                from: e[0],
+                to: e[1],
+            });
+        }
+        cdt.add_constraint(h0, h1);
+    }
+    let orient2 = |a: DVec2, b: DVec2, c: DVec2| {
+        robust::orient2d(
+            robust::Coord { x: a.x, y: a.y },
+            robust::Coord { x: b.x, y: b.y },
+            robust::Coord { x: c.x, y: c.y },
+        )
+    };
+    let flat = |p: Vec3| DVec2::new(p[u] as f64, p[v] as f64);
+    let mut seam = Seam {
+        vertices: cdt.num_vertices(),
+        ..Seam::default()
+    };
+    for f in cdt.inner_faces() {
+        let [a, b, c] = f.vertices().map(|h| to3(h.position()));
+        let mut t = [a, b, c];
+        // Which in-plane scene triangle contains the centroid (strictly)?
+        let g = (flat(a) + flat(b) + flat(c)) / 3.0;
+        let mut source = None;
+        for (s, id) in in_plane {
+            let [p, q, r] = s.map(flat);
+            let o = orient2(p, q, r);
+            let inside = [(p, q), (q, r), (r, p)]
+                .iter()
+                .all(|&(x, y)| orient2(x, y, g) * o > 0.0);
+            if inside {
+                source = Some(*id);
+                // Orient like the scene triangle.
+                if orient2(flat(t[0]), flat(t[1]), flat(t[2])) * o < 0.0 {
+                    t.swap(1, 2);
+                }
+                break;
+            }
+        }
+        seam.triangles.push(t);
+        seam.source.push(source);
+    }
+    Ok(seam)
+}
+
+/// A facet of a half's PLC and what it becomes in the merged mesh.
+#[derive(Clone, Copy, Debug)]
+enum FacetKind {
+    /// A scene-triangle piece (cleaned index).
+    Scene(u32),
+    /// A seam-only face.
+    Seam,
+}
+
+/// One half after TetGen: f32 points, positive tets, constrained faces.
+struct HalfMesh {
+    points: Vec<Vec3>,
+    tets: Vec<[u32; 4]>,
+    /// (vertices, cleaned source) in the half's point indices.
+    constrained: Vec<([u32; 3], u32)>,
+    input_points: usize,
+    input_triangles: usize,
+    peak_kib: Option<u64>,
+}
+
+fn run_half(
+    half: usize,
+    facets: &[([Vec3; 3], FacetKind)],
+    box_faces: &[[Vec3; 3]],
+    options: &SeamOptions,
+) -> Result<HalfMesh, SeamError> {
+    let mut index: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut points: Vec<Vec3> = Vec::new();
+    let mut id = |p: Vec3| {
+        *index.entry(key(p)).or_insert_with(|| {
+            points.push(p);
+            points.len() as u32 - 1
+        })
+    };
+    let mut triangles = Vec::new();
+    let mut markers = Vec::new();
+    for (i, (t, _)) in facets.iter().enumerate() {
+        triangles.push(t.map(&mut id));
+        markers.push(i as i32 + 1);
+    }
+    for t in box_faces {
+        triangles.push(t.map(&mut id));
+        markers.push(0);
+    }
+    let input = TetgenInput {
+        points: points.iter().map(|p| p.as_dvec3().to_array()).collect(),
+        triangles,
+        markers,
+    };
+    let mut topts = options.tetgen.clone();
+    topts.preserve_surface = true;
+    let out = tetrahedralize(&input, &topts, &options.isolation)
+        .map_err(|source| SeamError::Tetgen { half, source })?;
+    if let Some(i) = (0..input.points.len()).find(|&i| out.points.get(i) != Some(&input.points[i])) {
+        return Err(SeamError::InputPointChanged { half, point: i });
+    }
+    // Every facet must be exactly one face with its own vertices.
+    let mut count = vec![0usize; facets.len()];
+    let mut same = vec![false; facets.len()];
+    for (face, &m) in out.faces.iter().zip(&out.face_markers) {
+        if m <= 0 || m as usize > facets.len() {
+            continue;
+        }
+        let f = m as usize - 1;
+        count[f] += 1;
+        same[f] = face_key(*face) == face_key(input.triangles[f]);
+    }
+    if let Some(f) = (0..facets.len()).find(|&f| count[f] != 1 || !same[f]) {
+        return Err(SeamError::FacetNotPreserved {
+            half,
+            facet: f,
+            faces: count[f],
+        });
+    }
+    let p32: Vec<Vec3> = out
+        .points
+        .iter()
+        .map(|p| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32))
+        .collect();
+    let mut tets = Vec::with_capacity(out.tets.len());
+    let mut bad = 0;
+    for &t in &out.tets {
+        let [a, b, c, d] = t.map(|v| DVec3::from_array(out.points[v as usize]));
+        let o = tet_core::predicates::orient3d(a, b, c, d);
+        let t = if o < 0.0 { [t[1], t[0], t[2], t[3]] } else { t };
+        let [a, b, c, d] = t.map(|v| p32[v as usize]);
+        if o == 0.0 || tet_core::predicates::orient3d_f32(a, b, c, d) <= 0.0 {
+            bad += 1;
+        }
+        tets.push(t);
+    }
+    if bad > 0 {
+        return Err(SeamError::RoundingFlattens { half, count: bad });
+    }
+    let constrained = facets
+        .iter()
+        .zip(&input.triangles)
+        .filter_map(|((_, k), &t)| match k {
+            FacetKind::Scene(s) => Some((t, *s)),
+            FacetKind::Seam => None,
+        })
+        .collect();
+    Ok(HalfMesh {
+        points: p32,
+        tets,
+        constrained,
+        input_points: input.points.len(),
+        input_triangles: input.triangles.len(),
+        peak_kib: out.worker_peak_kib,
+    })
+}
+
+/// Vertices off a cut plane by less than this × the box's largest extent
+/// make the plane unusable ([`SeamError::PlaneNearVertex`]): TetGen would
+/// merge crossing points with them (its duplicate tolerance is relative).
+pub const NEAR_PLANE: f64 = 1e-7;
+
+/// The first vertex strictly off the plane but within `tolerance` of it.
+pub fn near_plane_vertex(vertices: &[Vec3], plane: SplitPlane, tolerance: f64) -> Option<u32> {
+    vertices.iter().position(|p| {
+        let d = (p[plane.axis] as f64 - plane.value as f64).abs();
+        d > 0.0 && d < tolerance
+    }).map(|i| i as u32)
+}
+
+/// Builds the mesh of `scene` in its enclosing box as two halves cut by
+/// `plane` with an exact seam, merged (see the module docs). The result
+/// passes [`TetMesh::validate`]; constrained faces carry the *input* scene
+/// triangle ids.
+pub fn build_split_once(
+    scene: &Scene,
+    plane: SplitPlane,
+    options: &SeamOptions,
+) -> Result<(TetMesh, SeamReport), SeamError> {
+    let (cleaned, cm) = clean_scene(scene)?;
+    if cleaned.triangles.is_empty() {
+        return Err(SeamError::EmptyScene);
+    }
+    let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
+    let a = plane.axis;
+    if plane.axis > 2 || !(plane.value > b.min[a] && plane.value < b.max[a]) {
+        return Err(SeamError::PlaneOutsideBox {
+            plane,
+            min: b.min,
+            max: b.max,
+        });
+    }
+    let tolerance = NEAR_PLANE * (b.max - b.min).max_element() as f64;
+    if let Some(v) = near_plane_vertex(&cleaned.vertices, plane, tolerance) {
+        let point = cleaned.vertices[v as usize];
+        return Err(SeamError::PlaneNearVertex {
+            plane,
+            vertex: v,
+            point,
+            distance: (point[a] as f64 - plane.value as f64).abs(),
+        });
+    }
+    let mut report = SeamReport::default();
+    let mut halves: [Vec<([Vec3; 3], FacetKind)>; 2] = [Vec::new(), Vec::new()];
+    let mut segments = Vec::new();
+    let mut seam_points = Vec::new();
+    let mut in_plane = Vec::new();
+    for (i, t) in cleaned.triangles.iter().enumerate() {
+        let tri = t.map(|v| cleaned.vertices[v as usize]);
+        let s = i as u32;
+        let on: Vec<Vec3> = tri.iter().copied().filter(|p| p[a] == plane.value).collect();
+        match plane.classify(tri) {
+            Side::Below | Side::Above => {
+                let h = usize::from(plane.classify(tri) == Side::Above);
+                halves[h].push((tri, FacetKind::Scene(s)));
+                match on.len() {
+                    1 => seam_points.push(on[0]),
+                    2 => segments.push([on[0], on[1]]),
+                    _ => {}
+                }
+            }
+            Side::Cut => {
+                report.triangles_cut += 1;
+                let (lo, hi, seg) = cut_triangle(tri, plane);
+                halves[0].extend(lo.into_iter().map(|p| (p, FacetKind::Scene(s))));
+                halves[1].extend(hi.into_iter().map(|p| (p, FacetKind::Scene(s))));
+                segments.push(seg);
+            }
+            Side::InPlane => {
+                report.triangles_in_plane += 1;
+                in_plane.push((tri, s));
+            }
+        }
+    }
+    // The section rectangle and the two half boxes.
+    let mut below_max = b.max;
+    below_max[a] = plane.value;
+    let mut above_min = b.min;
+    above_min[a] = plane.value;
+    let corners_of = |lo: Vec3, hi: Vec3| -> [Vec3; 8] {
+        std::array::from_fn(|i| {
+            Vec3::new(
+                if i & 1 != 0 { hi.x } else { lo.x },
+                if i & 2 != 0 { hi.y } else { lo.y },
+                if i & 4 != 0 { hi.z } else { lo.z },
+            )
+        })
+    };
+    let below = corners_of(b.min, below_max);
+    let section: Vec<Vec3> = below.iter().copied().filter(|p| p[a] == plane.value).collect();
+    let section: [Vec3; 4] = section.try_into().expect("a box has 4 corners per face");
+    let seam = seam_triangulation(plane, section, &segments, &seam_points, &in_plane)?;
+    report.seam_vertices = seam.vertices;
+    report.seam_triangles = seam.triangles.len();
+    for (t, s) in seam.triangles.iter().zip(&seam.source) {
+        let k = s.map_or(FacetKind::Seam, FacetKind::Scene);
+        halves[0].push((*t, k));
+        halves[1].push((*t, k));
+    }
+    // Box faces: BOX_TRIANGLES pairs are z-min, z-max, y-min, y-max, x-min, x-max.
+    let min_face = [8, 4, 0][a];
+    let max_face = [10, 6, 2][a];
+    let box_faces = |corners: [Vec3; 8], skip: usize| -> Vec<[Vec3; 3]> {
+        BOX_TRIANGLES
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != skip && *i != skip + 1)
+            .map(|(_, t)| t.map(|v| corners[v as usize]))
+            .collect()
+    };
+    let above = corners_of(above_min, b.max);
+    let faces = [box_faces(below, max_face), box_faces(above, min_face)];
+    let mut meshes = Vec::new();
+    for h in 0..2 {
+        meshes.push(run_half(h, &halves[h], &faces[h], options)?);
+    }
+    // Merge: exact point dedup, tets concatenated, constrained faces once each.
+    let mut index: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut points = Vec::new();
+    let mut tets = Vec::new();
+    let mut tris: Vec<([u32; 3], u32)> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    for (h, m) in meshes.iter().enumerate() {
+        let map: Vec<u32> = m
+            .points
+            .iter()
+            .map(|&p| {
+                *index.entry(key(p)).or_insert_with(|| {
+                    points.push(p);
+                    points.len() as u32 - 1
+                })
+            })
+            .collect();
+        tets.extend(m.tets.iter().map(|t| t.map(|v| map[v as usize])));
+        for &(t, s) in &m.constrained {
+            let g = t.map(|v| map[v as usize]);
+            if seen.insert(face_key(g)) {
+                tris.push((g, cm.triangle_source[s as usize]));
+            }
+        }
+        report.half_points[h] = m.input_points;
+        report.half_triangles[h] = m.input_triangles;
+        report.half_tets[h] = m.tets.len();
+        report.half_peak_kib[h] = m.peak_kib;
+    }
+    let mesh = TetMesh::assemble(points, tets, &tris, scene.triangles.len() as u32)?;
+    mesh.validate()?;
+    Ok((mesh, report))
+}

@@ -1,0 +1,338 @@
+//! Recursive split plan (Erkoç et al., seed 003, §3 `CLIP`): while a part's
+//! predicted TetGen memory exceeds the limit, cut it by an axis-aligned
+//! plane through the mean of the axis of largest variance; among nearby
+//! planes prefer the one that cuts the fewest triangles (the paper's future
+//! work).
+//!
+//! Planes are axis-aligned with an `f32` offset, so points computed on the
+//! plane later (seams) have that exact coordinate on the cut axis.
+//!
+//! ## Classification (exact, on f32 coordinates)
+//! A triangle is *below* a plane `x[axis] = value` when one of its vertices
+//! has `x[axis] < value`, *above* when one has `x[axis] > value`, *cut* when
+//! both, and *in the plane* when all three equal `value` (it then belongs to
+//! both halves: it is part of the seam). A triangle touching the plane only
+//! with a vertex or an edge belongs to its own side only.
+//!
+//! ## Size estimate of a part
+//! The part's TetGen input is estimated as: its distinct triangle vertices
+//! + one seam vertex per triangle cut at any ancestor plane bounding it
+//! + 8 box corners; triangles: its triangles + 3 per cut triangle (up to two
+//! pieces on one side, plus about two seam-triangulation triangles per
+//! seam vertex, minus the original) + 12 box triangles. The classification
+//! of deeper parts uses the original triangles' vertices (not the clipped
+//! pieces), so cut counts below the root are upper bounds.
+
+use glam::Vec3;
+
+use super::memory_model::MemoryModel;
+
+/// An axis-aligned cut plane `x[axis] = value`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SplitPlane {
+    /// 0 = x, 1 = y, 2 = z.
+    pub axis: usize,
+    /// Plane offset (f32, so seam points are exactly on it).
+    pub value: f32,
+}
+
+/// Where a triangle lies relative to a plane (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// All vertices at or below, at least one strictly below.
+    Below,
+    /// All vertices at or above, at least one strictly above.
+    Above,
+    /// Vertices strictly on both sides: the plane cuts it.
+    Cut,
+    /// All three vertices on the plane.
+    InPlane,
+}
+
+impl SplitPlane {
+    /// Classifies a triangle (exact comparisons of f32 coordinates).
+    pub fn classify(&self, tri: [Vec3; 3]) -> Side {
+        let below = tri.iter().any(|p| p[self.axis] < self.value);
+        let above = tri.iter().any(|p| p[self.axis] > self.value);
+        match (below, above) {
+            (true, true) => Side::Cut,
+            (true, false) => Side::Below,
+            (false, true) => Side::Above,
+            (false, false) => Side::InPlane,
+        }
+    }
+}
+
+/// The split plan: a binary tree of parts.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SplitTree {
+    /// A part tetrahedralized by one TetGen run.
+    Leaf {
+        /// The part's box `(min, max)`.
+        bounds: (Vec3, Vec3),
+        /// Scene triangles (indices) touching the part.
+        triangles: Vec<u32>,
+        /// Estimated TetGen input points (see the module docs).
+        points_estimate: usize,
+        /// Estimated TetGen input triangles.
+        triangles_estimate: usize,
+        /// Predicted peak memory (bytes, with margin).
+        predicted_bytes: u64,
+    },
+    /// A part cut in two.
+    Split {
+        /// The part's box.
+        bounds: (Vec3, Vec3),
+        /// The cut plane.
+        plane: SplitPlane,
+        /// Triangles of the part the plane cuts.
+        triangles_cut: usize,
+        /// The half with `x[axis] ≤ value`.
+        below: Box<SplitTree>,
+        /// The half with `x[axis] ≥ value`.
+        above: Box<SplitTree>,
+    },
+}
+
+impl SplitTree {
+    /// Number of leaves (TetGen runs).
+    pub fn parts(&self) -> usize {
+        match self {
+            SplitTree::Leaf { .. } => 1,
+            SplitTree::Split { below, above, .. } => below.parts() + above.parts(),
+        }
+    }
+
+    /// Depth (0 for a single leaf).
+    pub fn depth(&self) -> usize {
+        match self {
+            SplitTree::Leaf { .. } => 0,
+            SplitTree::Split { below, above, .. } => 1 + below.depth().max(above.depth()),
+        }
+    }
+
+    /// Triangles cut, summed over all split nodes.
+    pub fn triangles_cut(&self) -> usize {
+        match self {
+            SplitTree::Leaf { .. } => 0,
+            SplitTree::Split {
+                triangles_cut,
+                below,
+                above,
+                ..
+            } => triangles_cut + below.triangles_cut() + above.triangles_cut(),
+        }
+    }
+
+    /// Largest predicted leaf peak (bytes).
+    pub fn max_predicted_bytes(&self) -> u64 {
+        match self {
+            SplitTree::Leaf {
+                predicted_bytes, ..
+            } => *predicted_bytes,
+            SplitTree::Split { below, above, .. } => below
+                .max_predicted_bytes()
+                .max(above.max_predicted_bytes()),
+        }
+    }
+
+    /// The leaves, left (below) first.
+    pub fn leaves(&self) -> Vec<&SplitTree> {
+        match self {
+            SplitTree::Leaf { .. } => vec![self],
+            SplitTree::Split { below, above, .. } => {
+                let mut v = below.leaves();
+                v.extend(above.leaves());
+                v
+            }
+        }
+    }
+}
+
+/// Options of [`plan_split`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SplitOptions {
+    /// Memory limit per TetGen run (bytes).
+    pub limit_bytes: u64,
+    /// The memory model.
+    pub model: MemoryModel,
+    /// Deepest split allowed (a leaf at this depth may exceed the limit).
+    pub max_depth: usize,
+    /// Candidate planes tried on each side of the mean, `search_steps`
+    /// steps of `search_step` × the part's extent on the chosen axis
+    /// (0 = the paper's plane exactly).
+    pub search_steps: u32,
+    /// Step of the plane search, relative to the part's extent.
+    pub search_step: f32,
+    /// Force splitting down to this depth even if the part fits (for tests
+    /// and for parallelism).
+    pub min_depth: usize,
+}
+
+impl Default for SplitOptions {
+    fn default() -> Self {
+        SplitOptions {
+            limit_bytes: u64::MAX,
+            model: MemoryModel::FITTED,
+            max_depth: 16,
+            search_steps: 4,
+            search_step: 1.0 / 64.0,
+            min_depth: 0,
+        }
+    }
+}
+
+/// Chooses the cut plane of a part: the axis of largest variance of the
+/// part's triangle corners (each corner counted once per triangle, clamped
+/// into the part's box), through their mean; then, among the planes `mean ± k·step·extent` (`k ≤ search_steps`)
+/// strictly inside the box, the one cutting the fewest triangles (ties: the
+/// nearest to the mean). Returns the plane and its cut count, or `None`
+/// when no plane lies strictly inside the box (a degenerate part).
+pub fn choose_plane(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    part: &[u32],
+    bounds: (Vec3, Vec3),
+    options: &SplitOptions,
+) -> Option<(SplitPlane, usize)> {
+    let (lo, hi) = bounds;
+    let n = part.len() as f64 * 3.0;
+    let (mut sum, mut sum2) = ([0f64; 3], [0f64; 3]);
+    for &t in part {
+        for &v in &triangles[t as usize] {
+            let p = vertices[v as usize].clamp(lo, hi);
+            for a in 0..3 {
+                let x = p[a] as f64;
+                sum[a] += x;
+                sum2[a] += x * x;
+            }
+        }
+    }
+    // Axis of largest variance; an empty part falls back to the longest box axis.
+    let (axis, mean) = if part.is_empty() {
+        let e = hi - lo;
+        let axis = (0..3).max_by(|&a, &b| e[a].total_cmp(&e[b])).unwrap_or(0);
+        (axis, 0.5 * (lo[axis] as f64 + hi[axis] as f64))
+    } else {
+        let var = |a: usize| sum2[a] / n - (sum[a] / n).powi(2);
+        let axis = (0..3).max_by(|&a, &b| var(a).total_cmp(&var(b))).unwrap_or(0);
+        (axis, sum[axis] / n)
+    };
+    let extent = (hi[axis] - lo[axis]) as f64;
+    let mut best: Option<(SplitPlane, usize, f64)> = None;
+    let steps = options.search_steps as i64;
+    for k in -steps..=steps {
+        let target = mean + k as f64 * options.search_step as f64 * extent;
+        let value = target as f32;
+        if !(value > lo[axis] && value < hi[axis]) {
+            continue;
+        }
+        let plane = SplitPlane { axis, value };
+        let cut = part
+            .iter()
+            .filter(|&&t| {
+                let tri = triangles[t as usize].map(|v| vertices[v as usize]);
+                plane.classify(tri) == Side::Cut
+            })
+            .count();
+        let dist = (value as f64 - mean).abs();
+        let better = match best {
+            None => true,
+            Some((_, c, d)) => cut < c || (cut == c && dist < d),
+        };
+        if better {
+            best = Some((plane, cut, dist));
+        }
+    }
+    best.map(|(p, c, _)| (p, c))
+}
+
+/// Plans the recursive split of the scene triangles inside `bounds` (the
+/// enclosing box of the whole build) under `options.limit_bytes`.
+pub fn plan_split(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    bounds: (Vec3, Vec3),
+    options: &SplitOptions,
+) -> SplitTree {
+    let part: Vec<u32> = (0..triangles.len() as u32).collect();
+    plan_part(vertices, triangles, part, 0, bounds, 0, options)
+}
+
+fn plan_part(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    part: Vec<u32>,
+    seam_vertices: usize,
+    bounds: (Vec3, Vec3),
+    depth: usize,
+    options: &SplitOptions,
+) -> SplitTree {
+    let mut used: Vec<u32> = part
+        .iter()
+        .flat_map(|&t| triangles[t as usize])
+        .collect();
+    used.sort_unstable();
+    used.dedup();
+    let points_estimate = used.len() + seam_vertices + 8;
+    let triangles_estimate = part.len() + 3 * seam_vertices + 12;
+    let predicted_bytes = options
+        .model
+        .predict(points_estimate, triangles_estimate);
+    let wants_split = depth < options.min_depth
+        || (predicted_bytes > options.limit_bytes && depth < options.max_depth);
+    let leaf = |part: Vec<u32>| SplitTree::Leaf {
+        bounds,
+        triangles: part,
+        points_estimate,
+        triangles_estimate,
+        predicted_bytes,
+    };
+    if !wants_split {
+        return leaf(part);
+    }
+    let Some((plane, cut)) = choose_plane(vertices, triangles, &part, bounds, options) else {
+        return leaf(part);
+    };
+    let (mut below, mut above) = (Vec::new(), Vec::new());
+    for &t in &part {
+        let tri = triangles[t as usize].map(|v| vertices[v as usize]);
+        match plane.classify(tri) {
+            Side::Below => below.push(t),
+            Side::Above => above.push(t),
+            Side::Cut | Side::InPlane => {
+                below.push(t);
+                above.push(t);
+            }
+        }
+    }
+    let (lo, hi) = bounds;
+    let mut mid_hi = hi;
+    mid_hi[plane.axis] = plane.value;
+    let mut mid_lo = lo;
+    mid_lo[plane.axis] = plane.value;
+    let seam = seam_vertices + cut;
+    SplitTree::Split {
+        bounds,
+        plane,
+        triangles_cut: cut,
+        below: Box::new(plan_part(
+            vertices,
+            triangles,
+            below,
+            seam,
+            (lo, mid_hi),
+            depth + 1,
+            options,
+        )),
+        above: Box::new(plan_part(
+            vertices,
+            triangles,
+            above,
+            seam,
+            (mid_lo, hi),
+            depth + 1,
+            options,
+        )),
+    }
+}

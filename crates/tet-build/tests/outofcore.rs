@@ -1,0 +1,424 @@
+//! Out-of-core construction (issue 8): memory model and split plan.
+
+#![cfg(feature = "tetgen")]
+
+use std::time::Duration;
+
+use glam::Vec3;
+use tet_build::outofcore::memory_model::{
+    MemoryModel, MemorySample, knot_grid, measure_peak_memory, measurement_scenes,
+    predict_peak_memory,
+};
+use tet_build::outofcore::split::{Side, SplitOptions, SplitPlane, SplitTree, plan_split};
+use tet_build::tetgen::{Isolation, WorkerCommand};
+
+fn worker() -> Isolation {
+    Isolation::Worker(WorkerCommand {
+        program: env!("CARGO_BIN_EXE_tet-build-worker").into(),
+        args: vec![],
+        timeout: Some(Duration::from_secs(600)),
+    })
+}
+
+/// Measures TetGen's peak on the measurement scenes and prints the fit
+/// (copy the constants into `MemoryModel::FITTED`). Run in release:
+/// `cargo test -p tet-build --release --test outofcore -- --ignored --nocapture measure_memory_model`.
+#[test]
+#[ignore]
+fn measure_memory_model() {
+    let samples = measure_peak_memory(&measurement_scenes(), &worker()).unwrap();
+    for s in &samples {
+        println!(
+            "| {} | {} | {} | {:.1} | {:.2} |",
+            s.points,
+            s.triangles,
+            s.tets,
+            s.peak_bytes as f64 / (1024.0 * 1024.0),
+            s.seconds
+        );
+    }
+    let m = MemoryModel::fit(&samples).unwrap();
+    println!("{m:?}");
+    for s in &samples {
+        let p = MemoryModel::FITTED.predict(s.points, s.triangles);
+        println!(
+            "FITTED predicts {:.1} MiB for measured {:.1} MiB",
+            p as f64 / 1048576.0,
+            s.peak_bytes as f64 / 1048576.0
+        );
+    }
+}
+
+/// The fitted model never under-predicts a fresh measurement (a scene not in
+/// the fitting set), and is not absurdly pessimistic (< 3×).
+#[test]
+fn prediction_bounds_a_measured_peak() {
+    let scene = knot_grid(1, 200, 16);
+    let s = measure_peak_memory(std::slice::from_ref(&scene), &worker()).unwrap()[0];
+    let p = predict_peak_memory(s.points, s.triangles);
+    assert!(s.peak_bytes > 0);
+    assert!(
+        p >= s.peak_bytes && p < 3 * s.peak_bytes,
+        "predicted {p} measured {}",
+        s.peak_bytes
+    );
+}
+
+#[test]
+fn fit_recovers_an_exact_line_and_margin_covers_residuals() {
+    let sample = |x: usize, y: u64| MemorySample {
+        points: x,
+        triangles: 0,
+        tets: 0,
+        peak_bytes: y,
+        seconds: 0.0,
+    };
+    // y = 1000 + 3x exactly.
+    let exact: Vec<_> = [10, 20, 40].iter().map(|&x| sample(x, 1000 + 3 * x as u64)).collect();
+    let m = MemoryModel::fit(&exact).unwrap();
+    assert!((m.base_bytes - 1000.0).abs() < 1e-6);
+    assert!((m.bytes_per_element - 3.0).abs() < 1e-9);
+    assert!((m.margin - 1.1).abs() < 1e-9);
+    // With noise, every sample is under the prediction.
+    let noisy = vec![sample(10, 1100), sample(20, 1000), sample(40, 1200), sample(80, 1250)];
+    let m = MemoryModel::fit(&noisy).unwrap();
+    for s in &noisy {
+        assert!(m.predict(s.points, s.triangles) >= s.peak_bytes);
+    }
+    assert!(MemoryModel::fit(&[sample(10, 5)]).is_none());
+    assert!(MemoryModel::fit(&[sample(10, 5), sample(10, 6)]).is_none());
+}
+
+#[test]
+fn classification_is_exact_on_the_plane() {
+    let p = SplitPlane { axis: 0, value: 1.0 };
+    let t = |a: f32, b: f32, c: f32| [Vec3::new(a, 0.0, 0.0), Vec3::new(b, 1.0, 0.0), Vec3::new(c, 0.0, 1.0)];
+    assert_eq!(p.classify(t(0.0, 2.0, 1.0)), Side::Cut);
+    assert_eq!(p.classify(t(0.0, 1.0, 1.0)), Side::Below); // edge on the plane
+    assert_eq!(p.classify(t(1.0, 2.0, 1.0)), Side::Above);
+    assert_eq!(p.classify(t(1.0, 1.0, 1.0)), Side::InPlane);
+    let next = 1.0f32.next_up();
+    assert_eq!(p.classify(t(1.0, next, 1.0)), Side::Above);
+    assert_eq!(p.classify(t(1.0f32.next_down(), next, 1.0)), Side::Cut);
+}
+
+/// Two rows of cubes: brute-force cut counts of every candidate plane agree
+/// with the chosen plane being the best among them, and the plane prefers
+/// a gap between cubes to the mean when the mean cuts cubes.
+#[test]
+fn plane_search_prefers_fewer_cuts() {
+    // 3 unit cubes at x = 0, 1.5, 3 (gaps 0.5), so the mean x (2.0) lies
+    // inside the middle cube.
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for i in 0..3 {
+        let m = tet_build::procedural::box_mesh(
+            Vec3::new(1.5 * i as f32, 0.0, 0.0),
+            Vec3::new(1.5 * i as f32 + 1.0, 1.0, 1.0),
+        );
+        let flat = m.flatten(false, false);
+        let base = vertices.len() as u32;
+        vertices.extend(flat.positions.iter().copied());
+        triangles.extend(flat.triangles.iter().map(|t| t.map(|v| v + base)));
+    }
+    let bounds = (Vec3::splat(-1.0), Vec3::new(5.0, 2.0, 2.0));
+    // Mean over triangle corners (each corner once per triangle).
+    let mean = triangles
+        .iter()
+        .flatten()
+        .map(|&v| vertices[v as usize].x as f64)
+        .sum::<f64>()
+        / (3 * triangles.len()) as f64;
+    assert_eq!(mean, 2.0);
+    let cuts_at = |x: f32| {
+        let p = SplitPlane { axis: 0, value: x };
+        triangles
+            .iter()
+            .filter(|t| p.classify(t.map(|v: u32| vertices[v as usize])) == Side::Cut)
+            .count()
+    };
+    assert!(cuts_at(mean as f32) > 0);
+    let opts = SplitOptions {
+        min_depth: 1,
+        max_depth: 1,
+        search_steps: 8,
+        search_step: 1.0 / 32.0,
+        ..SplitOptions::default()
+    };
+    let tree = plan_split(&vertices, &triangles, bounds, &opts);
+    let SplitTree::Split { plane, triangles_cut, .. } = &tree else {
+        panic!("expected a split");
+    };
+    assert_eq!(plane.axis, 0);
+    assert_eq!(*triangles_cut, cuts_at(plane.value));
+    // The best of the candidates (brute force over the same candidate set).
+    let extent = 6.0f64;
+    let best = (-8..=8)
+        .map(|k| cuts_at((mean + k as f64 / 32.0 * extent) as f32))
+        .min()
+        .unwrap();
+    assert_eq!(*triangles_cut, best);
+    assert_eq!(best, 0, "a gap lies within the search window");
+    // The paper's rule alone (no search) cuts at the mean.
+    let paper = plan_split(
+        &vertices,
+        &triangles,
+        bounds,
+        &SplitOptions { search_steps: 0, ..opts },
+    );
+    let SplitTree::Split { plane, triangles_cut, .. } = paper else {
+        panic!("expected a split");
+    };
+    assert_eq!(plane.value, mean as f32);
+    assert_eq!(triangles_cut, cuts_at(mean as f32));
+}
+
+/// The split recurses until every leaf's prediction fits, the leaves cover
+/// every triangle, and halving the limit never gives fewer parts.
+#[test]
+fn split_recurses_until_parts_fit() {
+    let scene = knot_grid(2, 60, 8);
+    let (lo, hi) = scene.bounds().unwrap();
+    let bounds = (lo - Vec3::ONE, hi + Vec3::ONE);
+    let whole = predict_peak_memory(scene.vertices.len() + 8, scene.triangles.len() + 12);
+    let mut last_parts = 1;
+    for div in [1u64, 2, 4] {
+        let limit = whole / div + 1;
+        let opts = SplitOptions { limit_bytes: limit, ..SplitOptions::default() };
+        let tree = plan_split(&scene.vertices, &scene.triangles, bounds, &opts);
+        assert!(tree.max_predicted_bytes() <= limit, "div {div}");
+        assert!(tree.parts() >= last_parts);
+        last_parts = tree.parts();
+        if div == 1 {
+            assert_eq!(tree.parts(), 1);
+        } else {
+            assert!(tree.parts() >= 2);
+        }
+        let mut seen = vec![false; scene.triangles.len()];
+        for leaf in tree.leaves() {
+            let SplitTree::Leaf { triangles, bounds: (a, b), .. } = leaf else { unreachable!() };
+            for &t in triangles {
+                seen[t as usize] = true;
+                // Every triangle of a leaf touches its box.
+                let tri = scene.triangles[t as usize].map(|v| scene.vertices[v as usize]);
+                let (tlo, thi) = (tri[0].min(tri[1]).min(tri[2]), tri[0].max(tri[1]).max(tri[2]));
+                assert!(tlo.cmple(*b).all() && thi.cmpge(*a).all());
+            }
+        }
+        assert!(seen.iter().all(|&s| s));
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Exact seams (one plane, two halves, merge).
+
+use glam::DVec3;
+use tet_build::bbox::BoxSpec;
+use tet_build::outofcore::seam::{SeamOptions, build_split_once, crossing_point, cut_triangle};
+use tet_build::pipeline::{BuildOptions, build};
+use tet_build::scene::Scene;
+use tet_core::TetMesh;
+
+fn single(name: &str, mesh: tet_build::scene::MeshData) -> Scene {
+    Scene::from_objects(
+        name,
+        &[tet_build::scene::ObjectPlacement {
+            name: name.into(),
+            mesh: &mesh,
+            transform: tet_build::scene::Transform::IDENTITY,
+            pre_transform: None,
+        }],
+        None,
+        Vec::new(),
+    )
+    .unwrap()
+}
+
+fn in_core(scene: &Scene) -> TetMesh {
+    let options = BuildOptions {
+        enclosing_box: Some(BoxSpec::default()),
+        ..BuildOptions::default()
+    };
+    build(scene, &options).unwrap().0
+}
+
+/// Sum of tet volumes in f64 (exact orientations of the f32 points).
+fn volume(mesh: &TetMesh) -> f64 {
+    mesh.tets
+        .iter()
+        .map(|t| {
+            let [a, b, c, d] = t.map(|v| mesh.points[v as usize].as_dvec3());
+            (b - a).cross(c - a).dot(d - a) / 6.0
+        })
+        .sum()
+}
+
+fn area(p: [DVec3; 3]) -> f64 {
+    0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()
+}
+
+/// Nearest constrained face hit by a ray (brute force over all faces, f64
+/// Möller–Trumbore): (distance, triangle id, smallest barycentric of the hit).
+fn first_hit(mesh: &TetMesh, o: DVec3, d: DVec3) -> Option<(f64, u32, f64)> {
+    let mut best: Option<(f64, u32, f64)> = None;
+    for f in &mesh.constrained {
+        let [a, b, c] = f.vertices.map(|v| mesh.points[v as usize].as_dvec3());
+        let (e1, e2) = (b - a, c - a);
+        let p = d.cross(e2);
+        let det = e1.dot(p);
+        if det.abs() < 1e-300 {
+            continue;
+        }
+        let s = o - a;
+        let u = s.dot(p) / det;
+        let q = s.cross(e1);
+        let v = d.dot(q) / det;
+        let t = e2.dot(q) / det;
+        if u < 0.0 || v < 0.0 || u + v > 1.0 || t <= 0.0 {
+            continue;
+        }
+        if best.is_none_or(|(bt, _, _)| t < bt) {
+            best = Some((t, f.triangle, u.min(v).min(1.0 - u - v)));
+        }
+    }
+    best
+}
+
+/// The checks of issue 8 against the in-core mesh: valid, same volume,
+/// every scene triangle's faces sum to its area, same first hits.
+fn check_against_in_core(scene: &Scene, merged: &TetMesh) {
+    merged.validate().unwrap();
+    let reference = in_core(scene);
+    let (vm, vr) = (volume(merged), volume(&reference));
+    assert!(((vm - vr) / vr).abs() < 1e-9, "volume {vm} vs in-core {vr}");
+    // Areas per scene triangle.
+    let mut sum = vec![0.0f64; scene.triangles.len()];
+    for f in &merged.constrained {
+        sum[f.triangle as usize] += area(f.vertices.map(|v| merged.points[v as usize].as_dvec3()));
+    }
+    for (i, t) in scene.triangles.iter().enumerate() {
+        let a = area(t.map(|v| scene.vertices[v as usize].as_dvec3()));
+        assert!(
+            ((sum[i] - a) / a).abs() < 1e-5,
+            "triangle {i}: faces sum to {} vs area {a}",
+            sum[i]
+        );
+    }
+    // Rays from a fixed pseudo-random set of origins and directions.
+    let (lo, hi) = scene.bounds().unwrap();
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    let mut rnd = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut compared, mut grazing) = (0, 0);
+    for _ in 0..300 {
+        let o = lo + (hi - lo) * DVec3::new(rnd(), rnd(), rnd());
+        let d = DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize();
+        let r = first_hit(&reference, o, d);
+        let m = first_hit(merged, o, d);
+        match (r, m) {
+            (Some((tr, ir, br)), Some((tm, im, _))) => {
+                // Grazing: the reference hit is within 1e-5 (barycentric)
+                // of its triangle's boundary, where rounded cut points
+                // may move the hit to the neighbour.
+                if br < 1e-5 {
+                    grazing += 1;
+                    continue;
+                }
+                assert_eq!(ir, im, "ray {o} {d}: in-core {ir} at {tr}, merged {im} at {tm}");
+                assert!((tr - tm).abs() <= 1e-5 * tr.max(1.0));
+                compared += 1;
+            }
+            (None, None) => compared += 1,
+            (r, m) => panic!("ray {o} {d}: in-core {r:?}, merged {m:?}"),
+        }
+    }
+    assert!(compared > 250, "{compared} compared, {grazing} grazing");
+}
+
+#[test]
+fn crossing_points_are_symmetric_and_on_the_plane() {
+    let plane = SplitPlane { axis: 1, value: 0.3 };
+    let p = Vec3::new(0.1, -1.0, 2.0);
+    let q = Vec3::new(0.7, 1.7, -0.3);
+    let x = crossing_point(p, q, plane);
+    assert_eq!(x.to_array(), crossing_point(q, p, plane).to_array());
+    assert_eq!(x.y, 0.3);
+    // Within one f32 ulp-ish of the exact f64 crossing.
+    let t = (0.3f32 as f64 - p.y as f64) / (q.y as f64 - p.y as f64);
+    let exact = p.as_dvec3() + t * (q.as_dvec3() - p.as_dvec3());
+    assert!((x.as_dvec3() - exact).abs().max_element() < 1e-6);
+    // A cut triangle: pieces keep the source normal direction and the
+    // segment joins the two crossing points.
+    let tri = [p, q, Vec3::new(-0.5, 2.0, 0.0)];
+    let (lo, hi, seg) = cut_triangle(tri, plane);
+    assert_eq!((lo.len(), hi.len()), (1, 2));
+    let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]).as_dvec3();
+    for piece in lo.iter().chain(&hi) {
+        let m = (piece[1] - piece[0]).cross(piece[2] - piece[0]).as_dvec3();
+        assert!(m.dot(n) > 0.0);
+    }
+    assert!(seg.iter().all(|s| s.y == 0.3));
+    let pieces: f64 = lo.iter().chain(&hi).map(|t| area(t.map(|v| v.as_dvec3()))).sum();
+    let whole = area(tri.map(|v| v.as_dvec3()));
+    assert!(((pieces - whole) / whole).abs() < 1e-6);
+}
+
+/// A torus knot cut through its middle (many cut triangles).
+#[test]
+fn torus_knot_split_once_matches_in_core() {
+    let scene = knot_grid(1, 120, 12);
+    for (axis, value) in [(0, 0.1f32), (1, 0.05), (2, -0.37)] {
+        let plane = SplitPlane { axis, value };
+        let (mesh, report) = build_split_once(&scene, plane, &SeamOptions::default()).unwrap();
+        assert!(report.triangles_cut > 10, "{report:?}");
+        check_against_in_core(&scene, &mesh);
+    }
+}
+
+/// A plane 7e-16 away from a knot vertex (y = 0; the vertex has y =
+/// −7.1e-16) is refused with a typed error naming the vertex.
+#[test]
+fn plane_grazing_a_vertex_is_refused() {
+    let scene = knot_grid(1, 120, 12);
+    let r = build_split_once(&scene, SplitPlane { axis: 1, value: 0.0 }, &SeamOptions::default());
+    match r {
+        Err(tet_build::outofcore::seam::SeamError::PlaneNearVertex { vertex, .. }) => {
+            assert!(scene.vertices[vertex as usize].y.abs() < 1e-14);
+        }
+        other => panic!("expected PlaneNearVertex, got {:?}", other.map(|x| x.1)),
+    }
+}
+
+/// Plane x = 0 passes exactly through icosphere vertices (and edges).
+#[test]
+fn cut_through_vertices_exactly() {
+    let scene = single("sphere", tet_build::procedural::icosphere(1));
+    let on = scene.vertices.iter().filter(|v| v.x == 0.0).count();
+    assert!(on >= 4, "{on} vertices on the plane");
+    let plane = SplitPlane { axis: 0, value: 0.0 };
+    let (mesh, report) = build_split_once(&scene, plane, &SeamOptions::default()).unwrap();
+    assert!(report.triangles_cut > 0);
+    check_against_in_core(&scene, &mesh);
+}
+
+/// The plane x = 1 contains a face of the cube [-1, 1]³: its two triangles
+/// become seam triangles carrying their scene ids; y = 0 cuts the cube.
+#[test]
+fn plane_on_a_scene_face_and_through_a_cube() {
+    let scene = single("cube", tet_build::procedural::cube(1.0));
+    let (mesh, report) =
+        build_split_once(&scene, SplitPlane { axis: 0, value: 1.0 }, &SeamOptions::default())
+            .unwrap();
+    assert_eq!((report.triangles_cut, report.triangles_in_plane), (0, 2));
+    check_against_in_core(&scene, &mesh);
+    let (mesh, report) =
+        build_split_once(&scene, SplitPlane { axis: 1, value: 0.0 }, &SeamOptions::default())
+            .unwrap();
+    assert_eq!((report.triangles_cut, report.triangles_in_plane), (8, 0));
+    check_against_in_core(&scene, &mesh);
+}
