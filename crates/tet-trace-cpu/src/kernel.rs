@@ -76,23 +76,6 @@ impl<L: Topology, P: Projection> Tracer for WalkTracer<'_, L, P> {
         trace::<P, L>(self.mesh, &self.layout, ray, start, self.cap)
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
-        static K: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-        let k = *K.get_or_init(|| {
-            if std::env::var_os("TT_NOPF").is_some() {
-                crate::walk::PF.store(false, std::sync::atomic::Ordering::Relaxed);
-            }
-            std::env::var("TT_K").ok().and_then(|v| v.parse().ok()).unwrap_or(LANES)
-        });
-        match k {
-            1 => {
-                for (r, o) in rays.iter().zip(out.iter_mut()) {
-                    *o = self.trace(r, start);
-                }
-            }
-            2 => trace_interleaved::<P, L, 2>(self.mesh, &self.layout, rays, start, self.cap, out),
-            4 => trace_interleaved::<P, L, 4>(self.mesh, &self.layout, rays, start, self.cap, out),
-            16 => trace_interleaved::<P, L, 16>(self.mesh, &self.layout, rays, start, self.cap, out),
-            _ => trace_interleaved::<P, L, LANES>(self.mesh, &self.layout, rays, start, self.cap, out),
-        }
+        trace_interleaved::<P, L, LANES>(self.mesh, &self.layout, rays, start, self.cap, out)
     }
 }

@@ -99,6 +99,15 @@ pub trait Projection: Copy + Send + Sync {
 /// the three `left` calls of Algorithm 1, as written.
 macro_rules! array_face {
     ($P:ty) => {
+        array_face!($P, no_mask);
+        #[inline(always)]
+        fn left_mask(&self, pd: $P, d: u32, f: &[$P; 3], ids: &[u32; 3]) -> usize {
+            self.left(pd, d, f[0], ids[0]) as usize
+                | (self.left(pd, d, f[1], ids[1]) as usize) << 1
+                | (self.left(pd, d, f[2], ids[2]) as usize) << 2
+        }
+    };
+    ($P:ty, no_mask) => {
         type Face = [$P; 3];
         #[inline(always)]
         fn face(p: [$P; 3]) -> [$P; 3] {
@@ -107,12 +116,6 @@ macro_rules! array_face {
         #[inline(always)]
         fn set_point(face: &mut [$P; 3], slot: usize, p: $P) {
             face[slot] = p;
-        }
-        #[inline(always)]
-        fn left_mask(&self, pd: $P, d: u32, f: &[$P; 3], ids: &[u32; 3]) -> usize {
-            self.left(pd, d, f[0], ids[0]) as usize
-                | (self.left(pd, d, f[1], ids[1]) as usize) << 1
-                | (self.left(pd, d, f[2], ids[2]) as usize) << 2
         }
     };
 }
@@ -360,9 +363,31 @@ pub struct TripleF32 {
     v: Vec3,
 }
 
+impl TripleF32 {
+    #[cold]
+    #[inline(never)]
+    fn left_mask_ties(&self, pd: Vec3, d: u32, f: &[Vec3; 3], ids: &[u32; 3]) -> usize {
+        self.left(pd, d, f[0], ids[0]) as usize
+            | (self.left(pd, d, f[1], ids[1]) as usize) << 1
+            | (self.left(pd, d, f[2], ids[2]) as usize) << 2
+    }
+}
+
 impl Projection for TripleF32 {
     type P = Vec3;
-    array_face!(Vec3);
+    array_face!(Vec3, no_mask);
+    /// The three triple products first, branch-free; the tie rule of
+    /// [`TripleF32::left`] only when one of them is zero (same products, so
+    /// the same bits as three `left` calls).
+    #[inline(always)]
+    fn left_mask(&self, pd: Vec3, d: u32, f: &[Vec3; 3], ids: &[u32; 3]) -> usize {
+        let s = f.map(|p| self.d.dot(pd.cross(p)));
+        if (s[0] != 0.0) & (s[1] != 0.0) & (s[2] != 0.0) {
+            (s[0] > 0.0) as usize | ((s[1] > 0.0) as usize) << 1 | ((s[2] > 0.0) as usize) << 2
+        } else {
+            self.left_mask_ties(pd, d, f, ids)
+        }
+    }
     const NAME: &'static str = "f32-stp";
     fn setup(ray: &Ray) -> Self {
         let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
@@ -615,8 +640,7 @@ pub fn trace<P: Projection, T: Topology>(
 /// each round advances every lane by one tet, so the CPU overlaps the
 /// dependent load → project → decide → load chains of independent rays
 /// (memory-level parallelism without SIMD). Each step prefetches the record
-/// of the lane's next tet, which that lane reads a round later; each round
-/// starts with a pass that prefetches every lane's new vertex.
+/// of the lane's next tet, which that lane reads a round later.
 /// Results are identical to [`trace`] ray by ray (same [`advance`] and
 /// `finish_step`). `out.len()` must equal `rays.len()`.
 pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
@@ -641,12 +665,6 @@ pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
         }
     }
     while !lanes.is_empty() {
-        if std::env::var_os("TT_PF2").is_some() {
-            for (_, lane) in lanes.iter() {
-                let ids = lane.st.ids;
-                prefetch_index(points, ids[0] ^ ids[1] ^ ids[2] ^ topo.vx(lane.next));
-            }
-        }
         let mut j = 0;
         while j < lanes.len() {
             let adv = advance(points, topo, &mut lanes[j].1, cap);
@@ -916,17 +934,16 @@ pub(crate) fn advance<P: Projection, T: Topology>(
     // variable-indexed store is one instruction per array.
     st.ids[slot] = d;
     P::set_point(&mut st.p, slot, pd);
-    st.tet = next;
-    st.link = raw;
     st.visited += 1;
     if raw < Link::BOUNDARY.0 {
-        if PF.load(std::sync::atomic::Ordering::Relaxed) {
-            topo.prefetch(raw);
-        }
+        topo.prefetch(raw);
         lane.entry_raw = next;
         lane.next = raw;
         Advance::Go
     } else {
+        // `tet` and `link` are read only when resolving a face.
+        st.tet = next;
+        st.link = raw;
         Advance::Face
     }
 }
@@ -1054,5 +1071,3 @@ mod tests {
     }
 }
 
-/// TEMP experiment switch.
-pub static PF: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);

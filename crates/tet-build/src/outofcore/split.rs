@@ -15,13 +15,14 @@
 //! with a vertex or an edge belongs to its own side only.
 //!
 //! ## Size estimate of a part
-//! The part's TetGen input is estimated as: its distinct triangle vertices
-//! + one seam vertex per triangle cut at any ancestor plane bounding it
-//! + 8 box corners; triangles: its triangles + 3 per cut triangle (up to two
-//! pieces on one side, plus about two seam-triangulation triangles per
-//! seam vertex, minus the original) + 12 box triangles. The classification
-//! of deeper parts uses the original triangles' vertices (not the clipped
-//! pieces), so cut counts below the root are upper bounds.
+//! The part's TetGen input is estimated as follows. Points: its distinct
+//! triangle vertices, plus one seam vertex per triangle cut at any ancestor
+//! plane, plus 8 box corners. Triangles: its triangles, plus 3 per cut
+//! triangle (up to two pieces on one side and about two seam-triangulation
+//! triangles per seam vertex, minus the original), plus 12 box triangles.
+//! Every ancestor's seam is counted whole, and deeper parts are classified
+//! by the original triangles' vertices (not the clipped pieces), so the
+//! estimates and cut counts below the root are upper bounds.
 
 use glam::Vec3;
 
