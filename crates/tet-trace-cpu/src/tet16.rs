@@ -26,9 +26,11 @@ impl Topology for Tet16Mesh {
     }
     #[inline(always)]
     fn exit_link(&self, tet: u32, f: [u32; 3], d: u32, exiting: u32, entry: u32) -> u32 {
-        let nx = self.tets[tet as usize].nx4();
+        let nx = &self.tets[tet as usize].nx;
         let ids = [f[0], f[1], f[2], d];
-        entry ^ nx[rank_of(d, ids) & 3] ^ nx[rank_of(exiting, ids) & 3]
+        // `NX_3 = 0` (Tet16::nx4) as a select: no stack array to index.
+        let pick = |rank: usize| if rank < 3 { nx[rank] } else { 0 };
+        entry ^ pick(rank_of(d, ids)) ^ pick(rank_of(exiting, ids))
     }
 }
 
