@@ -269,7 +269,10 @@ fn bad_scenes_are_typed_errors() {
     match build(&crossing, &isolated) {
         Err(BuildError::SelfIntersections { pairs, total }) => {
             assert!(total >= 1 && total == pairs.len());
-            assert!(pairs.iter().all(|p| p.first < 4 && p.second == 4), "{pairs:?}");
+            assert!(
+                pairs.iter().all(|p| p.first < 4 && p.second == 4),
+                "{pairs:?}"
+            );
         }
         other => panic!("expected SelfIntersections, got {other:?}"),
     }

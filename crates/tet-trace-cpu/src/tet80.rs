@@ -26,7 +26,7 @@ use tet_core::{FACE_VERTICES, NO_TET, TetMesh};
 
 use crate::kernel::Tracer;
 use crate::ray::{Failure, Hit, Ray, TraceOutcome};
-use crate::walk::{Start, TripleF32, face_hit, start_exit_face, step_cap};
+use crate::walk::{Start, TripleF32, degenerate_crossing, face_hit, start_exit_face, step_cap};
 
 /// `EXIT[e][2·s₁ + s₂]`: the exit face of a tet entered through face `e`,
 /// from the sign `s₁` of the side product with edge `V_e → A` and the sign
@@ -136,11 +136,18 @@ impl<'m> Tet80Tracer<'m> {
                         tets_visited: visited,
                     });
                 }
+                let barycentrics = w.map(|x| x as f32);
+                if degenerate_crossing(t, &barycentrics) {
+                    return Err(TraceOutcome::Failed {
+                        failure: Failure::Lost,
+                        tets_visited: visited,
+                    });
+                }
                 return Err(TraceOutcome::Hit(Hit {
                     triangle: cf.triangle,
                     face: f.occlusion,
                     t: t as f32,
-                    barycentrics: w.map(|x| x as f32),
+                    barycentrics,
                     tet,
                     far_tet: f.neighbor_tet().unwrap_or(NO_TET),
                     tets_visited: visited,

@@ -865,6 +865,12 @@ fn resolve_face<P: Projection>(mesh: &TetMesh, ray: &Ray, st: &State<P>, link: L
         let j = st.ids.iter().position(|&x| x == vk).unwrap_or(k);
         bary[k] = w[j] as f32;
     }
+    if degenerate_crossing(t, &bary) {
+        return Resolved::Done(TraceOutcome::Failed {
+            failure: Failure::Lost,
+            tets_visited: st.visited,
+        });
+    }
     let far = cf.other_side(st.tet).map_or(NO_TET, |s| s.tet);
     Resolved::Done(TraceOutcome::Hit(Hit {
         triangle: cf.triangle,
@@ -875,6 +881,14 @@ fn resolve_face<P: Projection>(mesh: &TetMesh, ray: &Ray, st: &State<P>, link: L
         far_tet: far,
         tets_visited: st.visited,
     }))
+}
+
+/// True when a crossing's hit record would hold infinities: the ray runs
+/// (numerically) inside the face's plane, e.g. a direction mixing subnormal
+/// and ordinary components. Kernels report such a walk as
+/// [`Failure::Lost`] instead of returning a meaningless hit.
+pub(crate) fn degenerate_crossing(t: f64, bary: &[f32; 3]) -> bool {
+    !(t as f32).is_finite() || bary.iter().any(|b| !b.is_finite())
 }
 
 /// Ray parameter and barycentrics (w.r.t. `ids`) of the line's crossing with

@@ -128,7 +128,11 @@ impl MemoryModel {
         }
         let mx = xs.iter().zip(&ws).map(|(x, w)| w * x).sum::<f64>() / sw;
         let my = ys.iter().zip(&ws).map(|(y, w)| w * y).sum::<f64>() / sw;
-        let sxx: f64 = xs.iter().zip(&ws).map(|(x, w)| w * (x - mx) * (x - mx)).sum();
+        let sxx: f64 = xs
+            .iter()
+            .zip(&ws)
+            .map(|(x, w)| w * (x - mx) * (x - mx))
+            .sum();
         let sxy: f64 = (0..xs.len())
             .map(|i| ws[i] * (xs[i] - mx) * (ys[i] - my))
             .sum();

@@ -1,9 +1,10 @@
-//! Exact seams: one cut plane, both halves tetrahedralized separately, and a
-//! merge by exact vertex triples (issue 8, item 3; replaces the paper's
+//! Exact seams: parallel cut planes, every slab tetrahedralized separately,
+//! and a merge by exact vertex triples (issue 8, item 3; replaces the paper's
 //! `CLIP`/`MERGE` with its vertex/edge repairs and centroid hashing, seed
 //! 003 §3.2–3.3).
 //!
-//! 1. **Cut** ([`cut_triangle`]): a scene triangle crossing the plane
+//! 1. **Cut** ([`clip_polygon`], [`cut_triangle`]): a scene triangle
+//!    (or the part of it left above the previous planes) crossing the plane
 //!    `x[axis] = value` is clipped into a polygon per side (source winding
 //!    kept) and fanned into triangles. The crossing point of an edge is
 //!    computed in f64 from the edge's endpoints in a canonical order (so the
@@ -17,13 +18,14 @@
 //!    scene vertex on the plane as constraints. Its triangles lying inside a
 //!    scene triangle that lies in the plane carry that triangle; the others
 //!    are seam-only faces.
-//! 3. **Halves**: each half's PLC is its pieces + all seam triangles + the
-//!    other five faces of its half box; every facet has its own marker, and
+//! 3. **Slabs**: each slab's PLC is its pieces + all triangles of the
+//!    seams bounding it + the other faces of its slab box; every facet has its own marker, and
 //!    TetGen with `-pY` keeps every facet as exactly one face (checked), so
-//!    both halves have the very same seam faces.
+//!    both slabs next to a seam have the very same seam faces.
 //! 4. **Merge**: points are deduplicated by their exact f32 bits, tets are
-//!    concatenated, and [`TetMesh::assemble`] pairs the two halves' seam
-//!    faces by vertex triple. Seam-only faces become ordinary interior
+//!    concatenated, and [`TetMesh::assemble`] pairs the two slabs' seam
+//!    faces by vertex triple (a seam face carrying an in-plane scene
+//!    triangle comes from both slabs and is listed once). Seam-only faces become ordinary interior
 //!    faces; pieces of a cut scene triangle are constrained faces carrying
 //!    the source triangle id (a scene triangle may then be several faces).
 //!
@@ -39,7 +41,7 @@ use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 use tet_core::{MeshError, TetMesh, face_key};
 use thiserror::Error;
 
-use super::split::{Side, SplitPlane};
+use super::split::SplitPlane;
 use crate::bbox::{BoxError, BoxSpec, EnclosingBox};
 use crate::clean::{CleanError, clean_scene};
 use crate::procedural::BOX_TRIANGLES;
@@ -70,7 +72,9 @@ pub enum SeamError {
     },
     /// A scene vertex lies off the plane but closer to it than TetGen's
     /// tolerance (its crossing points would be merged with it by TetGen).
-    #[error("scene vertex {vertex} {point:?} is {distance:e} off the plane {plane:?}; move the plane")]
+    #[error(
+        "scene vertex {vertex} {point:?} is {distance:e} off the plane {plane:?}; move the plane"
+    )]
     PlaneNearVertex {
         /// The plane.
         plane: SplitPlane,
@@ -80,6 +84,12 @@ pub enum SeamError {
         point: Vec3,
         /// Its distance to the plane.
         distance: f64,
+    },
+    /// No slab plan fits the memory limit.
+    #[error("no slab plan keeps every part under {limit_bytes} bytes")]
+    LimitTooSmall {
+        /// The limit.
+        limit_bytes: u64,
     },
     /// Two seam constraints cross (the scene self-intersects on the plane,
     /// or rounding of crossing points made two segments cross).
@@ -98,37 +108,37 @@ pub enum SeamError {
         /// spade's error.
         message: String,
     },
-    /// TetGen failed on one half.
-    #[error("TetGen on half {half}: {source}")]
+    /// TetGen failed on one part (slab).
+    #[error("TetGen on part {part}: {source}")]
     Tetgen {
-        /// 0 = below, 1 = above.
-        half: usize,
+        /// Part index (0 = lowest slab).
+        part: usize,
         /// TetGen's error.
         source: TetgenError,
     },
-    /// A facet of a half did not come back as exactly one face.
-    #[error("half {half}: facet {facet} came back as {faces} faces, expected exactly one")]
+    /// A facet of a part did not come back as exactly one face.
+    #[error("part {part}: facet {facet} came back as {faces} faces, expected exactly one")]
     FacetNotPreserved {
-        /// 0 = below, 1 = above.
-        half: usize,
-        /// Facet index in the half's PLC.
+        /// Part index (0 = lowest slab).
+        part: usize,
+        /// Facet index in the part's PLC.
         facet: usize,
         /// Faces carrying its marker.
         faces: usize,
     },
     /// TetGen moved or dropped an input point.
-    #[error("half {half}: TetGen moved or dropped input point {point}")]
+    #[error("part {part}: TetGen moved or dropped input point {point}")]
     InputPointChanged {
-        /// 0 = below, 1 = above.
-        half: usize,
+        /// Part index (0 = lowest slab).
+        part: usize,
         /// Point index.
         point: usize,
     },
     /// Rounding Steiner points to f32 flattened or inverted tets.
-    #[error("half {half}: {count} tets are flat or inverted after rounding to f32")]
+    #[error("part {part}: {count} tets are flat or inverted after rounding to f32")]
     RoundingFlattens {
-        /// 0 = below, 1 = above.
-        half: usize,
+        /// Part index (0 = lowest slab).
+        part: usize,
         /// How many.
         count: usize,
     },
@@ -137,28 +147,30 @@ pub enum SeamError {
     Mesh(#[from] MeshError),
 }
 
-/// What [`build_split_once`] did.
+/// What [`build_slabs`] (and [`build_split_once`]) did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SeamReport {
-    /// Scene triangles (after cleaning) strictly crossing the plane.
+    /// Scene triangles (after cleaning) strictly crossing at least one plane.
     pub triangles_cut: usize,
-    /// Scene triangles lying in the plane.
+    /// Scene triangles lying in one of the planes.
     pub triangles_in_plane: usize,
-    /// Vertices of the seam triangulation (including the 4 section corners).
-    pub seam_vertices: usize,
-    /// Triangles of the seam triangulation.
-    pub seam_triangles: usize,
-    /// Input points / triangles / output tets of each half.
-    pub half_points: [usize; 2],
-    /// Facets of each half's PLC.
-    pub half_triangles: [usize; 2],
-    /// Tets of each half.
-    pub half_tets: [usize; 2],
-    /// Peak memory of each half's worker (KiB), when isolated.
-    pub half_peak_kib: [Option<u64>; 2],
+    /// Vertices of each seam triangulation (including its 4 section corners).
+    pub seam_vertices: Vec<usize>,
+    /// Triangles of each seam triangulation.
+    pub seam_triangles: Vec<usize>,
+    /// Input points of each part's PLC (part `k` lies between planes `k − 1` and `k`).
+    pub part_points: Vec<usize>,
+    /// Facets of each part's PLC.
+    pub part_triangles: Vec<usize>,
+    /// Tets of each part.
+    pub part_tets: Vec<usize>,
+    /// Peak memory of each part's worker (KiB), when isolated.
+    pub part_peak_kib: Vec<Option<u64>>,
+    /// Predicted peak memory of each part's TetGen run (bytes, with margin).
+    pub part_predicted_bytes: Vec<u64>,
 }
 
-/// Options of [`build_split_once`].
+/// Options of [`build_slabs`].
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SeamOptions {
     /// Box around the scene (the whole mesh's boundary).
@@ -167,6 +179,10 @@ pub struct SeamOptions {
     pub tetgen: TetgenOptions,
     /// Where TetGen runs.
     pub isolation: Isolation,
+    /// Run the parts concurrently (one thread each, at most this many at a
+    /// time; 0 or 1 = one after the other). Only worth it with
+    /// [`Isolation::Worker`]: in-process TetGen runs are serialized.
+    pub parallel_parts: usize,
 }
 
 /// One scene-triangle piece: three vertices in the source winding and the
@@ -181,7 +197,11 @@ pub struct Piece {
 
 /// Exact bits of a point (−0 folded into +0).
 fn key(p: Vec3) -> [u32; 3] {
-    [(p.x + 0.0).to_bits(), (p.y + 0.0).to_bits(), (p.z + 0.0).to_bits()]
+    [
+        (p.x + 0.0).to_bits(),
+        (p.y + 0.0).to_bits(),
+        (p.z + 0.0).to_bits(),
+    ]
 }
 
 /// The crossing point of edge `p q` with the plane (endpoints strictly on
@@ -206,9 +226,9 @@ fn non_degenerate(t: [Vec3; 3]) -> bool {
         x: p[i] as f64,
         y: p[j] as f64,
     };
-    [(0, 1), (1, 2), (2, 0)]
-        .iter()
-        .any(|&(i, j)| robust::orient2d(proj(t[0], i, j), proj(t[1], i, j), proj(t[2], i, j)) != 0.0)
+    [(0, 1), (1, 2), (2, 0)].iter().any(|&(i, j)| {
+        robust::orient2d(proj(t[0], i, j), proj(t[1], i, j), proj(t[2], i, j)) != 0.0
+    })
 }
 
 /// Fans a convex polygon (3 or 4 vertices, source winding) into proper
@@ -231,14 +251,19 @@ fn fan(poly: &[Vec3]) -> Vec<[Vec3; 3]> {
         .collect()
 }
 
-/// Clips a triangle crossing the plane into (below pieces, above pieces,
-/// the seam segment). Source winding is kept in every piece.
-pub fn cut_triangle(tri: [Vec3; 3], plane: SplitPlane) -> (Vec<[Vec3; 3]>, Vec<[Vec3; 3]>, [Vec3; 2]) {
+/// Clips a convex polygon (source winding) strictly crossing the plane
+/// into its part below and its part above (both keep the winding) and the
+/// two polygon points on the plane (the seam segment).
+pub fn clip_polygon(poly: &[Vec3], plane: SplitPlane) -> (Vec<Vec3>, Vec<Vec3>, [Vec3; 2]) {
     let a = plane.axis;
-    let side = |p: Vec3| p[a].partial_cmp(&plane.value).unwrap_or(std::cmp::Ordering::Equal);
+    let side = |p: Vec3| {
+        p[a].partial_cmp(&plane.value)
+            .unwrap_or(std::cmp::Ordering::Equal)
+    };
     let (mut lo, mut hi, mut on) = (Vec::new(), Vec::new(), Vec::new());
-    for i in 0..3 {
-        let (p, q) = (tri[i], tri[(i + 1) % 3]);
+    let n = poly.len();
+    for i in 0..n {
+        let (p, q) = (poly[i], poly[(i + 1) % n]);
         let (sp, sq) = (side(p), side(q));
         if sp.is_le() {
             lo.push(p);
@@ -256,8 +281,22 @@ pub fn cut_triangle(tri: [Vec3; 3], plane: SplitPlane) -> (Vec<[Vec3; 3]>, Vec<[
             on.push(x);
         }
     }
-    debug_assert_eq!(on.len(), 2);
-    (fan(&lo), fan(&hi), [on[0], on[1]])
+    debug_assert_eq!(
+        on.len(),
+        2,
+        "a convex polygon crossing a plane meets it twice"
+    );
+    (lo, hi, [on[0], on[1]])
+}
+
+/// Clips a triangle crossing the plane into (below pieces, above pieces,
+/// the seam segment). Source winding is kept in every piece.
+pub fn cut_triangle(
+    tri: [Vec3; 3],
+    plane: SplitPlane,
+) -> (Vec<[Vec3; 3]>, Vec<[Vec3; 3]>, [Vec3; 2]) {
+    let (lo, hi, seg) = clip_polygon(&tri, plane);
+    (fan(&lo), fan(&hi), seg)
 }
 
 /// The seam: triangles in the plane, each with the in-plane scene triangle
@@ -374,7 +413,7 @@ pub fn seam_triangulation(
     Ok(seam)
 }
 
-/// A facet of a half's PLC and what it becomes in the merged mesh.
+/// A facet of a part's PLC and what it becomes in the merged mesh.
 #[derive(Clone, Copy, Debug)]
 enum FacetKind {
     /// A scene-triangle piece (cleaned index).
@@ -383,23 +422,23 @@ enum FacetKind {
     Seam,
 }
 
-/// One half after TetGen: f32 points, positive tets, constrained faces.
-struct HalfMesh {
+/// One part after TetGen: f32 points, positive tets, constrained faces.
+struct PartMesh {
     points: Vec<Vec3>,
     tets: Vec<[u32; 4]>,
-    /// (vertices, cleaned source) in the half's point indices.
+    /// (vertices, cleaned source) in the part's point indices.
     constrained: Vec<([u32; 3], u32)>,
     input_points: usize,
     input_triangles: usize,
     peak_kib: Option<u64>,
 }
 
-fn run_half(
-    half: usize,
+fn run_part(
+    part: usize,
     facets: &[([Vec3; 3], FacetKind)],
     box_faces: &[[Vec3; 3]],
     options: &SeamOptions,
-) -> Result<HalfMesh, SeamError> {
+) -> Result<PartMesh, SeamError> {
     let mut index: HashMap<[u32; 3], u32> = HashMap::new();
     let mut points: Vec<Vec3> = Vec::new();
     let mut id = |p: Vec3| {
@@ -426,9 +465,10 @@ fn run_half(
     let mut topts = options.tetgen.clone();
     topts.preserve_surface = true;
     let out = tetrahedralize(&input, &topts, &options.isolation)
-        .map_err(|source| SeamError::Tetgen { half, source })?;
-    if let Some(i) = (0..input.points.len()).find(|&i| out.points.get(i) != Some(&input.points[i])) {
-        return Err(SeamError::InputPointChanged { half, point: i });
+        .map_err(|source| SeamError::Tetgen { part, source })?;
+    if let Some(i) = (0..input.points.len()).find(|&i| out.points.get(i) != Some(&input.points[i]))
+    {
+        return Err(SeamError::InputPointChanged { part, point: i });
     }
     // Every facet must be exactly one face with its own vertices.
     let mut count = vec![0usize; facets.len()];
@@ -443,7 +483,7 @@ fn run_half(
     }
     if let Some(f) = (0..facets.len()).find(|&f| count[f] != 1 || !same[f]) {
         return Err(SeamError::FacetNotPreserved {
-            half,
+            part,
             facet: f,
             faces: count[f],
         });
@@ -466,7 +506,7 @@ fn run_half(
         tets.push(t);
     }
     if bad > 0 {
-        return Err(SeamError::RoundingFlattens { half, count: bad });
+        return Err(SeamError::RoundingFlattens { part, count: bad });
     }
     let constrained = facets
         .iter()
@@ -476,7 +516,7 @@ fn run_half(
             FacetKind::Seam => None,
         })
         .collect();
-    Ok(HalfMesh {
+    Ok(PartMesh {
         points: p32,
         tets,
         constrained,
@@ -493,19 +533,36 @@ pub const NEAR_PLANE: f64 = 1e-7;
 
 /// The first vertex strictly off the plane but within `tolerance` of it.
 pub fn near_plane_vertex(vertices: &[Vec3], plane: SplitPlane, tolerance: f64) -> Option<u32> {
-    vertices.iter().position(|p| {
-        let d = (p[plane.axis] as f64 - plane.value as f64).abs();
-        d > 0.0 && d < tolerance
-    }).map(|i| i as u32)
+    vertices
+        .iter()
+        .position(|p| {
+            let d = (p[plane.axis] as f64 - plane.value as f64).abs();
+            d > 0.0 && d < tolerance
+        })
+        .map(|i| i as u32)
 }
 
 /// Builds the mesh of `scene` in its enclosing box as two halves cut by
-/// `plane` with an exact seam, merged (see the module docs). The result
-/// passes [`TetMesh::validate`]; constrained faces carry the *input* scene
-/// triangle ids.
+/// `plane` with an exact seam, merged ([`build_slabs`] with one plane).
 pub fn build_split_once(
     scene: &Scene,
     plane: SplitPlane,
+    options: &SeamOptions,
+) -> Result<(TetMesh, SeamReport), SeamError> {
+    build_slabs(scene, plane.axis, &[plane.value], options)
+}
+
+/// Builds the mesh of `scene` in its enclosing box as `values.len() + 1`
+/// slabs cut by the parallel planes `x[axis] = values[i]` (strictly
+/// increasing, strictly inside the box), each tetrahedralized separately,
+/// with exact seams, merged (see the module docs). Parallel planes keep
+/// every seam a plain rectangle whose boundary lies on the enclosing box,
+/// so no seam meets another. The result passes [`TetMesh::validate`];
+/// constrained faces carry the *input* scene triangle ids.
+pub fn build_slabs(
+    scene: &Scene,
+    axis: usize,
+    values: &[f32],
     options: &SeamOptions,
 ) -> Result<(TetMesh, SeamReport), SeamError> {
     let (cleaned, cm) = clean_scene(scene)?;
@@ -513,61 +570,81 @@ pub fn build_split_once(
         return Err(SeamError::EmptyScene);
     }
     let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
-    let a = plane.axis;
-    if plane.axis > 2 || !(plane.value > b.min[a] && plane.value < b.max[a]) {
-        return Err(SeamError::PlaneOutsideBox {
-            plane,
-            min: b.min,
-            max: b.max,
-        });
-    }
-    let tolerance = NEAR_PLANE * (b.max - b.min).max_element() as f64;
-    if let Some(v) = near_plane_vertex(&cleaned.vertices, plane, tolerance) {
-        let point = cleaned.vertices[v as usize];
-        return Err(SeamError::PlaneNearVertex {
-            plane,
-            vertex: v,
-            point,
-            distance: (point[a] as f64 - plane.value as f64).abs(),
-        });
-    }
-    let mut report = SeamReport::default();
-    let mut halves: [Vec<([Vec3; 3], FacetKind)>; 2] = [Vec::new(), Vec::new()];
-    let mut segments = Vec::new();
-    let mut seam_points = Vec::new();
-    let mut in_plane = Vec::new();
-    for (i, t) in cleaned.triangles.iter().enumerate() {
-        let tri = t.map(|v| cleaned.vertices[v as usize]);
-        let s = i as u32;
-        let on: Vec<Vec3> = tri.iter().copied().filter(|p| p[a] == plane.value).collect();
-        match plane.classify(tri) {
-            Side::Below | Side::Above => {
-                let h = usize::from(plane.classify(tri) == Side::Above);
-                halves[h].push((tri, FacetKind::Scene(s)));
-                match on.len() {
-                    1 => seam_points.push(on[0]),
-                    2 => segments.push([on[0], on[1]]),
-                    _ => {}
-                }
-            }
-            Side::Cut => {
-                report.triangles_cut += 1;
-                let (lo, hi, seg) = cut_triangle(tri, plane);
-                halves[0].extend(lo.into_iter().map(|p| (p, FacetKind::Scene(s))));
-                halves[1].extend(hi.into_iter().map(|p| (p, FacetKind::Scene(s))));
-                segments.push(seg);
-            }
-            Side::InPlane => {
-                report.triangles_in_plane += 1;
-                in_plane.push((tri, s));
-            }
+    let a = axis;
+    let planes: Vec<SplitPlane> = values
+        .iter()
+        .map(|&value| SplitPlane { axis, value })
+        .collect();
+    for (j, &plane) in planes.iter().enumerate() {
+        let after_previous = j == 0 || plane.value > planes[j - 1].value;
+        if axis > 2 || !(plane.value > b.min[a] && plane.value < b.max[a]) || !after_previous {
+            return Err(SeamError::PlaneOutsideBox {
+                plane,
+                min: b.min,
+                max: b.max,
+            });
+        }
+        let tolerance = NEAR_PLANE * (b.max - b.min).max_element() as f64;
+        if let Some(v) = near_plane_vertex(&cleaned.vertices, plane, tolerance) {
+            let point = cleaned.vertices[v as usize];
+            return Err(SeamError::PlaneNearVertex {
+                plane,
+                vertex: v,
+                point,
+                distance: (point[a] as f64 - plane.value as f64).abs(),
+            });
         }
     }
-    // The section rectangle and the two half boxes.
-    let mut below_max = b.max;
-    below_max[a] = plane.value;
-    let mut above_min = b.min;
-    above_min[a] = plane.value;
+    let n = planes.len();
+    let mut report = SeamReport::default();
+    let mut parts: Vec<Vec<([Vec3; 3], FacetKind)>> = vec![Vec::new(); n + 1];
+    let mut segments: Vec<Vec<[Vec3; 2]>> = vec![Vec::new(); n];
+    let mut seam_points: Vec<Vec<Vec3>> = vec![Vec::new(); n];
+    let mut in_plane: Vec<Vec<([Vec3; 3], u32)>> = vec![Vec::new(); n];
+    for (i, t) in cleaned.triangles.iter().enumerate() {
+        let s = i as u32;
+        let mut poly: Vec<Vec3> = t.map(|v| cleaned.vertices[v as usize]).to_vec();
+        let mut slab = n;
+        let mut cut = false;
+        for (j, &plane) in planes.iter().enumerate() {
+            let below = poly.iter().any(|p| p[a] < plane.value);
+            let above = poly.iter().any(|p| p[a] > plane.value);
+            let on: Vec<Vec3> = poly
+                .iter()
+                .copied()
+                .filter(|p| p[a] == plane.value)
+                .collect();
+            if !below && !above {
+                // The original triangle lies in this plane.
+                in_plane[j].push((t.map(|v| cleaned.vertices[v as usize]), s));
+                slab = usize::MAX;
+                break;
+            }
+            if below && above {
+                cut = true;
+                let (lo, hi, seg) = clip_polygon(&poly, plane);
+                parts[j].extend(fan(&lo).into_iter().map(|p| (p, FacetKind::Scene(s))));
+                segments[j].push(seg);
+                poly = hi;
+                continue;
+            }
+            match on.len() {
+                1 => seam_points[j].push(on[0]),
+                2 => segments[j].push([on[0], on[1]]),
+                _ => {}
+            }
+            if below {
+                slab = j;
+                break;
+            }
+        }
+        report.triangles_cut += usize::from(cut);
+        if slab == usize::MAX {
+            report.triangles_in_plane += 1;
+        } else {
+            parts[slab].extend(fan(&poly).into_iter().map(|p| (p, FacetKind::Scene(s))));
+        }
+    }
     let corners_of = |lo: Vec3, hi: Vec3| -> [Vec3; 8] {
         std::array::from_fn(|i| {
             Vec3::new(
@@ -577,41 +654,60 @@ pub fn build_split_once(
             )
         })
     };
-    let below = corners_of(b.min, below_max);
-    let section: Vec<Vec3> = below.iter().copied().filter(|p| p[a] == plane.value).collect();
-    let section: [Vec3; 4] = section.try_into().expect("a box has 4 corners per face");
-    let seam = seam_triangulation(plane, section, &segments, &seam_points, &in_plane)?;
-    report.seam_vertices = seam.vertices;
-    report.seam_triangles = seam.triangles.len();
-    for (t, s) in seam.triangles.iter().zip(&seam.source) {
-        let k = s.map_or(FacetKind::Seam, FacetKind::Scene);
-        halves[0].push((*t, k));
-        halves[1].push((*t, k));
+    // Seams: one planar CDT per plane, given to both adjacent slabs.
+    for (j, &plane) in planes.iter().enumerate() {
+        let section: Vec<Vec3> = corners_of(b.min, b.max)
+            .iter()
+            .filter(|p| p[a] == b.min[a])
+            .map(|&p| {
+                let mut p = p;
+                p[a] = plane.value;
+                p
+            })
+            .collect();
+        let section: [Vec3; 4] = section.try_into().expect("a box has 4 corners per face");
+        let seam = seam_triangulation(plane, section, &segments[j], &seam_points[j], &in_plane[j])?;
+        report.seam_vertices.push(seam.vertices);
+        report.seam_triangles.push(seam.triangles.len());
+        for (t, src) in seam.triangles.iter().zip(&seam.source) {
+            let k = src.map_or(FacetKind::Seam, FacetKind::Scene);
+            parts[j].push((*t, k));
+            parts[j + 1].push((*t, k));
+        }
     }
-    // Box faces: BOX_TRIANGLES pairs are z-min, z-max, y-min, y-max, x-min, x-max.
+    // Box faces of each slab: BOX_TRIANGLES pairs are z-min, z-max, y-min,
+    // y-max, x-min, x-max; a slab skips its faces on cut planes.
     let min_face = [8, 4, 0][a];
     let max_face = [10, 6, 2][a];
-    let box_faces = |corners: [Vec3; 8], skip: usize| -> Vec<[Vec3; 3]> {
+    let slab_faces = |k: usize| -> Vec<[Vec3; 3]> {
+        let (mut lo, mut hi) = (b.min, b.max);
+        if k > 0 {
+            lo[a] = planes[k - 1].value;
+        }
+        if k < n {
+            hi[a] = planes[k].value;
+        }
+        let corners = corners_of(lo, hi);
         BOX_TRIANGLES
             .iter()
             .enumerate()
-            .filter(|(i, _)| *i != skip && *i != skip + 1)
+            .filter(|(i, _)| {
+                let face = i - i % 2;
+                let on_cut = (k > 0 && face == min_face) || (k < n && face == max_face);
+                !on_cut
+            })
             .map(|(_, t)| t.map(|v| corners[v as usize]))
             .collect()
     };
-    let above = corners_of(above_min, b.max);
-    let faces = [box_faces(below, max_face), box_faces(above, min_face)];
-    let mut meshes = Vec::new();
-    for h in 0..2 {
-        meshes.push(run_half(h, &halves[h], &faces[h], options)?);
-    }
+    let faces: Vec<Vec<[Vec3; 3]>> = (0..=n).map(slab_faces).collect();
+    let meshes = run_parts(&parts, &faces, options)?;
     // Merge: exact point dedup, tets concatenated, constrained faces once each.
     let mut index: HashMap<[u32; 3], u32> = HashMap::new();
     let mut points = Vec::new();
     let mut tets = Vec::new();
     let mut tris: Vec<([u32; 3], u32)> = Vec::new();
     let mut seen = std::collections::HashSet::new();
-    for (h, m) in meshes.iter().enumerate() {
+    for m in &meshes {
         let map: Vec<u32> = m
             .points
             .iter()
@@ -629,12 +725,71 @@ pub fn build_split_once(
                 tris.push((g, cm.triangle_source[s as usize]));
             }
         }
-        report.half_points[h] = m.input_points;
-        report.half_triangles[h] = m.input_triangles;
-        report.half_tets[h] = m.tets.len();
-        report.half_peak_kib[h] = m.peak_kib;
+        report.part_points.push(m.input_points);
+        report.part_triangles.push(m.input_triangles);
+        report.part_tets.push(m.tets.len());
+        report.part_peak_kib.push(m.peak_kib);
+        report
+            .part_predicted_bytes
+            .push(super::memory_model::predict_peak_memory(
+                m.input_points,
+                m.input_triangles,
+            ));
     }
     let mesh = TetMesh::assemble(points, tets, &tris, scene.triangles.len() as u32)?;
     mesh.validate()?;
     Ok((mesh, report))
+}
+
+/// Builds `scene` so that every TetGen run's *predicted* peak fits
+/// `options.limit_bytes` ([`super::split::plan_slabs`], then
+/// [`build_slabs`]); returns the plan with the mesh and report.
+pub fn build_with_memory_limit(
+    scene: &Scene,
+    split: &super::split::SplitOptions,
+    options: &SeamOptions,
+) -> Result<(TetMesh, SeamReport, super::split::SlabPlan), SeamError> {
+    let (cleaned, _) = clean_scene(scene)?;
+    if cleaned.triangles.is_empty() {
+        return Err(SeamError::EmptyScene);
+    }
+    let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
+    let plan =
+        super::split::plan_slabs(&cleaned.vertices, &cleaned.triangles, (b.min, b.max), split)
+            .ok_or(SeamError::LimitTooSmall {
+                limit_bytes: split.limit_bytes,
+            })?;
+    let (mesh, report) = build_slabs(scene, plan.axis, &plan.values, options)?;
+    Ok((mesh, report, plan))
+}
+
+/// Runs TetGen on every part, concurrently when `options.parallel_parts > 1`.
+fn run_parts(
+    parts: &[Vec<([Vec3; 3], FacetKind)>],
+    faces: &[Vec<[Vec3; 3]>],
+    options: &SeamOptions,
+) -> Result<Vec<PartMesh>, SeamError> {
+    let width = options.parallel_parts.max(1);
+    let mut out = Vec::with_capacity(parts.len());
+    let ids: Vec<usize> = (0..parts.len()).collect();
+    for wave in ids.chunks(width) {
+        let results: Vec<Result<PartMesh, SeamError>> = if wave.len() == 1 {
+            vec![run_part(wave[0], &parts[wave[0]], &faces[wave[0]], options)]
+        } else {
+            std::thread::scope(|scope| {
+                let handles: Vec<_> = wave
+                    .iter()
+                    .map(|&k| scope.spawn(move || run_part(k, &parts[k], &faces[k], options)))
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                    .collect()
+            })
+        };
+        for r in results {
+            out.push(r?);
+        }
+    }
+    Ok(out)
 }

@@ -131,9 +131,9 @@ impl SplitTree {
             SplitTree::Leaf {
                 predicted_bytes, ..
             } => *predicted_bytes,
-            SplitTree::Split { below, above, .. } => below
-                .max_predicted_bytes()
-                .max(above.max_predicted_bytes()),
+            SplitTree::Split { below, above, .. } => {
+                below.max_predicted_bytes().max(above.max_predicted_bytes())
+            }
         }
     }
 
@@ -216,7 +216,9 @@ pub fn choose_plane(
         (axis, 0.5 * (lo[axis] as f64 + hi[axis] as f64))
     } else {
         let var = |a: usize| sum2[a] / n - (sum[a] / n).powi(2);
-        let axis = (0..3).max_by(|&a, &b| var(a).total_cmp(&var(b))).unwrap_or(0);
+        let axis = (0..3)
+            .max_by(|&a, &b| var(a).total_cmp(&var(b)))
+            .unwrap_or(0);
         (axis, sum[axis] / n)
     };
     let extent = (hi[axis] - lo[axis]) as f64;
@@ -269,17 +271,12 @@ fn plan_part(
     depth: usize,
     options: &SplitOptions,
 ) -> SplitTree {
-    let mut used: Vec<u32> = part
-        .iter()
-        .flat_map(|&t| triangles[t as usize])
-        .collect();
+    let mut used: Vec<u32> = part.iter().flat_map(|&t| triangles[t as usize]).collect();
     used.sort_unstable();
     used.dedup();
     let points_estimate = used.len() + seam_vertices + 8;
     let triangles_estimate = part.len() + 3 * seam_vertices + 12;
-    let predicted_bytes = options
-        .model
-        .predict(points_estimate, triangles_estimate);
+    let predicted_bytes = options.model.predict(points_estimate, triangles_estimate);
     let wants_split = depth < options.min_depth
         || (predicted_bytes > options.limit_bytes && depth < options.max_depth);
     let leaf = |part: Vec<u32>| SplitTree::Leaf {
@@ -336,4 +333,145 @@ fn plan_part(
             options,
         )),
     }
+}
+
+/// A slab plan: parallel planes `x[axis] = values[i]` and each slab's
+/// estimated TetGen input and predicted peak.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SlabPlan {
+    /// Cut axis (the axis of largest variance of the triangle corners).
+    pub axis: usize,
+    /// Plane offsets, strictly increasing.
+    pub values: Vec<f32>,
+    /// Triangles each plane cuts.
+    pub triangles_cut: Vec<usize>,
+    /// Predicted peak (bytes, with margin) of each slab.
+    pub predicted_bytes: Vec<u64>,
+}
+
+/// Plans parallel cut planes so that every slab's predicted TetGen peak
+/// fits `options.limit_bytes`: `k` planes at the `k + 1`-quantiles of the
+/// triangle corners along the axis of largest variance, each moved (within
+/// `±search_steps · search_step ·` extent) to the candidate cutting the
+/// fewest triangles and lying no closer than [`super::seam::NEAR_PLANE`] ×
+/// the box extent to a vertex off it (when that crowds planes into one gap
+/// and the slabs do not fit, the plain quantiles are tried too); `k` grows
+/// (0, 1, 2, 3, 4, 6, 9, …) until all slabs fit. Slab
+/// sizes are estimated as in [`plan_split`] (module docs). `None` when no
+/// plan with at most `2^min(max_depth, 10) − 1` planes fits.
+pub fn plan_slabs(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    bounds: (Vec3, Vec3),
+    options: &SplitOptions,
+) -> Option<SlabPlan> {
+    let (lo, hi) = bounds;
+    let part: Vec<u32> = (0..triangles.len() as u32).collect();
+    let axis = choose_plane(
+        vertices,
+        triangles,
+        &part,
+        bounds,
+        &SplitOptions {
+            search_steps: 0,
+            ..*options
+        },
+    )
+    .map_or(0, |(p, _)| p.axis);
+    let mut coords: Vec<f32> = triangles
+        .iter()
+        .flatten()
+        .map(|&v| vertices[v as usize][axis].clamp(lo[axis], hi[axis]))
+        .collect();
+    coords.sort_by(f32::total_cmp);
+    let extent = (hi[axis] - lo[axis]) as f64;
+    let tolerance = super::seam::NEAR_PLANE * (hi - lo).max_element() as f64;
+    let max_planes = (1usize << options.max_depth.min(10)) - 1;
+    let cuts = |value: f32| {
+        let plane = SplitPlane { axis, value };
+        triangles
+            .iter()
+            .filter(|t| plane.classify(t.map(|v| vertices[v as usize])) == Side::Cut)
+            .count()
+    };
+    // k = 0, 1, 2, 3, 4, 6, 9, 13, … (×1.5) planes.
+    let mut k = 0usize;
+    while k <= max_planes {
+        // The fewest-cuts search may crowd planes into one gap; retry
+        // with the plain quantiles when it does not fit.
+        let variants = if options.search_steps == 0 { 1 } else { 2 };
+        for search in [options.search_steps, 0].into_iter().take(variants) {
+            let mut values: Vec<f32> = Vec::new();
+            let mut triangles_cut = Vec::new();
+            for i in 1..=k {
+                let q = coords[(i * coords.len() / (k + 1)).min(coords.len() - 1)] as f64;
+                let mut best: Option<(f32, usize, f64)> = None;
+                let steps = search as i64;
+                for s in -steps..=steps {
+                    let value = (q + s as f64 * options.search_step as f64 * extent) as f32;
+                    let previous = values.last().copied().unwrap_or(lo[axis]);
+                    if !(value > previous && value < hi[axis]) {
+                        continue;
+                    }
+                    let plane = SplitPlane { axis, value };
+                    if super::seam::near_plane_vertex(vertices, plane, tolerance).is_some() {
+                        continue;
+                    }
+                    let c = cuts(value);
+                    let d = (value as f64 - q).abs();
+                    if best.is_none_or(|(_, bc, bd)| c < bc || (c == bc && d < bd)) {
+                        best = Some((value, c, d));
+                    }
+                }
+                if let Some((v, c, _)) = best {
+                    values.push(v);
+                    triangles_cut.push(c);
+                }
+            }
+            // Estimate each slab.
+            let mut predicted = Vec::with_capacity(values.len() + 1);
+            for s in 0..=values.len() {
+                let below = if s > 0 {
+                    values[s - 1]
+                } else {
+                    f32::NEG_INFINITY
+                };
+                let above = values.get(s).copied().unwrap_or(f32::INFINITY);
+                let mut used = Vec::new();
+                let mut tris = 0usize;
+                for t in triangles {
+                    let p = t.map(|v| vertices[v as usize][axis]);
+                    let inside = p.iter().any(|&x| x > below && x < above)
+                        || (p.iter().any(|&x| x <= below) && p.iter().any(|&x| x >= above))
+                        || p.iter().all(|&x| x == below || x == above);
+                    if inside {
+                        tris += 1;
+                        used.extend_from_slice(t);
+                    }
+                }
+                used.sort_unstable();
+                used.dedup();
+                let seam: usize = [s.checked_sub(1), (s < values.len()).then_some(s)]
+                    .into_iter()
+                    .flatten()
+                    .map(|j| triangles_cut[j])
+                    .sum();
+                predicted.push(
+                    options
+                        .model
+                        .predict(used.len() + seam + 8, tris + 3 * seam + 12),
+                );
+            }
+            if predicted.iter().all(|&p| p <= options.limit_bytes) {
+                return Some(SlabPlan {
+                    axis,
+                    values,
+                    triangles_cut,
+                    predicted_bytes: predicted,
+                });
+            }
+        }
+        k = (k + 1).max(k * 3 / 2);
+    }
+    None
 }
