@@ -30,7 +30,7 @@ use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::locate::locate;
 use tet_trace_cpu::ray::{Failure, Ray, TraceOutcome};
-use tet_trace_cpu::reference::{Aim, random_ray, ray_triangle};
+use tet_trace_cpu::reference::{Aim, edge_distance, random_ray, ray_triangle};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Start;
 
@@ -53,17 +53,6 @@ pub struct Reference<'m> {
     bvh: Bvh2,
     /// Grazing tolerance (world units).
     pub tol: f64,
-}
-
-fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let ab = b - a;
-    let l = ab.length_squared();
-    let s = if l > 0.0 {
-        ((p - a).dot(ab) / l).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + ab * s - p).length()
 }
 
 fn a3(v: Vec3) -> Vec3A {
@@ -141,9 +130,7 @@ impl<'m> Reference<'m> {
         let cf = &mesh.constrained[face as usize];
         let v = cf.vertices.map(|k| mesh.points[k as usize].as_dvec3());
         let p = ray.origin.as_dvec3() + ray.direction.as_dvec3() * t;
-        let edge = segment_distance(p, v[0], v[1])
-            .min(segment_distance(p, v[1], v[2]))
-            .min(segment_distance(p, v[2], v[0]));
+        let edge = edge_distance(p, v);
         Some(RefHit {
             face,
             triangle: cf.triangle,
@@ -155,10 +142,7 @@ impl<'m> Reference<'m> {
     fn near_edge(&self, face: u32, p: DVec3) -> bool {
         let cf = &self.mesh.constrained[face as usize];
         let v = cf.vertices.map(|k| self.mesh.points[k as usize].as_dvec3());
-        segment_distance(p, v[0], v[1])
-            .min(segment_distance(p, v[1], v[2]))
-            .min(segment_distance(p, v[2], v[0]))
-            < self.tol
+        edge_distance(p, v) < self.tol
     }
 }
 

@@ -48,6 +48,13 @@ fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
     (a + ab * s - p).length()
 }
 
+/// Distance from `p` to the nearest edge of triangle `v`.
+pub fn edge_distance(p: DVec3, v: [DVec3; 3]) -> f64 {
+    segment_distance(p, v[0], v[1])
+        .min(segment_distance(p, v[1], v[2]))
+        .min(segment_distance(p, v[2], v[0]))
+}
+
 /// Intersection of the ray's line with triangle `v` (closed), as
 /// `(t, barycentrics)`; `None` when the line misses it or is parallel.
 pub fn ray_triangle(ray: &Ray, v: [Vec3; 3]) -> Option<(f64, [f64; 3])> {
@@ -88,9 +95,7 @@ pub fn closest_hit(mesh: &TetMesh, ray: &Ray) -> Option<RefHit> {
             }
             let vd = v.map(|p| p.as_dvec3());
             let p = ray.origin.as_dvec3() + ray.direction.as_dvec3() * t;
-            let edge_distance = segment_distance(p, vd[0], vd[1])
-                .min(segment_distance(p, vd[1], vd[2]))
-                .min(segment_distance(p, vd[2], vd[0]));
+            let edge_distance = edge_distance(p, vd);
             best = Some(RefHit {
                 face: i as u32,
                 triangle: cf.triangle,
@@ -129,9 +134,7 @@ pub fn grazes_an_edge(mesh: &TetMesh, ray: &Ray, tol: f64) -> bool {
             return false;
         }
         let p = o + d * t;
-        segment_distance(p, v[0], v[1]) < tol
-            || segment_distance(p, v[1], v[2]) < tol
-            || segment_distance(p, v[2], v[0]) < tol
+        edge_distance(p, v) < tol
     })
 }
 
