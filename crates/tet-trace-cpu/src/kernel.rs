@@ -1,12 +1,18 @@
-//! Shared plumbing of the kernel modules: the [`Tracer`] trait and the
-//! tracer type every layout kernel instantiates.
+//! Shared plumbing of the kernel modules: the [`Tracer`] trait, the
+//! tracer type every layout kernel instantiates, and the [`WalkRecord`]
+//! glue that makes every index-based layout container ([`LayoutMesh`]) a
+//! [`Topology`] with one constructor.
 
 use std::marker::PhantomData;
 
 use tet_core::TetMesh;
+use tet_core::layout::{LayoutError, LayoutMesh, LayoutRecord};
+use tet_core::link::Link;
 
 use crate::ray::{Ray, TraceOutcome};
-use crate::walk::{Projection, Start, Topology, step_cap, trace, trace_interleaved};
+use crate::walk::{
+    Projection, Start, Topology, prefetch_index, step_cap, trace, trace_interleaved,
+};
 
 /// A ray-traversal method over one mesh.
 pub trait Tracer: Sync {
@@ -77,5 +83,66 @@ impl<L: Topology, P: Projection> Tracer for WalkTracer<'_, L, P> {
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
         trace_interleaved::<P, L, LANES>(self.mesh, &self.layout, rays, start, self.cap, out)
+    }
+}
+
+/// The per-record part of a projected-walk kernel over an index-based layout
+/// ([`tet_core::layout::Baseline32`], `Tet32`, `Tet20`, `Tet16`): with it,
+/// [`LayoutMesh`] of that record is a [`Topology`] and
+/// [`WalkTracer::new`] encodes and wraps it.
+pub trait WalkRecord: LayoutRecord + Sync {
+    /// Kernel name for reports (`"sctp"`, `"tet20"`, ...).
+    const KERNEL: &'static str;
+    /// Whether [`Topology::prefetch`] prefetches the record (else a no-op).
+    const PREFETCH: bool;
+    /// Xor of the four vertex ids (paper `VX^i`), see [`Topology::vx`].
+    fn vx(&self) -> u32;
+    /// Raw link across the face opposite vertex `exiting`, see
+    /// [`Topology::exit_link`].
+    fn exit_link(&self, face: [u32; 3], d: u32, exiting: u32, entry_raw: u32) -> u32;
+}
+
+impl<R: WalkRecord> Topology for LayoutMesh<R> {
+    #[inline(always)]
+    fn vx(&self, tet: u32) -> u32 {
+        self.tets[tet as usize].vx()
+    }
+    #[inline(always)]
+    fn exit_link(&self, tet: u32, face: [u32; 3], d: u32, exiting: u32, entry_raw: u32) -> u32 {
+        self.tets[tet as usize].exit_link(face, d, exiting, entry_raw)
+    }
+    #[inline(always)]
+    fn prefetch(&self, tet: u32) {
+        if R::PREFETCH {
+            prefetch_index(&self.tets, tet);
+        }
+    }
+}
+
+impl<'m, R: WalkRecord, P: Projection> WalkTracer<'m, LayoutMesh<R>, P> {
+    /// Encodes `mesh` (validated) in the layout of record `R`.
+    pub fn new(mesh: &'m TetMesh) -> Result<Self, LayoutError> {
+        Ok(Self::with_layout(
+            mesh,
+            LayoutMesh::from_mesh(mesh)?,
+            R::KERNEL,
+        ))
+    }
+}
+
+/// Algorithm 3 (GETNEXTTET32) for records that keep the ids of slots 0..2:
+/// the raw link `n[k]` of the slot `k` holding `exiting`, slot 3 when it is
+/// none of `v`. Written as a select chain rather than a variable-indexed
+/// stack array.
+#[inline(always)]
+pub(crate) fn slot_exit_link(v: [u32; 3], n: [Link; 4], exiting: u32) -> u32 {
+    if exiting == v[0] {
+        n[0].0
+    } else if exiting == v[1] {
+        n[1].0
+    } else if exiting == v[2] {
+        n[2].0
+    } else {
+        n[3].0
     }
 }

@@ -21,44 +21,24 @@
 //! projection removes the `d` component before multiplying and does not
 //! suffer from this (see the robustness census in `tests/robustness.rs`).
 
-use tet_core::TetMesh;
-use tet_core::layout::{Baseline32Mesh, LayoutError};
+use tet_core::layout::{Baseline32, Baseline32Mesh};
 
-use crate::kernel::WalkTracer;
-use crate::walk::{Projection, Topology, TripleF32};
+use crate::kernel::{WalkRecord, WalkTracer, slot_exit_link};
+use crate::walk::TripleF32;
 
-impl Topology for Baseline32Mesh {
+impl WalkRecord for Baseline32 {
+    const KERNEL: &'static str = "sctp";
+    const PREFETCH: bool = false;
     #[inline(always)]
-    fn vx(&self, tet: u32) -> u32 {
-        let v = self.tets[tet as usize].v;
+    fn vx(&self) -> u32 {
+        let v = self.v;
         v[0] ^ v[1] ^ v[2] ^ v[3]
     }
     #[inline(always)]
-    fn exit_link(&self, tet: u32, _f: [u32; 3], _d: u32, exiting: u32, _entry: u32) -> u32 {
-        let r = &self.tets[tet as usize];
-        let n = r.n;
-        if exiting == r.v[0] {
-            n[0].0
-        } else if exiting == r.v[1] {
-            n[1].0
-        } else if exiting == r.v[2] {
-            n[2].0
-        } else {
-            n[3].0
-        }
+    fn exit_link(&self, _f: [u32; 3], _d: u32, exiting: u32, _entry: u32) -> u32 {
+        slot_exit_link([self.v[0], self.v[1], self.v[2]], self.n, exiting)
     }
 }
 
 /// ScTP tracer (default: f32 triple products).
 pub type SctpTracer<'m, P = TripleF32> = WalkTracer<'m, Baseline32Mesh, P>;
-
-impl<'m, P: Projection> WalkTracer<'m, Baseline32Mesh, P> {
-    /// Encodes `mesh` (validated) in the baseline layout.
-    pub fn new(mesh: &'m TetMesh) -> Result<Self, LayoutError> {
-        Ok(Self::with_layout(
-            mesh,
-            Baseline32Mesh::from_mesh(mesh)?,
-            "sctp",
-        ))
-    }
-}

@@ -9,24 +9,21 @@
 //! rank of the exit vertex. Per step: as [`crate::tet20`] plus one more rank
 //! (4 comparisons) and two xors; the record load is 16 bytes.
 
-use tet_core::TetMesh;
-use tet_core::layout::{LayoutError, Tet16Mesh, rank_of};
+use tet_core::layout::{Tet16, Tet16Mesh, rank_of};
 
-use crate::kernel::WalkTracer;
-use crate::walk::{DuffF32, DuffF64, Projection, Topology, prefetch_index};
+use crate::kernel::{WalkRecord, WalkTracer};
+use crate::walk::{DuffF32, DuffF64};
 
-impl Topology for Tet16Mesh {
+impl WalkRecord for Tet16 {
+    const KERNEL: &'static str = "tet16";
+    const PREFETCH: bool = true;
     #[inline(always)]
-    fn vx(&self, tet: u32) -> u32 {
-        self.tets[tet as usize].vx
+    fn vx(&self) -> u32 {
+        self.vx
     }
     #[inline(always)]
-    fn prefetch(&self, tet: u32) {
-        prefetch_index(&self.tets, tet);
-    }
-    #[inline(always)]
-    fn exit_link(&self, tet: u32, f: [u32; 3], d: u32, exiting: u32, entry: u32) -> u32 {
-        let nx = &self.tets[tet as usize].nx;
+    fn exit_link(&self, f: [u32; 3], d: u32, exiting: u32, entry: u32) -> u32 {
+        let nx = &self.nx;
         let ids = [f[0], f[1], f[2], d];
         // `NX_3 = 0` (Tet16::nx4) as a select: no stack array to index.
         let pick = |rank: usize| if rank < 3 { nx[rank] } else { 0 };
@@ -38,14 +35,3 @@ impl Topology for Tet16Mesh {
 pub type Tet16Tracer<'m, P = DuffF32> = WalkTracer<'m, Tet16Mesh, P>;
 /// Tet16 in f64.
 pub type Tet16TracerF64<'m> = Tet16Tracer<'m, DuffF64>;
-
-impl<'m, P: Projection> WalkTracer<'m, Tet16Mesh, P> {
-    /// Encodes `mesh` (validated) in the Tet16 layout.
-    pub fn new(mesh: &'m TetMesh) -> Result<Self, LayoutError> {
-        Ok(Self::with_layout(
-            mesh,
-            Tet16Mesh::from_mesh(mesh)?,
-            "tet16",
-        ))
-    }
-}

@@ -14,28 +14,24 @@
 //! | paper | code |
 //! |---|---|
 //! | `idx_0..2`, `p_0..2` | walk state `ids`, `p` |
-//! | `VX^next` | [`Topology::vx`] |
+//! | `VX^next` | [`Topology::vx`](crate::walk::Topology::vx) |
 //! | `order_a`, GETNEXTTET20 | [`tet_core::layout::rank_of`], [`Tet20::neighbor_by_rank`] |
 
-use tet_core::TetMesh;
-use tet_core::layout::{LayoutError, Tet20, Tet20Mesh, rank_of};
+use tet_core::layout::{Tet20, Tet20Mesh, rank_of};
 
-use crate::kernel::WalkTracer;
-use crate::walk::{DuffF32, DuffF64, Projection, Topology, prefetch_index};
+use crate::kernel::{WalkRecord, WalkTracer};
+use crate::walk::{DuffF32, DuffF64};
 
-impl Topology for Tet20Mesh {
+impl WalkRecord for Tet20 {
+    const KERNEL: &'static str = "tet20";
+    const PREFETCH: bool = true;
     #[inline(always)]
-    fn vx(&self, tet: u32) -> u32 {
-        self.tets[tet as usize].vx
+    fn vx(&self) -> u32 {
+        self.vx
     }
     #[inline(always)]
-    fn prefetch(&self, tet: u32) {
-        prefetch_index(&self.tets, tet);
-    }
-    #[inline(always)]
-    fn exit_link(&self, tet: u32, f: [u32; 3], d: u32, exiting: u32, _entry: u32) -> u32 {
-        let rec: &Tet20 = &self.tets[tet as usize];
-        rec.neighbor_by_rank(rank_of(exiting, [f[0], f[1], f[2], d]))
+    fn exit_link(&self, f: [u32; 3], d: u32, exiting: u32, _entry: u32) -> u32 {
+        self.neighbor_by_rank(rank_of(exiting, [f[0], f[1], f[2], d]))
             .0
     }
 }
@@ -44,14 +40,3 @@ impl Topology for Tet20Mesh {
 pub type Tet20Tracer<'m, P = DuffF32> = WalkTracer<'m, Tet20Mesh, P>;
 /// Tet20 in f64.
 pub type Tet20TracerF64<'m> = Tet20Tracer<'m, DuffF64>;
-
-impl<'m, P: Projection> WalkTracer<'m, Tet20Mesh, P> {
-    /// Encodes `mesh` (validated) in the Tet20 layout.
-    pub fn new(mesh: &'m TetMesh) -> Result<Self, LayoutError> {
-        Ok(Self::with_layout(
-            mesh,
-            Tet20Mesh::from_mesh(mesh)?,
-            "tet20",
-        ))
-    }
-}

@@ -71,7 +71,7 @@ use thiserror::Error;
 
 use crate::error::MeshError;
 use crate::link::{Link, LinkKind};
-use crate::mesh::TetMesh;
+use crate::mesh::{Attributes, ConstrainedFace, TetMesh};
 use crate::predicates::orient3d_f32;
 
 pub mod baseline32;
@@ -155,6 +155,198 @@ pub(crate) fn validate_input(layout: &'static str, mesh: &TetMesh) -> Result<(),
 pub(crate) fn validate_output(layout: &'static str, mesh: &TetMesh) -> Result<(), LayoutError> {
     mesh.validate()
         .map_err(|source| LayoutError::DecodedInvalid { layout, source })
+}
+
+/// The cold parts every container keeps beside its records: points,
+/// constrained-face table, triangle count, attributes.
+pub(crate) type Cold<'a> = (&'a [Vec3], &'a [ConstrainedFace], u32, &'a Attributes);
+
+/// Builds the decoded canonical mesh from per-tet ids and links (slot order)
+/// and the container's cold parts, and validates it
+/// ([`LayoutError::DecodedInvalid`] on failure). Shared by every `to_mesh`.
+pub(crate) fn decoded_mesh(
+    layout: &'static str,
+    (tets, neighbors): Decoded,
+    (points, constrained, triangle_count, attributes): Cold<'_>,
+) -> Result<TetMesh, LayoutError> {
+    let mesh = TetMesh {
+        points: points.to_vec(),
+        tets,
+        neighbors,
+        constrained: constrained.to_vec(),
+        triangle_count,
+        attributes: attributes.clone(),
+    };
+    validate_output(layout, &mesh)?;
+    Ok(mesh)
+}
+
+/// Algorithm 3's branch-light search: the slot `i < 3` with `ids[i] == v`
+/// (the first one), else 3. Shared by the layouts that keep the ids of
+/// slots 0..2 ([`Baseline32`], [`Tet32`]).
+#[inline]
+pub(crate) fn slot_among(ids: [u32; 3], v: u32) -> usize {
+    let mut s = 3;
+    for i in (0..3).rev() {
+        if ids[i] == v {
+            s = i;
+        }
+    }
+    s
+}
+
+/// Fails with [`LayoutError::Corrupt`] naming the first tet `t < count` whose
+/// stored record differs from its re-encoding (`same(t)` is false).
+pub(crate) fn check_reencodes(
+    layout: &'static str,
+    count: usize,
+    same: impl Fn(usize) -> bool,
+) -> Result<(), LayoutError> {
+    match (0..count).find(|&t| !same(t)) {
+        Some(t) => Err(LayoutError::Corrupt {
+            layout,
+            element: "tet",
+            index: t,
+            detail: "record does not re-encode from the decoded mesh".into(),
+        }),
+        None => Ok(()),
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Shared container of the Baseline32 / Tet32 / Tet20 / Tet16 layouts
+
+/// A per-tet record of one of the index-based layouts ([`Baseline32`],
+/// [`Tet32`], [`Tet20`], [`Tet16`]): what [`LayoutMesh`] needs to encode and
+/// decode a whole mesh, so the four containers share one implementation.
+pub trait LayoutRecord: Pod + PartialEq + std::fmt::Debug {
+    /// Layout name used in errors and memory reports.
+    const NAME: &'static str;
+    /// Whether the record drops the vertex ids (Tet20, Tet16): the mesh is
+    /// then stored in [canonical slot order](canonical_slot_order) with one
+    /// [`Anchor`] per component and decoded by walking; otherwise the slot
+    /// order of the input is kept and the anchor table stays empty.
+    const ID_LESS: bool;
+    /// Whether `to_mesh` also checks that every record re-encodes from the
+    /// decoded mesh (Tet16, whose decode reads one link difference per tet).
+    const CHECK_REENCODE: bool;
+
+    /// Encodes one tet from its vertex ids and links in slot order (for an
+    /// id-less record, the canonical slot order).
+    fn encode_record(ids: [u32; 4], links: [Link; 4]) -> Self;
+
+    /// Decodes every tet of `mesh`: vertex ids and links in slot order.
+    #[allow(clippy::type_complexity)]
+    fn decode_all(mesh: &LayoutMesh<Self>) -> Result<(Vec<[u32; 4]>, Vec<[Link; 4]>), LayoutError>;
+}
+
+/// A mesh in one of the index-based layouts: hot `tets` + `points`; cold
+/// constrained-face table, attributes and (id-less layouts only) anchors.
+/// Used through the aliases [`Baseline32Mesh`], [`Tet32Mesh`], [`Tet20Mesh`]
+/// and [`Tet16Mesh`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayoutMesh<R> {
+    /// Vertex positions (hot).
+    pub points: Vec<Vec3>,
+    /// Tet records (hot).
+    pub tets: Vec<R>,
+    /// Constrained-face table (cold); for id-less layouts the `face` fields
+    /// are in canonical slot order.
+    pub constrained: Vec<ConstrainedFace>,
+    /// Id-less layouts (Tet20, Tet16): one fully decoded tet per connected
+    /// component (cold), the start of point location and of whole-mesh
+    /// decoding. Empty for layouts that keep the vertex ids.
+    pub anchors: Vec<Anchor>,
+    /// Number of scene triangles.
+    pub triangle_count: u32,
+    /// Optional attributes (cold).
+    pub attributes: Attributes,
+}
+
+impl<R: LayoutRecord> LayoutMesh<R> {
+    /// Encodes a valid mesh (validated first). Id-less layouts store it in
+    /// canonical slot order and build the anchor table.
+    pub fn from_mesh(mesh: &TetMesh) -> Result<Self, LayoutError> {
+        validate_input(R::NAME, mesh)?;
+        let canon;
+        let (source, anchors) = if R::ID_LESS {
+            canon = canonical_slot_order(mesh);
+            (&canon, anchors_of(&canon))
+        } else {
+            (mesh, Vec::new())
+        };
+        Ok(LayoutMesh {
+            points: source.points.clone(),
+            tets: source
+                .tets
+                .iter()
+                .zip(&source.neighbors)
+                .map(|(&v, &n)| R::encode_record(v, n))
+                .collect(),
+            constrained: source.constrained.clone(),
+            anchors,
+            triangle_count: source.triangle_count,
+            attributes: source.attributes.clone(),
+        })
+    }
+
+    /// Decodes back to the canonical mesh: exactly the input of `from_mesh`
+    /// for layouts that keep the vertex ids, `canonical_slot_order(input)`
+    /// for id-less ones (decoded by walking out from the anchors). The result
+    /// is validated; inconsistent data gives [`LayoutError::Corrupt`].
+    pub fn to_mesh(&self) -> Result<TetMesh, LayoutError> {
+        let cold = (
+            &self.points[..],
+            &self.constrained[..],
+            self.triangle_count,
+            &self.attributes,
+        );
+        let mesh = decoded_mesh(R::NAME, R::decode_all(self)?, cold)?;
+        if R::CHECK_REENCODE {
+            check_reencodes(R::NAME, self.tets.len(), |t| {
+                R::encode_record(mesh.tets[t], mesh.neighbors[t]) == self.tets[t]
+            })?;
+        }
+        Ok(mesh)
+    }
+
+    /// Walk decoding of an id-less layout: `vx(r)` is a record's xor-sum and
+    /// `links(r, entry, entry_rank)` its rank-ordered links given one known
+    /// link (see [`decode_by_walk`]). Returns ids and links in slot order.
+    pub(crate) fn decode_walk(
+        &self,
+        vx: impl Fn(&R) -> u32,
+        links: impl Fn(&R, Link, usize) -> [Link; 4],
+    ) -> Result<Decoded, LayoutError> {
+        let vx: Vec<u32> = self.tets.iter().map(vx).collect();
+        let (ids, by_rank) = decode_by_walk(
+            R::NAME,
+            &vx,
+            &self.points,
+            &self.constrained,
+            &self.anchors,
+            |t, entry, rank| links(&self.tets[t], entry, rank),
+        )?;
+        let neighbors = ids
+            .iter()
+            .zip(&by_rank)
+            .map(|(&v, &n)| links_by_slot(v, n))
+            .collect();
+        Ok((ids, neighbors))
+    }
+
+    /// Exact memory of this container (see [`crate::memory`]).
+    pub fn memory(&self) -> crate::memory::LayoutMemory {
+        crate::memory::LayoutMemory {
+            name: R::NAME,
+            tets: self.tets.len() * size_of::<R>(),
+            points: self.points.len() * size_of::<Vec3>(),
+            constrained: self.constrained.len() * size_of::<ConstrainedFace>(),
+            attributes: self.attributes.bytes(),
+            anchors: self.anchors.len() * size_of::<Anchor>(),
+            reconstruction: 0,
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------

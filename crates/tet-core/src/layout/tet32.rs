@@ -14,12 +14,9 @@
 //! `v` serves Algorithm 3's search for the exit vertex's slot. The slot order
 //! of the input mesh is kept, so the round trip is exact.
 
-use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
-
-use super::{LayoutError, validate_input, validate_output, xor_sum};
+use super::{LayoutError, LayoutMesh, LayoutRecord, xor_sum};
 use crate::link::Link;
-use crate::mesh::{Attributes, ConstrainedFace, TetMesh};
+use bytemuck::{Pod, Zeroable};
 
 /// Layout name used in errors and memory reports.
 pub const NAME: &str = "tet32";
@@ -55,13 +52,7 @@ impl Tet32 {
     /// (Algorithm 3: vertex ids and links share slots).
     #[inline]
     pub fn slot_of(&self, v: u32) -> usize {
-        let mut s = 3;
-        for i in (0..3).rev() {
-            if self.v[i] == v {
-                s = i;
-            }
-        }
-        s
+        super::slot_among(self.v, v)
     }
 
     /// GETNEXTTET32: the link across the face opposite vertex id `v` (which
@@ -72,68 +63,28 @@ impl Tet32 {
     }
 }
 
-/// A mesh in the Tet32 layout: hot `tets` + `points`, cold table and attributes.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Tet32Mesh {
-    /// Vertex positions (hot).
-    pub points: Vec<Vec3>,
-    /// Tet records (hot).
-    pub tets: Vec<Tet32>,
-    /// Constrained-face table (cold).
-    pub constrained: Vec<ConstrainedFace>,
-    /// Number of scene triangles.
-    pub triangle_count: u32,
-    /// Optional attributes (cold).
-    pub attributes: Attributes,
-}
+impl LayoutRecord for Tet32 {
+    const NAME: &'static str = NAME;
+    const ID_LESS: bool = false;
+    const CHECK_REENCODE: bool = false;
 
-impl Tet32Mesh {
-    /// Encodes a valid mesh (validated first).
-    pub fn from_mesh(mesh: &TetMesh) -> Result<Self, LayoutError> {
-        validate_input(NAME, mesh)?;
-        Ok(Tet32Mesh {
-            points: mesh.points.clone(),
-            tets: mesh
-                .tets
-                .iter()
-                .zip(&mesh.neighbors)
-                .map(|(&v, &n)| Tet32 {
-                    v: [v[0], v[1], v[2]],
-                    vx: xor_sum(v),
-                    n,
-                })
-                .collect(),
-            constrained: mesh.constrained.clone(),
-            triangle_count: mesh.triangle_count,
-            attributes: mesh.attributes.clone(),
-        })
-    }
-
-    /// Decodes back to the canonical mesh (exactly the input of `from_mesh`).
-    /// The result is validated.
-    pub fn to_mesh(&self) -> Result<TetMesh, LayoutError> {
-        let mesh = TetMesh {
-            points: self.points.clone(),
-            tets: self.tets.iter().map(Tet32::vertices).collect(),
-            neighbors: self.tets.iter().map(|t| t.n).collect(),
-            constrained: self.constrained.clone(),
-            triangle_count: self.triangle_count,
-            attributes: self.attributes.clone(),
-        };
-        validate_output(NAME, &mesh)?;
-        Ok(mesh)
-    }
-
-    /// Exact memory of this container (see [`crate::memory`]).
-    pub fn memory(&self) -> crate::memory::LayoutMemory {
-        crate::memory::LayoutMemory {
-            name: NAME,
-            tets: self.tets.len() * size_of::<Tet32>(),
-            points: self.points.len() * size_of::<Vec3>(),
-            constrained: self.constrained.len() * size_of::<ConstrainedFace>(),
-            attributes: self.attributes.bytes(),
-            anchors: 0,
-            reconstruction: 0,
+    fn encode_record(v: [u32; 4], n: [Link; 4]) -> Self {
+        Tet32 {
+            v: [v[0], v[1], v[2]],
+            vx: xor_sum(v),
+            n,
         }
     }
+
+    fn decode_all(mesh: &LayoutMesh<Self>) -> Result<(Vec<[u32; 4]>, Vec<[Link; 4]>), LayoutError> {
+        let tets = &mesh.tets;
+        Ok((
+            tets.iter().map(Tet32::vertices).collect(),
+            tets.iter().map(|t| t.n).collect(),
+        ))
+    }
 }
+
+/// A mesh in the Tet32 layout: hot `tets` + `points`, cold table and
+/// attributes (no anchors). The slot order is kept, so the round trip is exact.
+pub type Tet32Mesh = LayoutMesh<Tet32>;

@@ -27,7 +27,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-use super::{LayoutError, fourth_vertex, validate_input, validate_output, xor_sum};
+use super::{LayoutError, check_reencodes, decoded_mesh, fourth_vertex, validate_input, xor_sum};
 use crate::link::{Link, LinkKind};
 use crate::mesh::{Attributes, ConstrainedFace, TetMesh};
 
@@ -224,28 +224,14 @@ impl Tet80Mesh {
                 })
             })
             .collect();
-        let mesh = TetMesh {
-            points: self.points.clone(),
-            tets: self.vertex_ids.clone(),
-            neighbors,
-            constrained: self.constrained.clone(),
-            triangle_count: self.triangle_count,
-            attributes: self.attributes.clone(),
-        };
-        validate_output(NAME, &mesh)?;
+        let (points, faces, attrs) = (&self.points, &self.constrained, &self.attributes);
+        let cold = (&points[..], &faces[..], self.triangle_count, attrs);
+        let mesh = decoded_mesh(NAME, (self.vertex_ids.clone(), neighbors), cold)?;
         // Bitwise comparison: -0.0 and NaN payloads must survive too.
-        let bad = (0..self.tets.len()).find(|&t| {
+        check_reencodes(NAME, self.tets.len(), |t| {
             let again = encode_tet(&mesh, t);
-            bytemuck::bytes_of(&again) != bytemuck::bytes_of(&self.tets[t])
-        });
-        if let Some(t) = bad {
-            return Err(LayoutError::Corrupt {
-                layout: NAME,
-                element: "tet",
-                index: t,
-                detail: "record does not re-encode from the decoded mesh".into(),
-            });
-        }
+            bytemuck::bytes_of(&again) == bytemuck::bytes_of(&self.tets[t])
+        })?;
         Ok(mesh)
     }
 
