@@ -11,7 +11,6 @@
 //!   `TETRAYS_FUZZ_ITERS`), printing counts and time;
 //! * `write_seed_corpus`: regenerates `fuzz/seeds/{obj_and_scene,tetgen_files}/`.
 
-use std::path::PathBuf;
 use std::time::Instant;
 
 use tet_build::tetgen_files;
@@ -71,25 +70,14 @@ fn bounded<R>(what: &str, data: &[u8], f: impl FnOnce() -> R) -> R {
 // Seed corpus.
 // ---------------------------------------------------------------------------
 
-fn seed_dir(target: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fuzz/seeds")
-        .join(target)
+#[allow(dead_code)]
+mod corpus {
+    include!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fuzz/targets_common/corpus.rs"
+    ));
 }
-
-fn read_seeds(target: &str) -> Vec<(String, Vec<u8>)> {
-    let dir = seed_dir(target);
-    let mut out: Vec<(String, Vec<u8>)> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| {
-            let path = e.expect("directory entry").path();
-            let name = path.file_name().unwrap().to_string_lossy().into_owned();
-            (name, std::fs::read(&path).expect("seed file"))
-        })
-        .collect();
-    out.sort();
-    out
-}
+use corpus::{read_seeds, seed_dir};
 
 /// A scenes.json in the shape of the real one, over the fixture meshes.
 const SCENES_JSON: &str = r#"{

@@ -13,7 +13,6 @@
 //!   `TETRAYS_FUZZ_ITERS`), printing counts and time;
 //! * `write_seed_corpus`: regenerates `fuzz/seeds/{mesh_file,xor_codecs}/`.
 
-use std::path::PathBuf;
 use std::time::Instant;
 
 use glam::{Vec2, Vec3};
@@ -83,25 +82,14 @@ fn check_mesh_file(data: &[u8]) {
 // Seed corpus.
 // ---------------------------------------------------------------------------
 
-fn seed_dir(target: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fuzz/seeds")
-        .join(target)
+#[allow(dead_code)]
+mod corpus {
+    include!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fuzz/targets_common/corpus.rs"
+    ));
 }
-
-fn read_seeds(target: &str) -> Vec<(String, Vec<u8>)> {
-    let dir = seed_dir(target);
-    let mut out: Vec<(String, Vec<u8>)> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| {
-            let path = e.expect("directory entry").path();
-            let name = path.file_name().unwrap().to_string_lossy().into_owned();
-            (name, std::fs::read(&path).expect("seed file"))
-        })
-        .collect();
-    out.sort();
-    out
-}
+use corpus::{read_seeds, seed_dir};
 
 /// Small valid meshes exercising every section of the format.
 fn sample_meshes() -> Vec<(&'static str, TetMesh)> {

@@ -237,8 +237,9 @@ pub(crate) fn left_f32(a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
 }
 
 /// Duff et al.'s orthonormal basis for a unit vector `n`, ordered so that
-/// `u × v` points along `n`.
-fn duff_basis(n: DVec3) -> (DVec3, DVec3) {
+/// `u × v` points along `n` (public so the GPU crate projects batch rays with
+/// exactly the CPU's basis).
+pub fn duff_basis(n: DVec3) -> (DVec3, DVec3) {
     let sign = 1.0f64.copysign(n.z);
     let a = -1.0 / (sign + n.z);
     let b = n.x * n.y * a;

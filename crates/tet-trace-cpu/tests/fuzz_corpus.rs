@@ -3,8 +3,6 @@
 //! fuzzer found. Each input is a small mesh plus rays; every kernel must end
 //! within its step cap with a well-formed outcome (see the target's docs).
 
-use std::path::PathBuf;
-
 #[allow(dead_code)]
 mod input {
     include!(concat!(
@@ -27,25 +25,18 @@ mod traversal {
     ));
 }
 
-fn inputs(dir: &str) -> Vec<(String, Vec<u8>)> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fuzz")
-        .join(dir);
-    let mut out: Vec<(String, Vec<u8>)> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| {
-            let path = e.unwrap().path();
-            let bytes = std::fs::read(&path).unwrap();
-            (path.display().to_string(), bytes)
-        })
-        .collect();
-    out.sort();
-    out
+#[allow(dead_code)]
+mod corpus {
+    include!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fuzz/targets_common/corpus.rs"
+    ));
 }
+use corpus::read_seeds;
 
 #[test]
 fn traversal_seed_corpus() {
-    let seeds = inputs("seeds/traversal");
+    let seeds = read_seeds("traversal");
     assert!(seeds.len() >= 10);
     for (name, bytes) in seeds {
         assert!(traversal::check(&bytes) > 0, "{name}: traced no ray");
@@ -57,7 +48,7 @@ fn traversal_seed_corpus() {
 /// reported as failures (`Failure::Lost`) or answered correctly.
 #[test]
 fn traversal_regressions() {
-    let found = inputs("regressions/traversal");
+    let found = read_seeds("../regressions/traversal");
     assert!(found.len() >= 5);
     for (name, bytes) in found {
         assert!(traversal::check(&bytes) > 0, "{name}: traced no ray");

@@ -10,7 +10,7 @@ use glam::{DVec3, Vec3};
 use tet_core::scene::Camera;
 use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
 use tet_trace_cpu::render::PinholeCamera;
-use tet_trace_cpu::walk::{start_exit_face, step_cap};
+use tet_trace_cpu::walk::{duff_basis, start_exit_face, step_cap};
 use tet_trace_cpu::{DuffF32, Failure, Hit, Ray, Start, TraceOutcome, TripleF32};
 use wgpu::util::DeviceExt;
 
@@ -114,21 +114,6 @@ impl HitRec {
             ST_INVALID => failed(Failure::InvalidRay),
             _ => failed(Failure::Lost),
         }
-    }
-}
-
-/// Duff et al.'s basis exactly as `tet_trace_cpu::walk` builds it (f64, then
-/// rounded to f32 by the caller), so batch rays project like on the CPU.
-fn duff_basis(n: DVec3) -> (DVec3, DVec3) {
-    let sign = 1.0f64.copysign(n.z);
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    let u = DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    let v = DVec3::new(b, sign + n.y * n.y * a, -n.y);
-    if u.cross(v).dot(n) >= 0.0 {
-        (u, v)
-    } else {
-        (v, u)
     }
 }
 
