@@ -1,5 +1,6 @@
 // Body of the `mesh_file` fuzz target: arbitrary bytes given to the mesh-file
-// loader `tet_core::format::from_bytes`.
+// loader `tet_core::format::from_bytes_with_scene` (mesh + optional scene
+// block of camera and lights).
 //
 // Property: the loader returns `Ok` with a mesh that passes
 // `TetMesh::validate` and survives a save/load round trip bit for bit, or a
@@ -47,20 +48,23 @@ pub fn with_consistent_header(data: &[u8]) -> Option<Vec<u8>> {
 
 /// The property for one byte string; returns whether it loaded.
 pub fn check_bytes(data: &[u8]) -> bool {
-    match format::from_bytes(data) {
-        Ok(mesh) => {
+    match format::from_bytes_with_scene(data) {
+        Ok((mesh, scene)) => {
+            if let Err(e) = scene.validate() {
+                panic!("from_bytes_with_scene returned an unusable scene: {e}");
+            }
             if let Err(e) = mesh.validate() {
                 panic!("from_bytes returned a mesh that fails validate(): {e}");
             }
             // Round trip through the writer: same bytes again (bitwise, so
             // attribute NaN payloads and -0.0 count too).
-            let written = format::to_bytes(&mesh);
-            let reread = match format::from_bytes(&written) {
+            let written = format::to_bytes_with_scene(&mesh, &scene);
+            let (reread, rescene) = match format::from_bytes_with_scene(&written) {
                 Ok(m) => m,
                 Err(e) => panic!("a loaded mesh, written again, does not load: {e}"),
             };
             assert!(
-                format::to_bytes(&reread) == written,
+                format::to_bytes_with_scene(&reread, &rescene) == written,
                 "write(load(write(mesh))) differs from write(mesh)"
             );
             assert_eq!(reread.tets, mesh.tets);

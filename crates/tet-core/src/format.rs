@@ -11,7 +11,7 @@
 //! |-------:|-----:|-------|---------|
 //! | 0   | 8 | `magic`             | the bytes `TETMESH\0` |
 //! | 8   | 4 | `version`           | `1` ([`VERSION`]) |
-//! | 12  | 4 | `flags`             | bit 0: normals present, bit 1: uvs, bit 2: materials; other bits 0 |
+//! | 12  | 4 | `flags`             | bit 0: normals present, bit 1: uvs, bit 2: materials, bit 3: scene block; other bits 0 |
 //! | 16  | 8 | `file_length`       | total file size in bytes, header included |
 //! | 24  | 4 | `triangle_count`    | [`TetMesh::triangle_count`] |
 //! | 28  | 4 | `reserved`          | 0 |
@@ -33,6 +33,20 @@
 //! | normals     | `[f32; 3]`                                           | 12 | `point_count` (if flag bit 0) |
 //! | uvs         | `[f32; 2]`                                           | 8  | `point_count` (if flag bit 1) |
 //! | materials   | `u32`                                                | 4  | `triangle_count` (if flag bit 2) |
+//!
+//! The **scene block** (flag bit 3; see [`SceneInfo`]) has no table entry:
+//! it starts at the first 8-byte boundary after the last present section and
+//! runs to `file_length`, as 48-byte records of twelve 4-byte words — word 0
+//! the kind, words 1–11 `f32`s, unused words 0:
+//!
+//! | kind | record | words 1–11 |
+//! |-----:|--------|------------|
+//! | 1 | camera (at most one) | position xyz, target xyz, up xyz, vertical FOV in degrees, 0 |
+//! | 2 | point light | position xyz, colour rgb, intensity, 0, 0, 0, 0 |
+//!
+//! A file without the flag is byte for byte what earlier writers produced;
+//! a reader older than the flag rejects a file with it by naming the unknown
+//! flag bit, never by misreading it.
 //!
 //! An absent optional section has offset 0 and length 0. A present section
 //! has `length = count × bytes`, an offset that is a multiple of 8, not below
@@ -72,6 +86,7 @@ use thiserror::Error;
 use crate::error::MeshError;
 use crate::link::{Link, MAX_TETS};
 use crate::mesh::{Attributes, ConstrainedFace, TetMesh};
+use crate::scene::{Camera, PointLight, SceneInfo, SceneInfoError};
 
 /// The first eight bytes of every file.
 pub const MAGIC: [u8; 8] = *b"TETMESH\0";
@@ -85,7 +100,15 @@ pub const FLAG_NORMALS: u32 = 1;
 pub const FLAG_UVS: u32 = 2;
 /// Flag bit: a materials section is present.
 pub const FLAG_MATERIALS: u32 = 4;
-const KNOWN_FLAGS: u32 = FLAG_NORMALS | FLAG_UVS | FLAG_MATERIALS;
+/// Flag bit: a scene block (camera and lights) ends the file.
+pub const FLAG_SCENE: u32 = 8;
+const KNOWN_FLAGS: u32 = FLAG_NORMALS | FLAG_UVS | FLAG_MATERIALS | FLAG_SCENE;
+/// Bytes per scene-block record.
+pub const SCENE_RECORD_BYTES: u64 = 48;
+/// Most records a scene block may hold (one camera and the lights).
+pub const MAX_SCENE_RECORDS: u64 = 1 << 16;
+const SCENE_CAMERA: u32 = 1;
+const SCENE_LIGHT: u32 = 2;
 
 /// Path used in errors from [`from_bytes`].
 pub const IN_MEMORY: &str = "<in-memory>";
@@ -205,6 +228,17 @@ pub enum FormatError {
         /// The CRC of the bytes read.
         computed: u32,
     },
+    /// A scene-block record is malformed or describes an unusable camera or
+    /// light.
+    #[error("{path}: scene block record {record}: {detail}", path = .path.display())]
+    BadScene {
+        /// The file.
+        path: PathBuf,
+        /// Record index within the block.
+        record: usize,
+        /// What is wrong.
+        detail: String,
+    },
     /// The file is well formed but the mesh breaks an invariant.
     #[error("{path}: invalid mesh: {source}", path = .path.display())]
     InvalidMesh {
@@ -224,6 +258,8 @@ struct Header {
     /// (offset, length) per section; length 0 when absent.
     sections: [(u64, u64); 7],
     counts: [u64; 7],
+    /// (offset, length) of the scene block; length 0 when absent.
+    scene: (u64, u64),
     payload_crc: u32,
 }
 
@@ -403,6 +439,23 @@ fn parse_header(head: &[u8], actual: u64, path: &Path) -> Result<Header, FormatE
         sections[i] = (offset, length);
         end = section_end;
     }
+    let mut scene = (0, 0);
+    if present(FLAG_SCENE) {
+        let offset = end + padding(end);
+        let length = file_length.saturating_sub(offset);
+        let records = length / SCENE_RECORD_BYTES;
+        if length == 0 || !length.is_multiple_of(SCENE_RECORD_BYTES) || records > MAX_SCENE_RECORDS
+        {
+            return Err(bad(
+                "file_length",
+                format!(
+                    "the scene block (flag {FLAG_SCENE:#x}) from offset {offset} to the end is \
+                     {length} bytes: not 1..={MAX_SCENE_RECORDS} records of {SCENE_RECORD_BYTES}"
+                ),
+            ));
+        }
+        scene = (offset, length);
+    }
     let stored = u32_at(head, HEADER_CRC_AT);
     let computed = crc32fast::hash(&head[..HEADER_CRC_AT]);
     if stored != computed {
@@ -419,6 +472,7 @@ fn parse_header(head: &[u8], actual: u64, path: &Path) -> Result<Header, FormatE
         triangle_count,
         sections,
         counts,
+        scene,
         payload_crc: u32_at(head, PAYLOAD_CRC_AT),
     })
 }
@@ -500,7 +554,11 @@ fn from_le_words(bytes: &mut [u8]) {
 #[cfg(target_endian = "little")]
 fn from_le_words(_bytes: &mut [u8]) {}
 
-fn decode<S: Source>(src: S, header: Header, path: &Path) -> Result<TetMesh, FormatError> {
+fn decode<S: Source>(
+    src: S,
+    header: Header,
+    path: &Path,
+) -> Result<(TetMesh, SceneInfo), FormatError> {
     let mut r = PayloadReader {
         src,
         pos: HEADER_LEN as u64,
@@ -528,6 +586,11 @@ fn decode<S: Source>(src: S, header: Header, path: &Path) -> Result<TetMesh, For
     } else {
         None
     };
+    let scene_records: Vec<[u32; 12]> = if present(FLAG_SCENE) {
+        r.section(header.scene)?
+    } else {
+        Vec::new()
+    };
     r.skip_to(header.file_length)?;
     let computed = r.crc.finalize();
     if computed != header.payload_crc {
@@ -551,16 +614,114 @@ fn decode<S: Source>(src: S, header: Header, path: &Path) -> Result<TetMesh, For
             materials,
         },
     };
+    let scene = decode_scene(&scene_records, path)?;
     mesh.validate().map_err(|source| FormatError::InvalidMesh {
         path: path.to_path_buf(),
         source,
     })?;
-    Ok(mesh)
+    Ok((mesh, scene))
+}
+
+/// Parses and checks the scene block's records.
+fn decode_scene(records: &[[u32; 12]], path: &Path) -> Result<SceneInfo, FormatError> {
+    let bad = |record: usize, detail: String| FormatError::BadScene {
+        path: path.to_path_buf(),
+        record,
+        detail,
+    };
+    let mut scene = SceneInfo::default();
+    for (i, rec) in records.iter().enumerate() {
+        let f = |k: usize| f32::from_bits(rec[k]);
+        let v = |k: usize| Vec3::new(f(k), f(k + 1), f(k + 2));
+        let (used, single) = match rec[0] {
+            SCENE_CAMERA => {
+                if scene.camera.is_some() {
+                    return Err(bad(i, "a second camera".into()));
+                }
+                let camera = Camera {
+                    position: v(1),
+                    target: v(4),
+                    up: v(7),
+                    vfov_deg: f(10),
+                };
+                scene.camera = Some(camera);
+                (
+                    11,
+                    SceneInfo {
+                        camera: Some(camera),
+                        lights: Vec::new(),
+                    },
+                )
+            }
+            SCENE_LIGHT => {
+                let light = PointLight {
+                    position: v(1),
+                    color: v(4),
+                    intensity: f(7),
+                };
+                scene.lights.push(light);
+                (
+                    8,
+                    SceneInfo {
+                        camera: None,
+                        lights: vec![light],
+                    },
+                )
+            }
+            kind => return Err(bad(i, format!("unknown kind {kind}"))),
+        };
+        if let Some(k) = (used..12).find(|&k| rec[k] != 0) {
+            return Err(bad(
+                i,
+                format!("unused word {k} is {:#x}, expected 0", rec[k]),
+            ));
+        }
+        // The record is checked alone, so a light error names "light 0":
+        // the record index above is the position that matters.
+        single
+            .validate()
+            .map_err(|e: SceneInfoError| bad(i, e.to_string().replace("light 0", "light")))?;
+    }
+    Ok(scene)
+}
+
+/// Encodes `scene` as scene-block records (camera first, then lights).
+fn scene_records(scene: &SceneInfo) -> Vec<[u32; 12]> {
+    let mut out = Vec::with_capacity(scene.lights.len() + 1);
+    let put = |kind: u32, words: &[f32]| {
+        let mut rec = [0u32; 12];
+        rec[0] = kind;
+        for (k, w) in words.iter().enumerate() {
+            rec[1 + k] = w.to_bits();
+        }
+        rec
+    };
+    if let Some(c) = &scene.camera {
+        let (p, t, u) = (c.position, c.target, c.up);
+        out.push(put(
+            SCENE_CAMERA,
+            &[p.x, p.y, p.z, t.x, t.y, t.z, u.x, u.y, u.z, c.vfov_deg],
+        ));
+    }
+    for l in &scene.lights {
+        let (p, c) = (l.position, l.color);
+        out.push(put(
+            SCENE_LIGHT,
+            &[p.x, p.y, p.z, c.x, c.y, c.z, l.intensity],
+        ));
+    }
+    out
 }
 
 /// Decodes a mesh from an in-memory file image (checks as in [`load`];
-/// errors name [`IN_MEMORY`] as the path).
+/// errors name [`IN_MEMORY`] as the path). A scene block, if any, is checked
+/// and dropped; [`from_bytes_with_scene`] returns it.
 pub fn from_bytes(bytes: &[u8]) -> Result<TetMesh, FormatError> {
+    from_bytes_with_scene(bytes).map(|(mesh, _)| mesh)
+}
+
+/// [`from_bytes`], also returning the scene block (empty when absent).
+pub fn from_bytes_with_scene(bytes: &[u8]) -> Result<(TetMesh, SceneInfo), FormatError> {
     let path = Path::new(IN_MEMORY);
     let head = &bytes[..bytes.len().min(HEADER_LEN)];
     let header = parse_header(head, bytes.len() as u64, path)?;
@@ -569,7 +730,14 @@ pub fn from_bytes(bytes: &[u8]) -> Result<TetMesh, FormatError> {
 
 /// Loads a mesh saved by [`save`]: header checks against the real file size,
 /// sections read straight into typed vectors, CRCs, then [`TetMesh::validate`].
+/// A scene block, if any, is checked and dropped; [`load_with_scene`]
+/// returns it.
 pub fn load(path: impl AsRef<Path>) -> Result<TetMesh, FormatError> {
+    load_with_scene(path).map(|(mesh, _)| mesh)
+}
+
+/// [`load`], also returning the scene block (empty when absent).
+pub fn load_with_scene(path: impl AsRef<Path>) -> Result<(TetMesh, SceneInfo), FormatError> {
     let path = path.as_ref();
     let io = |source| FormatError::Io {
         path: path.to_path_buf(),
@@ -637,8 +805,19 @@ fn hash_le_words(h: &mut Hasher, bytes: &[u8]) {
 /// by [`load`] with [`FormatError::InvalidMesh`] (or a size mismatch when an
 /// attribute array has the wrong length).
 pub fn write_to(mesh: &TetMesh, w: &mut impl Write) -> io::Result<()> {
+    write_to_with_scene(mesh, &SceneInfo::default(), w)
+}
+
+/// [`write_to`] followed by a scene block holding `scene` (none when it is
+/// empty). The scene is not validated here either.
+pub fn write_to_with_scene(
+    mesh: &TetMesh,
+    scene: &SceneInfo,
+    w: &mut impl Write,
+) -> io::Result<()> {
     let sections = section_bytes(mesh);
-    let mut flags = 0;
+    let records = scene_records(scene);
+    let mut flags = if records.is_empty() { 0 } else { FLAG_SCENE };
     for (bit, s) in [
         (FLAG_NORMALS, sections[4]),
         (FLAG_UVS, sections[5]),
@@ -660,6 +839,9 @@ pub fn write_to(mesh: &TetMesh, w: &mut impl Write) -> io::Result<()> {
             end += len + padding(len);
         }
     }
+    let scene_bytes: &[u8] = bytemuck::cast_slice(&records);
+    hash_le_words(&mut crc, scene_bytes);
+    end += scene_bytes.len() as u64;
     let mut head = [0u8; HEADER_LEN];
     head[0..8].copy_from_slice(&MAGIC);
     head[8..12].copy_from_slice(&VERSION.to_le_bytes());
@@ -681,13 +863,19 @@ pub fn write_to(mesh: &TetMesh, w: &mut impl Write) -> io::Result<()> {
         write_le_words(w, bytes)?;
         w.write_all(&[0u8; 8][..padding(bytes.len() as u64) as usize])?;
     }
-    Ok(())
+    write_le_words(w, scene_bytes)
 }
 
 /// Serialises `mesh` into a new byte vector (see [`write_to`]).
 pub fn to_bytes(mesh: &TetMesh) -> Vec<u8> {
+    to_bytes_with_scene(mesh, &SceneInfo::default())
+}
+
+/// Serialises `mesh` and `scene` into a new byte vector (see
+/// [`write_to_with_scene`]).
+pub fn to_bytes_with_scene(mesh: &TetMesh, scene: &SceneInfo) -> Vec<u8> {
     let mut out = Vec::new();
-    write_to(mesh, &mut out).expect("writing to a Vec cannot fail");
+    write_to_with_scene(mesh, scene, &mut out).expect("writing to a Vec cannot fail");
     out
 }
 
@@ -695,6 +883,16 @@ pub fn to_bytes(mesh: &TetMesh) -> Vec<u8> {
 /// in the same directory, which is synced and then renamed over `path`.
 /// On error the temporary file is removed and `path` is untouched.
 pub fn save(path: impl AsRef<Path>, mesh: &TetMesh) -> Result<(), FormatError> {
+    save_with_scene(path, mesh, &SceneInfo::default())
+}
+
+/// [`save`] with a scene block holding `scene` (none when it is empty), so
+/// the file remembers the camera and lights of the scene it was built from.
+pub fn save_with_scene(
+    path: impl AsRef<Path>,
+    mesh: &TetMesh,
+    scene: &SceneInfo,
+) -> Result<(), FormatError> {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let path = path.as_ref();
     let io = |source| FormatError::Io {
@@ -720,7 +918,7 @@ pub fn save(path: impl AsRef<Path>, mesh: &TetMesh) -> Result<(), FormatError> {
     let result = (|| -> io::Result<()> {
         let file = OpenOptions::new().write(true).create_new(true).open(&tmp)?;
         let mut w = BufWriter::with_capacity(1 << 16, file);
-        write_to(mesh, &mut w)?;
+        write_to_with_scene(mesh, scene, &mut w)?;
         let file = w.into_inner().map_err(io::IntoInnerError::into_error)?;
         file.sync_all()?;
         drop(file);

@@ -121,6 +121,26 @@ fn sample_meshes() -> Vec<(&'static str, TetMesh)> {
     ]
 }
 
+/// A small mesh with a scene block (camera and two lights).
+fn scene_seed() -> Vec<u8> {
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [1, 1, 1],
+        constrained_fraction: 0.5,
+        seed: 4,
+        ..GridSpec::default()
+    });
+    let light = |x: f32| tet_core::scene::PointLight {
+        position: Vec3::new(x, 2.0, 3.0),
+        color: Vec3::ONE,
+        intensity: 0.5,
+    };
+    let scene = tet_core::scene::SceneInfo {
+        camera: Some(tet_core::scene::Camera::default()),
+        lights: vec![light(1.0), light(-1.0)],
+    };
+    format::to_bytes_with_scene(&mesh, &scene)
+}
+
 /// Seed inputs of `xor_codecs`: one per placement and grid shape, plus the
 /// all-zero and empty inputs.
 fn xor_seeds() -> Vec<(String, Vec<u8>)> {
@@ -146,6 +166,7 @@ fn write_seed_corpus() {
             sample_meshes()
                 .into_iter()
                 .map(|(name, m)| (format!("{name}.tmeshbin"), format::to_bytes(&m)))
+                .chain([("scene.tmeshbin".to_string(), scene_seed())])
                 .collect::<Vec<_>>(),
         ),
         ("xor_codecs", xor_seeds()),
