@@ -15,15 +15,15 @@
 //! 3. `cargo metadata` (handles vendored sources and `[patch]`).
 
 use std::env;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 
-/// Must equal the exact pin of `tritet` in the workspace `Cargo.toml`.
-const TRITET_VERSION: &str = "3.4.0";
-const FILES: [&str; 3] = ["tetgen.cxx", "predicates.cxx", "tetgen.h"];
+#[path = "build/locate.rs"]
+mod locate;
+use locate::FILES;
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=build/locate.rs");
     println!("cargo:rerun-if-changed=cpp/tet_shim.cpp");
     println!("cargo:rerun-if-changed=cpp/tet_shim.h");
     println!("cargo:rerun-if-env-changed=TET_BUILD_TETGEN_SRC");
@@ -70,14 +70,10 @@ fn main() {
     build.compile("tet_build_tetgen");
 }
 
-fn has_sources(dir: &Path) -> bool {
-    FILES.iter().all(|f| dir.join(f).is_file())
-}
-
 fn find_tetgen() -> Result<PathBuf, String> {
     if let Some(dir) = env::var_os("TET_BUILD_TETGEN_SRC") {
         let dir = PathBuf::from(dir);
-        return if has_sources(&dir) {
+        return if locate::has_sources(&dir) {
             Ok(dir)
         } else {
             Err(format!(
@@ -89,69 +85,11 @@ fn find_tetgen() -> Result<PathBuf, String> {
     let cargo_home = env::var_os("CARGO_HOME")
         .map(PathBuf::from)
         .or_else(|| env::var_os("HOME").map(|h| PathBuf::from(h).join(".cargo")));
-    if let Some(home) = cargo_home {
-        let registry = home.join("registry").join("src");
-        if let Ok(entries) = std::fs::read_dir(&registry) {
-            let mut candidates: Vec<PathBuf> = entries
-                .flatten()
-                .map(|e| {
-                    e.path()
-                        .join(format!("tritet-{TRITET_VERSION}"))
-                        .join("c_code")
-                })
-                .filter(|d| has_sources(d))
-                .collect();
-            candidates.sort();
-            if let Some(dir) = candidates.into_iter().next() {
-                return Ok(dir);
-            }
-        }
+    if let Some(dir) = cargo_home.and_then(|home| locate::from_registry(&home)) {
+        return Ok(dir);
     }
-    from_cargo_metadata()
-}
-
-/// Asks Cargo where the `tritet` package of the pinned version lives.
-fn from_cargo_metadata() -> Result<PathBuf, String> {
     let cargo = env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let manifest = PathBuf::from(env::var("CARGO_MANIFEST_DIR").map_err(|e| e.to_string())?)
         .join("Cargo.toml");
-    let out = Command::new(cargo)
-        .args([
-            "metadata",
-            "--format-version",
-            "1",
-            "--offline",
-            "--manifest-path",
-        ])
-        .arg(&manifest)
-        .output()
-        .map_err(|e| format!("cargo metadata: {e}"))?;
-    if !out.status.success() {
-        return Err(format!(
-            "cargo metadata failed: {}",
-            String::from_utf8_lossy(&out.stderr)
-        ));
-    }
-    let json: serde_json::Value =
-        serde_json::from_slice(&out.stdout).map_err(|e| format!("cargo metadata JSON: {e}"))?;
-    let packages = json["packages"]
-        .as_array()
-        .ok_or("no packages in cargo metadata")?;
-    for p in packages {
-        if p["name"] == "tritet"
-            && p["version"] == TRITET_VERSION
-            && let Some(m) = p["manifest_path"].as_str()
-        {
-            let dir = Path::new(m)
-                .parent()
-                .unwrap_or(Path::new("."))
-                .join("c_code");
-            if has_sources(&dir) {
-                return Ok(dir);
-            }
-        }
-    }
-    Err(format!(
-        "package tritet {TRITET_VERSION} not found by cargo metadata"
-    ))
+    locate::from_cargo_metadata(&cargo, &manifest)
 }

@@ -5,6 +5,7 @@ use serde::Serialize;
 
 use crate::cli::BuildArgs;
 use crate::load::{BuildSummary, MESH_EXTENSION, load};
+use crate::outofcore::{MemoryReport, predict, print_memory};
 
 /// The `build` document.
 #[derive(Debug, Serialize)]
@@ -23,6 +24,8 @@ pub struct BuildDoc {
     pub file_bytes: u64,
     /// Construction report.
     pub build: Option<BuildSummary>,
+    /// With `--memory-limit`: the prediction, parts and peaks (else `null`).
+    pub memory: Option<MemoryReport>,
 }
 
 /// Prints a construction report.
@@ -54,26 +57,56 @@ pub fn print_build(b: &BuildSummary) {
 
 /// `tet-bench build`.
 pub fn run(args: &BuildArgs, json: bool) -> Result<()> {
-    if args.output.extension().is_none_or(|e| e != MESH_EXTENSION) {
+    if args.predict_memory {
+        return run_predict(args, json);
+    }
+    let Some(output) = &args.output else {
+        bail!("give the output mesh file with -o FILE.{MESH_EXTENSION}");
+    };
+    if output.extension().is_none_or(|e| e != MESH_EXTENSION) {
         bail!(
             "the output file must end in .{MESH_EXTENSION} (got {})",
-            args.output.display()
+            output.display()
         );
     }
-    let loaded = load(&args.scene, &args.build, json)?;
-    tet_core::format::save(&args.output, &loaded.mesh)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
-    let file_bytes = std::fs::metadata(&args.output)
-        .map(|m| m.len())
-        .unwrap_or(0);
+    let (loaded, memory) = match args.memory_limit {
+        None => (load(&args.scene, &args.build, json)?, None),
+        Some(limit) => {
+            if args.scene.ends_with(&format!(".{MESH_EXTENSION}")) {
+                bail!(
+                    "--memory-limit builds a scene; `{}` is already a mesh file",
+                    args.scene
+                );
+            }
+            let scene = tet_build::scene::Scene::load(&args.scene)
+                .with_context(|| format!("cannot load scene `{}`", args.scene))?;
+            let (mesh, build, memory) = crate::outofcore::build_limited(
+                &scene,
+                &args.build,
+                limit,
+                args.threads
+                    .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+                json,
+                &[],
+            )?;
+            (
+                crate::load::with_mesh(scene, mesh, Some(build)),
+                Some(memory),
+            )
+        }
+    };
+    tet_core::format::save(output, &loaded.mesh)
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    let file_bytes = std::fs::metadata(output).map(|m| m.len()).unwrap_or(0);
     let doc = BuildDoc {
         name: loaded.name.clone(),
-        output: args.output.display().to_string(),
+        output: output.display().to_string(),
         points: loaded.mesh.points.len(),
         tets: loaded.mesh.tets.len(),
         constrained_faces: loaded.mesh.constrained.len(),
         file_bytes,
         build: loaded.build.clone(),
+        memory,
     };
     if json {
         println!("{}", serde_json::to_string_pretty(&doc)?);
@@ -85,6 +118,39 @@ pub fn run(args: &BuildArgs, json: bool) -> Result<()> {
         if let Some(b) = &doc.build {
             print_build(b);
         }
+        if let Some(m) = &doc.memory {
+            print_memory(m);
+        }
+    }
+    Ok(())
+}
+
+/// `build --predict-memory`: the memory model's prediction, no build.
+fn run_predict(args: &BuildArgs, json: bool) -> Result<()> {
+    if args.scene.ends_with(&format!(".{MESH_EXTENSION}")) {
+        bail!(
+            "--predict-memory predicts a TetGen run on a scene; `{}` is a mesh file",
+            args.scene
+        );
+    }
+    let scene = tet_build::scene::Scene::load(&args.scene)
+        .with_context(|| format!("cannot load scene `{}`", args.scene))?;
+    let p = predict(&scene, args.build.no_box)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&p)?);
+    } else {
+        println!(
+            "{}: TetGen input {} points + {} triangles; predicted peak memory {:.1} MiB ({} bytes) = {:.3} × ({:.2} MB + {:.0} B × {})",
+            p.name,
+            p.points,
+            p.triangles,
+            p.predicted_peak_bytes as f64 / (1024.0 * 1024.0),
+            p.predicted_peak_bytes,
+            p.model.margin,
+            p.model.base_bytes / 1e6,
+            p.model.bytes_per_element,
+            p.points + p.triangles
+        );
     }
     Ok(())
 }

@@ -4,6 +4,15 @@
 //! configuration for closest-hit single rays. It implements the same
 //! [`Tracer`] interface as the tet walks so every method renders the same
 //! rays through the same code.
+//!
+//! obvhs counts nothing, so [`BvhTracer::counting`] gives a second tracer
+//! over the *same* BVH that walks its `Bvh2` nodes with our own copy of
+//! obvhs's stack traversal ([`BvhTracer::count_trace`]: same child order,
+//! same pruning by the closest hit so far) and reports the number of nodes
+//! whose bounding box was tested (root included) as `tets_visited`: seed
+//! 000 Table 5's "visited node count per pixel" (pbrt counts a node when
+//! it tests its bounds). Timed renders use obvhs's own traversal; the
+//! counting one is run once, untimed, and checked to return the same hits.
 
 use std::time::Duration;
 
@@ -28,6 +37,9 @@ pub struct BvhTracer<'m> {
     tris: Vec<RtTriangle>,
     /// Constrained-face index of each BVH primitive.
     faces: Vec<u32>,
+    /// Trace with [`BvhTracer::count_trace`] (nodes visited reported as
+    /// `tets_visited`) instead of obvhs's traversal.
+    count_nodes: bool,
 }
 
 fn a(v: Vec3) -> Vec3A {
@@ -60,6 +72,101 @@ impl<'m> BvhTracer<'m> {
             bvh,
             tris,
             faces,
+            count_nodes: false,
+        }
+    }
+
+    /// The same BVH traced by [`BvhTracer::count_trace`]: hits as obvhs's
+    /// traversal, `tets_visited` = BVH nodes visited.
+    pub fn counting(mut self) -> Self {
+        self.count_nodes = true;
+        self
+    }
+
+    /// Nodes in the BVH.
+    #[cfg(test)]
+    pub fn node_count(&self) -> usize {
+        self.bvh.nodes.len()
+    }
+
+    /// Closest hit `(primitive in BVH order, t)` and the number of nodes
+    /// whose box was tested, by obvhs's stack traversal
+    /// (`Bvh2::ray_traverse_dynamic`) re-written with a counter: the two
+    /// children of the current node are tested together, the nearer one
+    /// is visited first, the farther one pushed; leaves are intersected
+    /// when their box is hit before the current closest hit.
+    pub fn count_trace(
+        &self,
+        ray: &BvhRay,
+        mut accept: impl FnMut(usize) -> bool,
+    ) -> (Option<(usize, f32)>, u32) {
+        let nodes = &self.bvh.nodes;
+        let mut tmax = ray.tmax;
+        let mut best: Option<(usize, f32)> = None;
+        let mut visited = 0u32;
+        let Some(root) = nodes.first() else {
+            return (None, 0);
+        };
+        visited += 1;
+        if root.aabb().intersect_ray(ray) >= tmax {
+            return (None, visited);
+        }
+        let mut leaf = |node: &obvhs::bvh2::node::Bvh2Node, tmax: &mut f32| {
+            for id in node.first_index..node.first_index + node.prim_count {
+                let id = id as usize;
+                if !accept(id) {
+                    continue;
+                }
+                let mut r = *ray;
+                r.tmax = *tmax;
+                let t = self.tris[id].intersect(&r);
+                if t < *tmax {
+                    *tmax = t;
+                    best = Some((id, t));
+                }
+            }
+        };
+        if root.is_leaf() {
+            leaf(root, &mut tmax);
+            return (best, visited);
+        }
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        let mut current = root.first_index as usize;
+        loop {
+            let (mut near, mut far) = (&nodes[current], &nodes[current + 1]);
+            visited += 2;
+            let (mut tn, mut tf) = (
+                near.aabb().intersect_ray(ray),
+                far.aabb().intersect_ray(ray),
+            );
+            if tn > tf {
+                std::mem::swap(&mut tn, &mut tf);
+                std::mem::swap(&mut near, &mut far);
+            }
+            let go_near = if tn < tmax && near.is_leaf() {
+                leaf(near, &mut tmax);
+                false
+            } else {
+                tn < tmax
+            };
+            let go_far = if tf < tmax && far.is_leaf() {
+                leaf(far, &mut tmax);
+                false
+            } else {
+                tf < tmax
+            };
+            match (go_near, go_far) {
+                (true, true) => {
+                    current = near.first_index as usize;
+                    stack.push(far.first_index);
+                }
+                (true, false) => current = near.first_index as usize,
+                (false, true) => current = far.first_index as usize,
+                (false, false) => match stack.pop() {
+                    Some(n) => current = n as usize,
+                    None => return (best, visited),
+                },
+            }
         }
     }
 
@@ -91,7 +198,11 @@ impl<'m> BvhTracer<'m> {
 
 impl Tracer for BvhTracer<'_> {
     fn name(&self) -> String {
-        "obvhs-bvh2/f32".into()
+        if self.count_nodes {
+            "obvhs-bvh2-counting/f32".into()
+        } else {
+            "obvhs-bvh2/f32".into()
+        }
     }
 
     fn mesh(&self) -> &TetMesh {
@@ -110,6 +221,19 @@ impl Tracer for BvhTracer<'_> {
             ray.t_max,
         );
         r.tmin = ray.t_min;
+        if self.count_nodes {
+            let (best, nodes) = self.count_trace(&r, |id| self.faces[id] != skip);
+            return match best {
+                Some((id, t)) => {
+                    let mut h = self.hit_record(ray, self.faces[id], t);
+                    h.tets_visited = nodes;
+                    TraceOutcome::Hit(h)
+                }
+                None => TraceOutcome::Miss {
+                    tets_visited: nodes,
+                },
+            };
+        }
         let mut hit = RayHit::none();
         let found = self.bvh.ray_traverse(r, &mut hit, |r, id| {
             if self.faces[id] == skip {
@@ -124,5 +248,65 @@ impl Tracer for BvhTracer<'_> {
         } else {
             TraceOutcome::Miss { tets_visited: 0 }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
+    use tet_trace_cpu::reference::{Aim, random_ray};
+
+    /// The counting traversal returns obvhs's hits, and visits at least
+    /// the path from the root to the hit leaf (both children tested at
+    /// every level: `1 + 2·depth` nodes) and at most every node once.
+    #[test]
+    fn counting_traversal_matches_obvhs_and_counts_the_path() {
+        let mesh = kuhn_grid(&GridSpec {
+            cells: [6; 3],
+            jitter: 0.1,
+            constrained_fraction: 0.08,
+            seed: 5,
+            ..Default::default()
+        });
+        let plain = BvhTracer::new(&mesh);
+        let counting = BvhTracer::new(&mesh).counting();
+        // Depth of each primitive's leaf, from an independent parent walk.
+        let nodes = &plain.bvh.nodes;
+        let mut depth = vec![0usize; nodes.len()];
+        let mut leaf_depth = vec![usize::MAX; plain.faces.len()];
+        for (i, n) in nodes.iter().enumerate() {
+            if n.is_leaf() {
+                for p in n.first_index..n.first_index + n.prim_count {
+                    leaf_depth[p as usize] = depth[i];
+                }
+            } else {
+                depth[n.first_index as usize] = depth[i] + 1;
+                depth[n.first_index as usize + 1] = depth[i] + 1;
+            }
+        }
+        let mut rng = SplitMix64(11);
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let (ray, tet) = random_ray(&mesh, &mut rng, Aim::Random);
+            let a = plain.trace(&ray, Start::Tet(tet));
+            let b = counting.trace(&ray, Start::Tet(tet));
+            let nodes_visited = b.tets_visited();
+            assert!(nodes_visited >= 1 && nodes_visited as usize <= counting.node_count());
+            match (a, b) {
+                (TraceOutcome::Hit(x), TraceOutcome::Hit(y)) => {
+                    hits += 1;
+                    assert_eq!((x.face, x.t), (y.face, y.t));
+                    let prim = plain.faces.iter().position(|&f| f == y.face).unwrap();
+                    assert!(nodes_visited as usize > 2 * leaf_depth[prim]);
+                }
+                (TraceOutcome::Miss { .. }, TraceOutcome::Miss { .. }) => {}
+                (x, y) => panic!("obvhs {x:?} vs counting {y:?}"),
+            }
+        }
+        assert!(
+            hits > 500,
+            "many random rays hit a constrained face: {hits}"
+        );
     }
 }

@@ -61,9 +61,22 @@ pub struct BuildFlags {
 pub struct BuildArgs {
     /// Scene: a procedural name (`torus-knots`, …), an OBJ path, or `FILE.json#Name`.
     pub scene: String,
-    /// Output mesh file.
-    #[arg(short, long)]
-    pub output: PathBuf,
+    /// Output mesh file (required unless `--predict-memory`).
+    #[arg(short, long, required_unless_present = "predict_memory")]
+    pub output: Option<PathBuf>,
+    /// Print TetGen's predicted peak memory for this scene (the memory
+    /// model of issue 8) and exit without building.
+    #[arg(long)]
+    pub predict_memory: bool,
+    /// Keep every TetGen run's predicted peak under this size (bytes, or
+    /// with a unit K, M, G: powers of 1024, e.g. 512M): over it, the scene
+    /// is built out of core in slabs with exact seams and merged.
+    #[arg(long, value_name = "BYTES", value_parser = crate::outofcore::parse_memory_limit)]
+    pub memory_limit: Option<u64>,
+    /// With `--memory-limit`: at most this many TetGen workers at once
+    /// (default: all cores); their predictions together stay under the limit.
+    #[arg(long, requires = "memory_limit")]
+    pub threads: Option<usize>,
     /// Build options.
     #[command(flatten)]
     pub build: BuildFlags,
@@ -228,4 +241,20 @@ pub struct TablesArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Measure this scene (repeatable; any SCENE as for `render`). Replaces
+    /// the default Torus Knots scenes; added to those of `--scenes`.
+    #[arg(long = "scene", value_name = "SCENE")]
+    pub scene: Vec<String>,
+    /// Directory of the SVG figures (default: the `--out` directory).
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<PathBuf>,
+    /// Image width (default: 1920, or 640 with `--quick`).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height (default: 1440, or 480 with `--quick`).
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Timed frames per method (default: 5, or 3 with `--quick`).
+    #[arg(long)]
+    pub frames: Option<u32>,
 }

@@ -57,6 +57,7 @@ pub fn time_gpu(
         median_ms: ms[ms.len() / 2],
         mrays_per_s: best.mrays_per_s(),
         tets_per_ray: best.tets_visited as f64 / best.rays.max(1) as f64,
+        nodes_per_ray: None,
         rays: best.rays,
         hits: best.hits,
         failures: best.failures,

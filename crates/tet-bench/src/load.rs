@@ -2,6 +2,7 @@
 //! loaded and built (TetGen in a worker process, killed at the time limit).
 
 use std::path::Path;
+#[cfg(feature = "tetgen")]
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
@@ -98,31 +99,40 @@ pub fn load(spec: &str, flags: &BuildFlags, quiet: bool) -> Result<Loaded> {
 /// Builds a loaded scene.
 pub fn from_scene(scene: Scene, flags: &BuildFlags, quiet: bool) -> Result<Loaded> {
     let (mesh, build) = build_scene(&scene, flags, quiet)?;
+    Ok(with_mesh(scene, mesh, Some(build)))
+}
+
+/// A scene with its already built mesh (camera and lights from the scene,
+/// or framing the mesh).
+pub fn with_mesh(scene: Scene, mesh: TetMesh, build: Option<BuildSummary>) -> Loaded {
     let camera = scene.camera.unwrap_or_else(|| framing_camera(&mesh));
     let lights = if scene.lights.is_empty() {
         vec![light_at(camera.position)]
     } else {
         scene.lights.clone()
     };
-    Ok(Loaded {
+    Loaded {
         name: scene.name.clone(),
         mesh,
         scene: Some(scene),
         camera,
         lights,
-        build: Some(build),
-    })
+        build,
+    }
 }
 
-/// The enclosing box: scene, camera and lights grown by 10 % of the largest
-/// extent on every side, so that primary and shadow rays start inside the mesh.
+/// The enclosing box: scene, camera, lights and `extra` points (the
+/// cameras and lights of other scenes sharing this mesh) grown by 10 % of
+/// the largest extent on every side, so that primary and shadow rays start
+/// inside the mesh.
 #[cfg(feature = "tetgen")]
-fn enclosing_box(scene: &Scene) -> tet_build::bbox::BoxSpec {
+pub fn enclosing_box(scene: &Scene, extra: &[Vec3]) -> tet_build::bbox::BoxSpec {
     let mut pts: Vec<Vec3> = scene.vertices.clone();
     if let Some(c) = scene.camera {
         pts.push(c.position);
     }
     pts.extend(scene.lights.iter().map(|l| l.position));
+    pts.extend_from_slice(extra);
     let (min, max) = pts
         .iter()
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
@@ -144,27 +154,40 @@ pub fn build_scene(
     flags: &BuildFlags,
     quiet: bool,
 ) -> Result<(TetMesh, BuildSummary)> {
+    build_scene_in(scene, flags, quiet, &[])
+}
+
+/// The TetGen worker: this executable re-run as `tet-bench tetgen-worker`,
+/// killed after `time_limit` seconds.
+#[cfg(feature = "tetgen")]
+pub fn worker_isolation(time_limit: f64) -> Result<tet_build::tetgen::Isolation> {
+    use tet_build::tetgen::{Isolation, WorkerCommand};
+    Ok(Isolation::Worker(WorkerCommand {
+        program: std::env::current_exe().context("cannot find this executable")?,
+        args: vec!["tetgen-worker".into()],
+        timeout: Some(Duration::from_secs_f64(time_limit.max(0.001))),
+    }))
+}
+
+/// [`build_scene`] with `extra` points inside the enclosing box (the
+/// cameras and lights of other scenes that share this mesh).
+#[cfg(feature = "tetgen")]
+pub fn build_scene_in(
+    scene: &Scene,
+    flags: &BuildFlags,
+    quiet: bool,
+    extra: &[Vec3],
+) -> Result<(TetMesh, BuildSummary)> {
     use std::sync::Arc;
     use tet_build::pipeline::{BuildOptions, build};
-    use tet_build::tetgen::{Isolation, WorkerCommand};
 
     let start = Instant::now();
-    let spinner = if quiet {
-        indicatif::ProgressBar::hidden()
-    } else {
-        let pb = indicatif::ProgressBar::new_spinner();
-        pb.enable_steady_tick(Duration::from_millis(120));
-        pb
-    };
+    let spinner = spinner(quiet);
     let pb = spinner.clone();
     let name = scene.name.clone();
     let mut options = BuildOptions {
-        isolation: Isolation::Worker(WorkerCommand {
-            program: std::env::current_exe().context("cannot find this executable")?,
-            args: vec!["tetgen-worker".into()],
-            timeout: Some(Duration::from_secs_f64(flags.time_limit.max(0.001))),
-        }),
-        enclosing_box: (!flags.no_box).then(|| enclosing_box(scene)),
+        isolation: worker_isolation(flags.time_limit)?,
+        enclosing_box: (!flags.no_box).then(|| enclosing_box(scene, extra)),
         progress: Some(Arc::new(move |p: &tet_build::pipeline::Progress| {
             pb.set_message(format!("building {name}: {:?}", p.stage));
         })),
@@ -205,7 +228,18 @@ pub fn build_scene(
 
 /// Without TetGen, scenes cannot be built.
 #[cfg(not(feature = "tetgen"))]
-pub fn build_scene(scene: &Scene, _: &BuildFlags, _: bool) -> Result<(TetMesh, BuildSummary)> {
+pub fn build_scene(scene: &Scene, f: &BuildFlags, q: bool) -> Result<(TetMesh, BuildSummary)> {
+    build_scene_in(scene, f, q, &[])
+}
+
+/// Without TetGen, scenes cannot be built.
+#[cfg(not(feature = "tetgen"))]
+pub fn build_scene_in(
+    scene: &Scene,
+    _: &BuildFlags,
+    _: bool,
+    _: &[Vec3],
+) -> Result<(TetMesh, BuildSummary)> {
     bail!(
         "`{}` is a scene, but this tet-bench was built without the `tetgen` feature: \
          pass a .{MESH_EXTENSION} mesh file instead",
@@ -241,6 +275,18 @@ fn light_at(position: Vec3) -> PointLight {
         position,
         color: Vec3::ONE,
         intensity: 1.0,
+    }
+}
+
+/// A progress spinner on stderr (hidden when `quiet`).
+#[cfg(feature = "tetgen")]
+pub fn spinner(quiet: bool) -> indicatif::ProgressBar {
+    if quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        let pb = indicatif::ProgressBar::new_spinner();
+        pb.enable_steady_tick(Duration::from_millis(120));
+        pb
     }
 }
 

@@ -6,11 +6,14 @@ mod brute;
 mod build;
 mod bvh;
 mod cli;
+mod exitface;
 mod extremes;
 mod gpu;
 mod info;
 mod load;
 mod methods;
+mod outofcore;
+mod plots;
 mod render;
 mod tables;
 

@@ -37,6 +37,10 @@ pub struct RenderDoc {
     pub mrays_per_s: f64,
     /// Mean tets visited per primary ray (0 for BVH methods).
     pub tets_per_ray: f64,
+    /// BVH methods: mean BVH nodes visited (bounding boxes tested) per
+    /// primary ray, counted in one extra untimed frame by our own traversal
+    /// of the same BVH; `null` for tet walks.
+    pub nodes_per_ray: Option<f64>,
     /// Primary rays per frame.
     pub rays: u64,
     /// Primary rays that hit.
@@ -110,6 +114,24 @@ pub fn time_method(
         frame = pool.install(run)?;
         stats.push(frame.stats);
     }
+    let mut nodes_per_ray = None;
+    if method == Method::Obvhs {
+        // Nodes visited: one untimed frame through the counting traversal
+        // (same BVH, same hits); its frame (heat map = nodes) is returned.
+        let counting = crate::bvh::BvhTracer::new(&loaded.mesh).counting();
+        let counted = pool
+            .install(|| render(&counting, &loaded.camera, &loaded.lights, opts))
+            .context("render failed")?;
+        if counted.stats.hits != frame.stats.hits {
+            bail!(
+                "the counting BVH traversal found {} hits, obvhs {}",
+                counted.stats.hits,
+                frame.stats.hits
+            );
+        }
+        nodes_per_ray = Some(counted.stats.tets_visited as f64 / counted.stats.rays.max(1) as f64);
+        frame = counted;
+    }
     let mut ms: Vec<f64> = stats.iter().map(|s| s.ms).collect();
     ms.sort_by(f64::total_cmp);
     let best = stats
@@ -129,6 +151,7 @@ pub fn time_method(
         median_ms: ms[ms.len() / 2],
         mrays_per_s: best.mrays_per_s(),
         tets_per_ray: best.tets_visited as f64 / best.rays.max(1) as f64,
+        nodes_per_ray,
         rays: best.rays,
         hits: best.hits,
         failures: best.failures,
@@ -169,8 +192,12 @@ pub fn run(args: &RenderArgs, json: bool) -> Result<()> {
     if json {
         println!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
+        let visited = match doc.nodes_per_ray {
+            Some(n) => format!("{n:.1} BVH nodes/ray"),
+            None => format!("{:.1} tets/ray", doc.tets_per_ray),
+        };
         println!(
-            "{} {} ({}) {}x{} {} threads: best {:.1} ms, median {:.1} ms, {:.2} Mrays/s, {:.1} tets/ray, {} hits, {} failures",
+            "{} {} ({}) {}x{} {} threads: best {:.1} ms, median {:.1} ms, {:.2} Mrays/s, {visited}, {} hits, {} failures",
             doc.scene,
             doc.method.name(),
             doc.tracer,
@@ -180,7 +207,6 @@ pub fn run(args: &RenderArgs, json: bool) -> Result<()> {
             doc.best_ms,
             doc.median_ms,
             doc.mrays_per_s,
-            doc.tets_per_ray,
             doc.hits,
             doc.failures
         );

@@ -111,6 +111,10 @@ fn render_and_accuracy_agree_with_the_reference() {
         b["hits"], r["hits"],
         "same camera rays hit in the BVH and the walk"
     );
+    // BVH nodes per ray: at least the root, for BVH methods only.
+    assert!(r["nodes_per_ray"].is_null());
+    let nodes = b["nodes_per_ray"].as_f64().unwrap();
+    assert!(nodes >= 1.0, "{nodes}");
 
     let a = json(&[
         "accuracy",
@@ -146,4 +150,291 @@ fn errors_are_reported_on_stderr_with_a_failure_code() {
     assert!(!out.status.success());
     assert!(out.stdout.is_empty(), "no JSON document on failure");
     assert!(String::from_utf8_lossy(&out.stderr).contains("bad.tmesh"));
+}
+
+/// Hands `tet-bench` a memory size that is not one.
+fn stderr_of(args: &[&str]) -> String {
+    let out = bench(args);
+    assert!(!out.status.success(), "{args:?} should fail");
+    assert!(out.stdout.is_empty(), "no document on failure");
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn predict_memory_counts_the_tetgen_input() {
+    // The torus knot: 120 × 12 = 1440 vertices, 2880 triangles; the box
+    // adds 8 corners and 12 triangles.
+    let p = json(&["build", "torus-knot", "--predict-memory"]);
+    assert_eq!(p["points"], 1448);
+    assert_eq!(p["triangles"], 2892);
+    let no_box = json(&["build", "torus-knot", "--predict-memory", "--no-box"]);
+    assert_eq!(no_box["points"], 1440);
+    assert_eq!(no_box["triangles"], 2880);
+    let one = p["predicted_peak_bytes"].as_u64().unwrap();
+    assert!(
+        no_box["predicted_peak_bytes"].as_u64().unwrap() < one,
+        "fewer inputs, less memory"
+    );
+    // 27 knots need more than one (and less than 27 × as much: the fixed part).
+    let many = json(&["build", "torus-knots", "--predict-memory"])["predicted_peak_bytes"]
+        .as_u64()
+        .unwrap();
+    assert!(many > 10 * one && many < 27 * one, "{one} vs {many}");
+    // Text mode prints the prediction; no output file is needed.
+    let out = bench(&["build", "torus-knot", "--predict-memory"]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("predicted peak memory"));
+}
+
+#[test]
+fn memory_limit_builds_in_parts_that_trace_like_the_in_core_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole.tmesh");
+    let parts = dir.path().join("parts.tmesh");
+    let (whole, parts) = (whole.to_str().unwrap(), parts.to_str().unwrap());
+    let predicted = json(&["build", "torus-knot", "--predict-memory"])["predicted_peak_bytes"]
+        .as_u64()
+        .unwrap();
+
+    // Over the prediction: in core, one part.
+    let big = format!("{}K", predicted / 1024 + 1);
+    let w = json(&["build", "torus-knot", "-o", whole, "--memory-limit", &big]);
+    assert_eq!(w["memory"]["out_of_core"], false);
+    assert_eq!(w["memory"]["parts"], 1);
+    assert_eq!(w["build"]["scene_triangles"], 2880);
+
+    // Under it: slabs, each predicted under the limit.
+    let limit = predicted * 3 / 4;
+    let limit_arg = limit.to_string();
+    let b = json(&[
+        "build",
+        "torus-knot",
+        "-o",
+        parts,
+        "--memory-limit",
+        &limit_arg,
+        "--threads",
+        "2",
+    ]);
+    let m = &b["memory"];
+    assert_eq!(m["out_of_core"], true);
+    assert_eq!(m["limit_bytes"].as_u64().unwrap(), limit);
+    let n = m["parts"].as_u64().unwrap() as usize;
+    assert!(n >= 2, "{m}");
+    assert_eq!(m["planes"].as_array().unwrap().len(), n - 1);
+    // The parts running at once fit the limit together.
+    let at_once = m["parallel_parts"].as_u64().unwrap();
+    assert!((1..=2).contains(&at_once), "{m}");
+    let largest = m["part_predicted_bytes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_u64().unwrap())
+        .max()
+        .unwrap();
+    assert!(at_once * largest <= limit, "{m}");
+    let part_tets: u64 = m["part_tets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_u64().unwrap())
+        .sum();
+    assert_eq!(
+        b["tets"].as_u64().unwrap(),
+        part_tets,
+        "merging keeps every tet"
+    );
+    assert!(
+        b["constrained_faces"].as_u64().unwrap() > 2880,
+        "cut triangles are kept as pieces"
+    );
+
+    // Both meshes fill the same box around the same knot: the same camera
+    // rays (framing the mesh) hit the knot in both, without failures.
+    let render = |file: &str| {
+        json(&[
+            "render", file, "--method", "tet20", "--width", "48", "--height", "36", "--frames", "1",
+        ])
+    };
+    let (a, c) = (render(whole), render(parts));
+    assert_eq!(a["failures"], 0);
+    assert_eq!(c["failures"], 0);
+    let (ha, hc) = (a["hits"].as_i64().unwrap(), c["hits"].as_i64().unwrap());
+    assert!(ha > 0);
+    assert!((ha - hc).abs() <= 2, "in core {ha} hits, out of core {hc}");
+}
+
+#[test]
+fn bad_memory_limits_are_explained() {
+    let err = stderr_of(&[
+        "build",
+        "torus-knot",
+        "-o",
+        "x.tmesh",
+        "--memory-limit",
+        "12Q",
+    ]);
+    assert!(
+        err.contains("--memory-limit") && err.contains("12Q"),
+        "{err}"
+    );
+    assert!(err.contains("512M"), "the error shows an example: {err}");
+    let err = stderr_of(&[
+        "build",
+        "torus-knot",
+        "-o",
+        "x.tmesh",
+        "--memory-limit",
+        "lots",
+    ]);
+    assert!(err.contains("lots"), "{err}");
+    // A limit below the model's fixed part cannot be met by any split.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.tmesh");
+    let err = stderr_of(&[
+        "build",
+        "torus-knot",
+        "-o",
+        out.to_str().unwrap(),
+        "--memory-limit",
+        "1M",
+    ]);
+    assert!(err.contains("raise --memory-limit"), "{err}");
+    assert!(!out.exists(), "no mesh file is written");
+    // Without -o (and without --predict-memory) clap asks for it.
+    let err = stderr_of(&["build", "torus-knot"]);
+    assert!(err.contains("--output"), "{err}");
+}
+
+/// An octahedron OBJ and a scenes.json with two cameras on it (a zoom
+/// series sharing one mesh) and a moved copy.
+fn tiny_scenes(dir: &std::path::Path) -> std::path::PathBuf {
+    std::fs::write(
+        dir.join("octa.obj"),
+        "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
+         f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n",
+    )
+    .unwrap();
+    let scene = |name: &str, distance: f64, dx: f64| {
+        format!(
+            r#"{{"name": "{name}", "camera": {{"orbit_x_rad": 0.3, "orbit_y_rad": 1.0, "distance": {distance}, "target": [0, 0, 0]}},
+              "lights": [{{"position": [3, 4, 5], "color": [1, 1, 1], "intensity": 1.0}}],
+              "objects": [{{"name": "o", "file": "octa.obj", "translation": [{dx}, 0, 0], "rotation_deg": [0, 0, 0], "scale": [1, 1, 1]}}]}}"#
+        )
+    };
+    let json = format!(
+        r#"{{"scenes": [{}, {}, {}]}}"#,
+        scene("Octa Zoom 0", 3.0, 0.0),
+        scene("Octa Zoom 1", 9.0, 0.0),
+        scene("Octa moved", 3.0, 0.5)
+    );
+    let path = dir.join("tiny.json");
+    std::fs::write(&path, json).unwrap();
+    path
+}
+
+#[test]
+fn tables_share_meshes_and_draw_one_mark_per_data_point() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = tiny_scenes(dir.path());
+    let obj = dir.path().join("octa.obj");
+    let out = dir.path().join("out");
+    let plots = dir.path().join("plots");
+    let doc = json(&[
+        "tables",
+        "--scenes",
+        scenes.to_str().unwrap(),
+        "--quick",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--frames",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+        "--plots",
+        plots.to_str().unwrap(),
+        "--scene",
+        obj.to_str().unwrap(),
+    ]);
+    let sc = doc["scenes"].as_array().unwrap();
+    assert_eq!(sc.len(), 4, "three scenes of --scenes, one of --scene");
+    for s in sc {
+        assert!(s["error"].is_null(), "{}", s["error"]);
+    }
+    // The two zoom cameras and the bare OBJ (same geometry, no camera)
+    // share one build; the moved copy is built alone.
+    assert_eq!(sc[0]["mesh_reused"], false);
+    assert_eq!(sc[1]["mesh_reused"], true);
+    assert_eq!(sc[3]["mesh_reused"], true);
+    assert_eq!(sc[1]["shares_mesh_with"][0], "Octa Zoom 0");
+    assert_eq!(sc[0]["shares_mesh_with"].as_array().unwrap().len(), 2);
+    assert_eq!(sc[2]["shares_mesh_with"].as_array().unwrap().len(), 0);
+    assert_eq!(sc[0]["info"]["tets"], sc[1]["info"]["tets"]);
+    assert_eq!(sc[0]["info"]["tets"], sc[3]["info"]["tets"]);
+    // The shared box holds the far camera of Zoom 1 although Zoom 0 (near
+    // camera) was built first: its walks start inside the mesh.
+    for r in sc[1]["renders"].as_array().unwrap() {
+        assert_eq!(r["failures"], 0, "{r}");
+        assert_eq!(r["rays"], 32 * 24);
+    }
+    // Nodes per ray for the BVH only.
+    for r in sc[0]["renders"].as_array().unwrap() {
+        assert_eq!(r["nodes_per_ray"].is_null(), r["method"] != "obvhs", "{r}");
+    }
+    // The exit-face table: every method, every decision right.
+    let stabs = doc["exit_face"]["stabs"].as_array().unwrap();
+    assert_eq!(stabs.len(), 5);
+    for r in stabs {
+        assert_eq!(r["wrong"], 0, "{r}");
+        assert!(r["ns_per_stab"].as_f64().unwrap() > 0.0);
+    }
+    assert_eq!(doc["exit_face"]["walks"].as_array().unwrap().len(), 7);
+    // Quick mode says why there is no out-of-core table.
+    assert!(
+        doc["out_of_core_note"]
+            .as_str()
+            .unwrap()
+            .contains("--quick")
+    );
+    let md = std::fs::read_to_string(out.join("tables.md")).unwrap();
+    assert!(md.contains("Exit-face search (seed 001 Table 5)"));
+    assert!(md.contains("skipped in --quick"));
+
+    // Figures: well-formed SVG with one mark per data point.
+    let figures: Vec<&str> = doc["figures"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    assert_eq!(figures.len(), 3);
+    let marks = |name: &str| {
+        let path = plots.join(name);
+        assert!(figures.contains(&path.to_str().unwrap()), "{figures:?}");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let svg = roxmltree::Document::parse(&text).expect("well-formed SVG");
+        let root = svg.root_element();
+        let (w, h) = (root.attribute("width"), root.attribute("height"));
+        let circles = svg
+            .descendants()
+            .filter(|n| n.has_tag_name("circle"))
+            .count();
+        let bars = svg
+            .descendants()
+            .filter(|n| n.has_tag_name("rect"))
+            .filter(|n| !(n.attribute("width") == w && n.attribute("height") == h))
+            .count();
+        (circles, bars)
+    };
+    let methods = sc[0]["renders"].as_array().unwrap().len();
+    let accuracy_points: usize = sc
+        .iter()
+        .map(|s| s["accuracy"]["methods"].as_array().unwrap().len())
+        .sum();
+    assert_eq!(accuracy_points, 4 * methods);
+    assert_eq!(marks("speed_vs_accuracy.svg"), (accuracy_points, 0));
+    assert_eq!(marks("mrays_per_method.svg"), (0, 4 * methods));
+    assert_eq!(marks("figure8_sorted_vs_unsorted.svg"), (0, 2 * 4));
 }

@@ -79,6 +79,7 @@ extern "C" int32_t tetshim_tetrahedralize(const double *points, int32_t npoints,
     view->nfaces = o.numberoftrifaces;
     view->faces = o.trifacelist;
     view->face_markers = o.trifacemarkerlist;
+    view->face_tets = o.adjtetlist;
     *handle = res;
     return TETSHIM_OK;
 }

@@ -17,6 +17,7 @@ typedef struct TetShimView {
     int32_t nfaces;
     const int32_t *faces;      // 3 * nfaces (constrained/boundary faces, 0-based)
     const int32_t *face_markers; // nfaces or NULL
+    const int32_t *face_tets;  // 2 * nfaces or NULL (only with -nn); -1 = none
 } TetShimView;
 
 // Status codes returned by tetshim_tetrahedralize.

@@ -16,6 +16,7 @@
 //! [`CleanMesh::triangle_source`] maps each output triangle to its input.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::{Vec2, Vec3};
 use thiserror::Error;
@@ -139,6 +140,37 @@ pub fn collinear(a: Vec3, b: Vec3, c: Vec3) -> bool {
         && o((a.z, a.x), (b.z, b.x), (c.z, c.x)) == 0.0
 }
 
+/// A multiply-rotate hasher (the "Fx" hash of rustc) for the small integer
+/// keys of [`clean`]: several times faster than SipHash, and the keys come
+/// from the caller's own scene, so there is no adversary to defend against
+/// (a collision-heavy input only costs time, never correctness).
+#[derive(Default)]
+struct FxHasher(u64);
+
+impl Hasher for FxHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut b = [0u8; 8];
+            b[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(b));
+        }
+    }
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(u64::from(v));
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_usize(&mut self, v: usize) {
+        self.write_u64(v as u64);
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+type FxMap<K, V> = HashMap<K, V, BuildHasherDefault<FxHasher>>;
+
 fn key(p: Vec3) -> [u32; 3] {
     // `+ 0.0` turns -0.0 into +0.0 so both merge.
     [
@@ -177,7 +209,8 @@ pub fn clean(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Result<CleanMesh, Cle
     };
 
     // 2. merge exactly-equal positions: rep[i] = lowest input index with that position.
-    let mut first: HashMap<[u32; 3], u32> = HashMap::with_capacity(vertices.len());
+    let mut first: FxMap<[u32; 3], u32> =
+        FxMap::with_capacity_and_hasher(vertices.len(), Default::default());
     let mut rep = Vec::with_capacity(vertices.len());
     for (i, v) in vertices.iter().enumerate() {
         let r = *first.entry(key(*v)).or_insert(i as u32);
@@ -188,7 +221,8 @@ pub fn clean(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Result<CleanMesh, Cle
     }
 
     // 3–5. filter triangles.
-    let mut seen: HashMap<[u32; 3], (u32, [u32; 3])> = HashMap::with_capacity(triangles.len());
+    let mut seen: FxMap<[u32; 3], (u32, [u32; 3])> =
+        FxMap::with_capacity_and_hasher(triangles.len(), Default::default());
     let mut kept: Vec<(u32, [u32; 3])> = Vec::with_capacity(triangles.len());
     for (t, tri) in triangles.iter().enumerate() {
         let t = t as u32;

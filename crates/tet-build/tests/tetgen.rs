@@ -4,6 +4,7 @@
 
 #![cfg(feature = "tetgen")]
 
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use tet_build::tetgen::{
@@ -400,5 +401,85 @@ fn crashed_worker_is_reported() {
             assert!(stderr.contains("boom"));
         }
         other => panic!("{other:?}"),
+    }
+}
+
+/// The build script's source locator, shared with `build.rs`.
+#[path = "../build/locate.rs"]
+mod locate;
+
+/// The `cargo metadata` route of `build.rs` (used for vendored sources,
+/// `[patch]`, or a registry outside `$CARGO_HOME`) finds the same TetGen
+/// source as the registry route the normal build takes, and the version
+/// pin it searches for is the workspace's.
+#[test]
+fn build_script_finds_tetgen_through_cargo_metadata_too() {
+    let manifest_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let workspace = std::fs::read_to_string(manifest_dir.join("../../Cargo.toml")).unwrap();
+    let pin = format!("tritet = {{ version = \"={}\"", locate::TRITET_VERSION);
+    assert!(
+        workspace.contains(&pin),
+        "workspace Cargo.toml lacks `{pin}`"
+    );
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let via_metadata =
+        locate::from_cargo_metadata(&cargo, &manifest_dir.join("Cargo.toml")).unwrap();
+    assert!(locate::has_sources(&via_metadata), "{via_metadata:?}");
+    let home = std::env::var_os("CARGO_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cargo")))
+        .unwrap();
+    if let Some(via_registry) = locate::from_registry(&home) {
+        assert_eq!(
+            via_registry.canonicalize().unwrap(),
+            via_metadata.canonicalize().unwrap()
+        );
+    }
+    // A manifest that does not exist is an error message, not a panic.
+    let err = locate::from_cargo_metadata(&cargo, Path::new("/nonexistent/Cargo.toml"));
+    assert!(err.unwrap_err().contains("cargo metadata failed"));
+    // An empty registry directory finds nothing.
+    let empty = tempfile::tempdir().unwrap();
+    assert_eq!(locate::from_registry(empty.path()), None);
+}
+
+/// `-nn`: for every output face, one of the two tets TetGen lists has that
+/// face (the other may be TetGen's unset hull-tet index on the convex hull),
+/// and a face between two tets lists both, which are neighbours.
+#[test]
+fn face_tets_name_a_tet_with_the_face() {
+    let (mut p, mut t) = cube([0.0; 3], 4.0);
+    let (pi, ti) = cube([1.0, 1.5, 1.2], 1.0);
+    let base = p.len() as u32;
+    p.extend(pi);
+    t.extend(ti.iter().map(|f| f.map(|v| v + base)));
+    let input = TetgenInput::with_index_markers(p, t);
+    let options = TetgenOptions {
+        face_tets: true,
+        ..TetgenOptions::default()
+    };
+    assert!(options.switches().contains("nn"));
+    for isolation in [Isolation::InProcess, worker(60.0)] {
+        let out = tetrahedralize(&input, &options, &isolation).unwrap();
+        let face_tets = out.face_tets.as_ref().unwrap();
+        let neighbors = out.neighbors.as_ref().unwrap();
+        assert_eq!(face_tets.len(), out.faces.len());
+        let has = |s: i32, f: [u32; 3]| {
+            usize::try_from(s)
+                .ok()
+                .and_then(|s| out.tets.get(s))
+                .is_some_and(|tet| f.iter().all(|v| tet.contains(v)))
+        };
+        let mut inner = 0;
+        for (f, sides) in out.faces.iter().zip(face_tets) {
+            assert!(has(sides[0], *f) || has(sides[1], *f), "{f:?} {sides:?}");
+            if has(sides[0], *f) && has(sides[1], *f) {
+                inner += 1;
+                let (a, b) = (sides[0] as usize, sides[1] as usize);
+                assert!(neighbors[a].contains(&(b as i32)) && neighbors[b].contains(&(a as i32)));
+            }
+        }
+        // The inner cube's 12 triangles have tets on both sides.
+        assert_eq!(inner, 12);
     }
 }

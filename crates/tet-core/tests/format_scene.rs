@@ -64,10 +64,7 @@ fn scene_round_trips_bit_for_bit() {
     assert_eq!(m2, m);
     assert_eq!(s2, s);
     // -0.0 and tiny values survive as bits, not just as equal floats.
-    assert_eq!(
-        s2.camera.unwrap().target.y.to_bits(),
-        (-0.0f32).to_bits()
-    );
+    assert_eq!(s2.camera.unwrap().target.y.to_bits(), (-0.0f32).to_bits());
     // The plain reader accepts the file and returns the same mesh.
     assert_eq!(from_bytes(&bytes).unwrap(), m);
     // Lights only, camera only.
@@ -81,7 +78,12 @@ fn scene_round_trips_bit_for_bit() {
             lights: Vec::new(),
         },
     ] {
-        assert_eq!(from_bytes_with_scene(&to_bytes_with_scene(&m, &s)).unwrap().1, s);
+        assert_eq!(
+            from_bytes_with_scene(&to_bytes_with_scene(&m, &s))
+                .unwrap()
+                .1,
+            s
+        );
     }
 }
 
@@ -95,7 +97,10 @@ fn empty_scene_writes_the_plain_file() {
     assert!(s.is_empty());
     // The block adds exactly one record per camera/light.
     let with = to_bytes_with_scene(&m, &scene());
-    assert_eq!(with.len() as u64, plain.len() as u64 + 3 * SCENE_RECORD_BYTES);
+    assert_eq!(
+        with.len() as u64,
+        plain.len() as u64 + 3 * SCENE_RECORD_BYTES
+    );
 }
 
 #[test]
@@ -125,11 +130,7 @@ fn put_word(b: &mut [u8], record: usize, word: usize, v: u32) {
     b[at..at + 4].copy_from_slice(&v.to_le_bytes());
 }
 
-fn expect_bad_scene(
-    r: Result<(TetMesh, SceneInfo), FormatError>,
-    record: usize,
-    needle: &str,
-) {
+fn expect_bad_scene(r: Result<(TetMesh, SceneInfo), FormatError>, record: usize, needle: &str) {
     match r {
         Err(FormatError::BadScene {
             record: got,
@@ -168,7 +169,11 @@ fn malformed_records_are_named() {
         0,
         "up vector",
     );
-    expect_bad_scene(patched(|b| put_word(b, 0, 10, 180f32.to_bits())), 0, "field of view");
+    expect_bad_scene(
+        patched(|b| put_word(b, 0, 10, 180f32.to_bits())),
+        0,
+        "field of view",
+    );
     expect_bad_scene(
         patched(|b| put_word(b, 2, 7, (-1f32).to_bits())),
         2,
@@ -204,7 +209,10 @@ fn block_size_and_checksum_are_checked() {
     fix_crcs(&mut b);
     assert!(matches!(
         from_bytes_with_scene(&b),
-        Err(FormatError::BadField { field: "file_length", .. })
+        Err(FormatError::BadField {
+            field: "file_length",
+            ..
+        })
     ));
     // A flipped bit in the block is caught by the payload checksum.
     let mut b = good.clone();
@@ -212,7 +220,10 @@ fn block_size_and_checksum_are_checked() {
     b[at] ^= 0x04;
     assert!(matches!(
         from_bytes_with_scene(&b),
-        Err(FormatError::ChecksumMismatch { part: "payload", .. })
+        Err(FormatError::ChecksumMismatch {
+            part: "payload",
+            ..
+        })
     ));
     // Cutting the file anywhere in the block is a typed error, never a panic.
     for cut in (good.len() - 3 * SCENE_RECORD_BYTES as usize)..good.len() {

@@ -9,6 +9,7 @@ use tet_core::TetMesh;
 use tet_core::layout::{LayoutError, LayoutMesh, LayoutRecord};
 use tet_core::link::Link;
 
+use crate::lockstep::{ExitRule, RecordWords};
 use crate::ray::{Ray, TraceOutcome};
 use crate::walk::{
     Projection, Start, Topology, prefetch_index, step_cap, trace, trace_interleaved,
@@ -68,6 +69,11 @@ impl<'m, L: Topology, P: Projection> WalkTracer<'m, L, P> {
     pub fn layout(&self) -> &L {
         &self.layout
     }
+
+    /// The step cap (tets visited before a walk reports failure).
+    pub fn step_cap(&self) -> u32 {
+        self.cap
+    }
 }
 
 impl<L: Topology, P: Projection> Tracer for WalkTracer<'_, L, P> {
@@ -82,7 +88,29 @@ impl<L: Topology, P: Projection> Tracer for WalkTracer<'_, L, P> {
         trace::<P, L>(self.mesh, &self.layout, ray, start, self.cap)
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
-        trace_interleaved::<P, L, LANES>(self.mesh, &self.layout, rays, start, self.cap, out)
+        P::trace_batch(self.mesh, &self.layout, rays, start, self.cap, out)
+    }
+}
+
+/// A [`WalkTracer`] whose batches take the scalar interleaved walk
+/// ([`trace_interleaved`], `LANES` walks per thread) whatever the
+/// projection: the reference the SIMD lockstep batches of
+/// [`crate::lockstep`] are tested and measured against.
+pub struct Interleaved<'a, 'm, L, P>(pub &'a WalkTracer<'m, L, P>);
+
+impl<L: Topology, P: Projection> Tracer for Interleaved<'_, '_, L, P> {
+    fn name(&self) -> String {
+        format!("{}/interleaved", self.0.name())
+    }
+    fn mesh(&self) -> &TetMesh {
+        self.0.mesh
+    }
+    fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
+        self.0.trace(ray, start)
+    }
+    fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
+        let w = self.0;
+        trace_interleaved::<P, L, LANES>(w.mesh, &w.layout, rays, start, w.cap, out)
     }
 }
 
@@ -100,6 +128,10 @@ pub trait WalkRecord: LayoutRecord + Sync {
     /// Raw link across the face opposite vertex `exiting`, see
     /// [`Topology::exit_link`].
     fn exit_link(&self, face: [u32; 3], d: u32, exiting: u32, entry_raw: u32) -> u32;
+    /// Where `VX` and the links sit in the record's 32-bit words, for the
+    /// gathers of the SIMD lockstep walk (see [`Topology::record_words`]);
+    /// `None`: the lockstep walk calls [`WalkRecord::exit_link`] per lane.
+    const WORDS: Option<(usize, ExitRule)> = None;
 }
 
 impl<R: WalkRecord> Topology for LayoutMesh<R> {
@@ -116,6 +148,16 @@ impl<R: WalkRecord> Topology for LayoutMesh<R> {
         if R::PREFETCH {
             prefetch_index(&self.tets, tet);
         }
+    }
+    #[inline(always)]
+    fn record_words(&self) -> Option<RecordWords<'_>> {
+        let (vx, rule) = R::WORDS?;
+        Some(RecordWords {
+            words: bytemuck::cast_slice(&self.tets),
+            stride: size_of::<R>() / 4,
+            vx,
+            rule,
+        })
     }
 }
 

@@ -15,8 +15,10 @@
 
 #![deny(missing_docs)]
 
+pub mod area_light;
 pub mod kernel;
 pub mod locate;
+pub mod lockstep;
 pub mod ray;
 pub mod reference;
 pub mod render;

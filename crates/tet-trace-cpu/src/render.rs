@@ -14,6 +14,18 @@
 //! per hit `Σ color·intensity·clamp(n·normalize(L − p), 0, 1)`, no falloff,
 //! `n` the interpolated vertex normal when the mesh has normals, else the
 //! face normal from the source triangle's winding.
+//!
+//! Shadows (seed 000 §6): each point light is located once per frame, from
+//! the camera's tet ([`LightTarget::locate_or_outside`]), and its shadow rays
+//! stop when they enter the light's tet (rule in [`crate::secondary`]).
+//! Area and mesh lights ([`crate::area_light`], passed through
+//! [`render_scene`]) add `E/π` per hit (a white Lambertian surface), with
+//! `E` estimated from [`RenderOptions::area_samples`] stratified samples per
+//! hit, jittered from [`RenderOptions::seed`] mixed with the pixel index.
+//! A scene without area lights takes none of that path. Shadow rays walk
+//! the [`ShadowTracer`] given to [`render_scene_with`] (the primary kernel
+//! itself, to measure it), or the canonical-mesh walker ([`MeshWalker`])
+//! from [`render`] and [`render_scene`], which accept any [`Tracer`].
 
 use std::io::Write;
 use std::path::Path;
@@ -25,10 +37,11 @@ use tet_core::TetMesh;
 use tet_core::scene::{Camera, PointLight};
 use thiserror::Error;
 
+use crate::area_light::{AreaLight, irradiance, irradiance_unshadowed};
 use crate::kernel::Tracer;
 use crate::locate::{LocateError, locate};
 use crate::ray::{Hit, Ray, TraceOutcome};
-use crate::secondary::{face_normal, light_visible};
+use crate::secondary::{LightTarget, MeshWalker, ShadowTracer, face_normal, trace_shadow};
 use crate::walk::Start;
 
 /// Tile edge in pixels.
@@ -52,6 +65,16 @@ pub enum RenderError {
         width: u32,
         /// Height.
         height: u32,
+    },
+    /// A point light has a non-finite position.
+    #[error("point light {index} at {position:?}: {source}")]
+    Light {
+        /// Index in the light list.
+        index: usize,
+        /// Its position.
+        position: Vec3,
+        /// Why.
+        source: LocateError,
     },
     /// Writing a PNG failed.
     #[error("writing {path}: {source}")]
@@ -87,6 +110,11 @@ pub struct RenderOptions {
     /// Shade only (no light) with the normal's absolute cosine to the view:
     /// useful when the scene has no lights.
     pub headlight: bool,
+    /// Samples per hit and area light (rounded up to a full stratification
+    /// grid, see [`crate::area_light::strata`]).
+    pub area_samples: u32,
+    /// Seed of the area-light sample jitter (mixed with the pixel index).
+    pub seed: u64,
 }
 
 impl Default for RenderOptions {
@@ -98,6 +126,8 @@ impl Default for RenderOptions {
             pixel_centers: false,
             background: 0.1,
             headlight: false,
+            area_samples: 16,
+            seed: 0,
         }
     }
 }
@@ -115,8 +145,10 @@ pub struct FrameStats {
     pub tets_visited: u64,
     /// Primary rays that failed (step cap, lost).
     pub failures: u64,
-    /// Shadow rays cast.
+    /// Shadow rays cast (point and area lights).
     pub shadow_rays: u64,
+    /// Shadow rays whose walk failed (counted as lit).
+    pub shadow_failures: u64,
 }
 
 impl FrameStats {
@@ -214,14 +246,63 @@ struct Pixel {
     hit: bool,
     failed: bool,
     shadow_rays: u32,
+    shadow_failures: u32,
+}
+
+/// The lights of a scene: point lights and area / mesh lights.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Lights<'a> {
+    /// Point lights.
+    pub points: &'a [PointLight],
+    /// Area and mesh lights.
+    pub areas: &'a [AreaLight],
+}
+
+/// Per-frame light data: point lights with their located stars.
+struct FrameLights<'a> {
+    points: Vec<(&'a PointLight, LightTarget)>,
+    areas: &'a [AreaLight],
 }
 
 /// Renders one frame with `tracer`. The camera is located once (from tet 0);
-/// every primary ray starts in its tet.
+/// every primary ray starts in its tet. Point lights only; shadow rays (when
+/// [`RenderOptions::shadows`]) walk the canonical mesh ([`MeshWalker`]).
 pub fn render<T: Tracer + ?Sized>(
     tracer: &T,
     camera: &Camera,
     lights: &[PointLight],
+    opts: &RenderOptions,
+) -> Result<Frame, RenderError> {
+    let lights = Lights {
+        points: lights,
+        areas: &[],
+    };
+    render_scene(tracer, camera, &lights, opts)
+}
+
+/// [`render`] with point and area lights.
+pub fn render_scene<T: Tracer + ?Sized>(
+    tracer: &T,
+    camera: &Camera,
+    lights: &Lights<'_>,
+    opts: &RenderOptions,
+) -> Result<Frame, RenderError> {
+    render_scene_with(
+        tracer,
+        &MeshWalker::new(tracer.mesh()),
+        camera,
+        lights,
+        opts,
+    )
+}
+
+/// [`render_scene`] with shadow rays walked by `shadow` (e.g. the primary
+/// kernel itself, which implements [`ShadowTracer`]).
+pub fn render_scene_with<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
+    tracer: &T,
+    shadow: &S,
+    camera: &Camera,
+    lights: &Lights<'_>,
     opts: &RenderOptions,
 ) -> Result<Frame, RenderError> {
     let (w, h) = (opts.width, opts.height);
@@ -237,6 +318,26 @@ pub fn render<T: Tracer + ?Sized>(
         position: camera.position,
         source,
     })?;
+    let mut points = Vec::with_capacity(lights.points.len());
+    for (index, light) in lights.points.iter().enumerate() {
+        // Located only when shadow rays need the star.
+        let target = if opts.shadows && !opts.headlight {
+            LightTarget::locate_or_outside(mesh, light.position, start).map_err(|source| {
+                RenderError::Light {
+                    index,
+                    position: light.position,
+                    source,
+                }
+            })?
+        } else {
+            LightTarget::outside(light.position)
+        };
+        points.push((light, target));
+    }
+    let frame_lights = FrameLights {
+        points,
+        areas: lights.areas,
+    };
     let cam = PinholeCamera::new(camera, w, h, opts.pixel_centers);
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
@@ -245,9 +346,11 @@ pub fn render<T: Tracer + ?Sized>(
         .map(|tile| {
             let (tx, ty) = (tile % tiles_x, tile / tiles_x);
             let mut rays = Vec::with_capacity((TILE * TILE) as usize);
+            let mut ids = Vec::with_capacity((TILE * TILE) as usize);
             for j in ty * TILE..((ty + 1) * TILE).min(h) {
                 for i in tx * TILE..((tx + 1) * TILE).min(w) {
                     rays.push(cam.ray(i, j));
+                    ids.push(j * w + i);
                 }
             }
             let mut outcomes = vec![TraceOutcome::Miss { tets_visited: 0 }; rays.len()];
@@ -255,7 +358,8 @@ pub fn render<T: Tracer + ?Sized>(
             let out = rays
                 .iter()
                 .zip(outcomes)
-                .map(|(ray, o)| shade(tracer, mesh, ray, o, lights, opts))
+                .zip(&ids)
+                .map(|((ray, o), &k)| shade(shadow, mesh, ray, o, k, &frame_lights, opts))
                 .collect();
             (tile, out)
         })
@@ -284,6 +388,7 @@ pub fn render<T: Tracer + ?Sized>(
                 frame.stats.failures += p.failed as u64;
                 frame.stats.tets_visited += p.tets as u64;
                 frame.stats.shadow_rays += p.shadow_rays as u64;
+                frame.stats.shadow_failures += p.shadow_failures as u64;
             }
         }
     }
@@ -291,12 +396,23 @@ pub fn render<T: Tracer + ?Sized>(
     Ok(frame)
 }
 
-fn shade<T: Tracer + ?Sized>(
-    tracer: &T,
+/// Per-pixel seed of the area-light jitter: the frame seed mixed with the
+/// pixel index (SplitMix64's finaliser).
+fn pixel_seed(seed: u64, pixel: u32) -> u64 {
+    let mut z = seed ^ (pixel as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn shade<S: ShadowTracer + ?Sized>(
+    shadow: &S,
     mesh: &TetMesh,
     ray: &Ray,
     out: TraceOutcome,
-    lights: &[PointLight],
+    pixel: u32,
+    lights: &FrameLights<'_>,
     opts: &RenderOptions,
 ) -> Pixel {
     let mut px = Pixel {
@@ -306,6 +422,7 @@ fn shade<T: Tracer + ?Sized>(
         hit: false,
         failed: out.is_failure(),
         shadow_rays: 0,
+        shadow_failures: 0,
     };
     let TraceOutcome::Hit(hit) = out else {
         return px;
@@ -319,7 +436,7 @@ fn shade<T: Tracer + ?Sized>(
         return px;
     }
     let mut c = Vec3::ZERO;
-    for light in lights {
+    for (light, target) in &lights.points {
         let l = (light.position - p).normalize_or_zero();
         let cos = n.dot(l).clamp(0.0, 1.0);
         if cos <= 0.0 {
@@ -327,11 +444,27 @@ fn shade<T: Tracer + ?Sized>(
         }
         if opts.shadows {
             px.shadow_rays += 1;
-            if !light_visible(tracer, &hit, light.position) {
-                continue;
+            match trace_shadow(shadow, &hit, target) {
+                Some(TraceOutcome::Hit(_)) => continue,
+                Some(TraceOutcome::Failed { .. }) => px.shadow_failures += 1,
+                _ => {}
             }
         }
         c += light.color * light.intensity * cos;
+    }
+    for (k, light) in lights.areas.iter().enumerate() {
+        let seed = pixel_seed(
+            opts.seed ^ (k as u64).wrapping_mul(0xD6E8_FEB8_6659_FD93),
+            pixel,
+        );
+        let e = if opts.shadows {
+            irradiance(shadow, &hit, n, light, opts.area_samples, seed)
+        } else {
+            irradiance_unshadowed(mesh, &hit, n, light, opts.area_samples, seed)
+        };
+        px.shadow_rays += e.rays;
+        px.shadow_failures += e.failures;
+        c += e.irradiance * std::f32::consts::FRAC_1_PI;
     }
     px.color = c;
     px

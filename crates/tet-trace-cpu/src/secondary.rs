@@ -7,13 +7,70 @@
 //! the walk never meets that face again and needs no epsilon offset.
 //! `front`/`back` follow [`tet_core::ConstrainedFace`]: the front side is the
 //! one the triangle's normal (right-hand rule on `vertices`) points to.
+//!
+//! # Shadow rays that end at the light's tet (§6)
+//!
+//! The paper locates each point light once per frame and stops a shadow walk
+//! "if the tetrahedron that contains the light source is reached". Here:
+//!
+//! * [`LightTarget::locate`] locates the light `L` exactly
+//!   ([`crate::locate::locate`]) and keeps its **star**: every tet whose
+//!   *closed* cell contains `L` ([`crate::locate::star`]). For `L` strictly
+//!   inside a tet that is one tet; on a face two, on an edge the ring of tets
+//!   around it, on a vertex every tet incident to it — across constrained
+//!   faces too.
+//! * The shadow ray runs from the hit point `P` (on the hit face, starting
+//!   in the tet on `L`'s side, [`start_beyond`]) with direction `L − P` and
+//!   `t_max = 1`. The walk ([`ShadowTracer::trace_until`]) reports
+//!   **unoccluded** as soon as it *enters* a star tet, or when the first
+//!   constrained face it crosses lies beyond the light (`t > 1`, computed in
+//!   f64 as for every hit) or it leaves the mesh; it reports **occluded**
+//!   when it crosses a constrained face at `t ≤ 1` before entering a star
+//!   tet. Whichever the walk sees first decides.
+//!
+//! The hit face itself never occludes: the shadow ray starts on it, in the
+//! tet on the light's side, whichever side the primary ray came from (a light
+//! behind the surface gets no light from the Lambert term anyway).
+//!
+//! Why the star and not only the located tet: the ray reaches `L` in the
+//! closure of whichever tet around `L` the walk happens to be in, which is
+//! decided by the walk's tie rule, not by [`crate::locate::locate`]. With the
+//! whole star, reaching `L` always means entering a star tet first, so the
+//! decision never depends on rounding at `t ≈ 1`. Consequences, exactly:
+//!
+//! * **Light strictly inside a tet, or on a non-constrained face, edge or
+//!   vertex**: the segment `P L` is unoccluded iff no constrained face meets
+//!   it before `L` (the walk enters the star from the segment's last tets).
+//! * **Light on a constrained face (or its edge / vertex)**: the star holds
+//!   the tets on both sides, so the light shines on both sides of that face;
+//!   the face it lies on never shadows it (the segment touches it only at
+//!   `L`). Other faces still do.
+//! * **Light inside a region cut off by constrained faces** (a set of tets
+//!   connected through non-constrained faces, bounded by constrained faces —
+//!   e.g. inside a closed object): if `L` is not on the region's boundary,
+//!   the star lies inside the region, and a walk from any `P` outside it must
+//!   cross a boundary face before it can enter a star tet, so the light is
+//!   occluded from every point outside the region. That crossing lies at
+//!   `t < 1` exactly; in f64 it could only round past 1 if `L` were within
+//!   f64 rounding (~1e-15 relative) of the face's plane without being on it.
+//! * **Light outside the mesh** ([`LightTarget::outside`], no star): the
+//!   shadow ray ends at the light's distance (`t_max = 1`) or at the mesh
+//!   boundary (the previous rule, still used by [`light_visible`]).
+//!
+//! The stop test costs one comparison per step for a light inside a tet
+//! (a short scan for a light on an edge or vertex). It is implemented as a
+//! [`Topology`] wrapper ([`StopAt`]) that reports the mesh boundary when the
+//! walk asks for the exit link of a star tet, so the projected walks reuse
+//! the watertight engine unchanged ([`crate::walk::trace`]); Tet80 checks
+//! the tet at the top of its loop.
 
 use glam::Vec3;
-use tet_core::{NO_TET, TetMesh};
+use tet_core::{Link, NO_TET, TetMesh};
 
-use crate::kernel::Tracer;
+use crate::kernel::{Tracer, WalkTracer};
+use crate::locate::{LocateError, locate, star};
 use crate::ray::{Hit, Ray, TraceOutcome};
-use crate::walk::Start;
+use crate::walk::{DuffF32, Projection, Start, Topology, step_cap, trace};
 
 /// Unit geometric normal of a hit's face (from the source triangle winding).
 pub fn face_normal(mesh: &TetMesh, face: u32) -> Vec3 {
@@ -117,4 +174,247 @@ fn cast<T: Tracer + ?Sized>(tracer: &T, hit: &Hit, dir: Vec3) -> Traced {
     let ray = Ray::new(hit_point(mesh, hit), dir);
     let outcome = start_beyond(mesh, hit.face, dir).map(|s| tracer.trace(&ray, s));
     Traced { ray, outcome }
+}
+
+/// Most tets kept in a light's star (a vertex of a valid mesh has far fewer).
+pub const MAX_STAR: usize = 4096;
+
+/// A point light located in the mesh: its position and its star (every tet
+/// whose closed cell contains it; empty for a light outside the mesh). See
+/// the module docs for the stopping rule.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightTarget {
+    /// The light's position.
+    pub position: Vec3,
+    /// Sorted star tets.
+    tets: Vec<u32>,
+}
+
+impl LightTarget {
+    /// Locates `position` by walking from `source` and collects its star.
+    /// Errors as [`locate`] does (outside the mesh, non-finite, bad source).
+    pub fn locate(mesh: &TetMesh, position: Vec3, source: u32) -> Result<Self, LocateError> {
+        let t = locate(mesh, position, source)?;
+        let mut tets = star(mesh, position, t, MAX_STAR);
+        tets.sort_unstable();
+        tets.dedup();
+        Ok(LightTarget { position, tets })
+    }
+
+    /// A light with no star (outside the mesh): shadow rays end at its
+    /// distance.
+    pub fn outside(position: Vec3) -> Self {
+        LightTarget {
+            position,
+            tets: Vec::new(),
+        }
+    }
+
+    /// [`LightTarget::locate`], or [`LightTarget::outside`] when the light
+    /// lies outside the mesh (other errors are returned).
+    pub fn locate_or_outside(
+        mesh: &TetMesh,
+        position: Vec3,
+        source: u32,
+    ) -> Result<Self, LocateError> {
+        match Self::locate(mesh, position, source) {
+            Err(LocateError::OutsideMesh { .. }) => Ok(Self::outside(position)),
+            r => r,
+        }
+    }
+
+    /// The star tets (sorted; empty for a light outside the mesh).
+    pub fn tets(&self) -> &[u32] {
+        &self.tets
+    }
+}
+
+/// True when `tet` is in the sorted set `stop` (a linear scan for the usual
+/// one or two tets, binary search beyond).
+#[inline(always)]
+pub fn stops_at(stop: &[u32], tet: u32) -> bool {
+    if stop.len() <= 8 {
+        stop.contains(&tet)
+    } else {
+        stop.binary_search(&tet).is_ok()
+    }
+}
+
+/// A [`Topology`] that ends the walk when it enters a tet of `stop`: the exit
+/// link of such a tet reads as the mesh boundary, so the walk reports a
+/// [`TraceOutcome::Miss`] there (for a shadow ray: unoccluded). Everything
+/// else is forwarded to `inner` unchanged (same decisions, same
+/// watertightness).
+#[derive(Clone, Copy, Debug)]
+pub struct StopAt<'a, T> {
+    /// The layout walked.
+    pub inner: &'a T,
+    /// Sorted tets at which the walk stops.
+    pub stop: &'a [u32],
+}
+
+impl<T: Topology> Topology for StopAt<'_, T> {
+    #[inline(always)]
+    fn vx(&self, tet: u32) -> u32 {
+        self.inner.vx(tet)
+    }
+    #[inline(always)]
+    fn exit_link(&self, tet: u32, face: [u32; 3], d: u32, exiting: u32, entry_raw: u32) -> u32 {
+        if stops_at(self.stop, tet) {
+            Link::BOUNDARY.0
+        } else {
+            self.inner.exit_link(tet, face, d, exiting, entry_raw)
+        }
+    }
+    #[inline(always)]
+    fn prefetch(&self, tet: u32) {
+        self.inner.prefetch(tet)
+    }
+}
+
+/// The canonical mesh as a [`Topology`] (`tets` + `neighbors`, neighbour `k`
+/// opposite vertex `k`): lets any tracer's shadow rays walk without a
+/// layout. An out-of-range tet reads as the boundary, never a panic.
+#[derive(Clone, Copy, Debug)]
+pub struct MeshTopology<'m>(pub &'m TetMesh);
+
+impl Topology for MeshTopology<'_> {
+    #[inline(always)]
+    fn vx(&self, tet: u32) -> u32 {
+        self.0
+            .tets
+            .get(tet as usize)
+            .map_or(0, |v| v[0] ^ v[1] ^ v[2] ^ v[3])
+    }
+    #[inline(always)]
+    fn exit_link(&self, tet: u32, _face: [u32; 3], _d: u32, exiting: u32, _entry: u32) -> u32 {
+        let (Some(v), Some(n)) = (
+            self.0.tets.get(tet as usize),
+            self.0.neighbors.get(tet as usize),
+        ) else {
+            return Link::BOUNDARY.0;
+        };
+        let k = if exiting == v[0] {
+            0
+        } else if exiting == v[1] {
+            1
+        } else if exiting == v[2] {
+            2
+        } else {
+            3
+        };
+        n[k].0
+    }
+}
+
+/// A tracer of shadow rays that can stop when the walk enters given tets.
+pub trait ShadowTracer: Sync {
+    /// The canonical mesh.
+    fn mesh(&self) -> &TetMesh;
+    /// Traces `ray` from `start` like [`Tracer::trace`], but reports
+    /// [`TraceOutcome::Miss`] as soon as the walk enters a tet of `stop`
+    /// (sorted; see [`stops_at`]), including the start tet.
+    fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome;
+}
+
+/// Shadow rays walked on the canonical mesh with the f32 2-D projection
+/// (the watertight engine of [`crate::walk`]): usable with any primary
+/// tracer, including ones that are not tet walks.
+#[derive(Clone, Copy, Debug)]
+pub struct MeshWalker<'m> {
+    mesh: &'m TetMesh,
+    cap: u32,
+}
+
+impl<'m> MeshWalker<'m> {
+    /// A walker over `mesh` (which must be valid) with the default step cap.
+    pub fn new(mesh: &'m TetMesh) -> Self {
+        MeshWalker {
+            mesh,
+            cap: step_cap(mesh),
+        }
+    }
+}
+
+/// True when a walk starting at `start` already starts in a stop tet.
+fn starts_in(start: Start, stop: &[u32]) -> bool {
+    match start {
+        Start::Tet(t) => stops_at(stop, t),
+        Start::Face { tet, .. } => stops_at(stop, tet),
+    }
+}
+
+fn stopped_at_start() -> TraceOutcome {
+    TraceOutcome::Miss { tets_visited: 1 }
+}
+
+impl ShadowTracer for MeshWalker<'_> {
+    fn mesh(&self) -> &TetMesh {
+        self.mesh
+    }
+    fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
+        if ray.is_valid() && starts_in(start, stop) {
+            return stopped_at_start();
+        }
+        let topo = StopAt {
+            inner: &MeshTopology(self.mesh),
+            stop,
+        };
+        trace::<DuffF32, _>(self.mesh, &topo, ray, start, self.cap)
+    }
+}
+
+/// Every projected-walk kernel walks its shadow rays on its own layout.
+impl<L: Topology, P: Projection> ShadowTracer for WalkTracer<'_, L, P> {
+    fn mesh(&self) -> &TetMesh {
+        Tracer::mesh(self)
+    }
+    fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
+        if ray.is_valid() && starts_in(start, stop) {
+            return stopped_at_start();
+        }
+        let mesh = Tracer::mesh(self);
+        let topo = StopAt {
+            inner: self.layout(),
+            stop,
+        };
+        trace::<P, _>(mesh, &topo, ray, start, step_cap(mesh))
+    }
+}
+
+/// The shadow ray from the hit point of `hit` to `light` (`t_max = 1`) and
+/// where it starts; `None` when no tet lies on the light's side of the hit
+/// face (the light is beyond the mesh boundary or in the face's plane).
+pub fn shadow_ray(mesh: &TetMesh, hit: &Hit, light: Vec3) -> Option<(Ray, Start)> {
+    let p = hit_point(mesh, hit);
+    let dir = light - p;
+    let start = start_beyond(mesh, hit.face, dir)?;
+    Some((
+        Ray {
+            origin: p,
+            direction: dir,
+            t_min: 0.0,
+            t_max: 1.0,
+        },
+        start,
+    ))
+}
+
+/// Traces the shadow ray from `hit` to `light` with the rule of the module
+/// docs: [`TraceOutcome::Miss`] = unoccluded, [`TraceOutcome::Hit`] = the
+/// occluder, [`TraceOutcome::Failed`] = the walk failed. `None` when no ray
+/// is cast (see [`shadow_ray`]; counts as unoccluded).
+pub fn trace_shadow<S: ShadowTracer + ?Sized>(
+    shadow: &S,
+    hit: &Hit,
+    light: &LightTarget,
+) -> Option<TraceOutcome> {
+    let (ray, start) = shadow_ray(shadow.mesh(), hit, light.position)?;
+    Some(shadow.trace_until(&ray, start, &light.tets))
+}
+
+/// True when `light` lights the hit point of `hit` under the rule of the
+/// module docs (a failed walk counts as lit).
+pub fn visible_from<S: ShadowTracer + ?Sized>(shadow: &S, hit: &Hit, light: &LightTarget) -> bool {
+    !matches!(trace_shadow(shadow, hit, light), Some(TraceOutcome::Hit(_)))
 }

@@ -12,11 +12,13 @@
 use tet_core::layout::{Tet16, Tet16Mesh, rank_of};
 
 use crate::kernel::{WalkRecord, WalkTracer};
+use crate::lockstep::ExitRule;
 use crate::walk::{DuffF32, DuffF64};
 
 impl WalkRecord for Tet16 {
     const KERNEL: &'static str = "tet16";
     const PREFETCH: bool = true;
+    const WORDS: Option<(usize, ExitRule)> = Some((0, ExitRule::RankXor { links: 1 }));
     #[inline(always)]
     fn vx(&self) -> u32 {
         self.vx

@@ -20,11 +20,13 @@
 use tet_core::layout::{Tet20, Tet20Mesh, rank_of};
 
 use crate::kernel::{WalkRecord, WalkTracer};
+use crate::lockstep::ExitRule;
 use crate::walk::{DuffF32, DuffF64};
 
 impl WalkRecord for Tet20 {
     const KERNEL: &'static str = "tet20";
     const PREFETCH: bool = true;
+    const WORDS: Option<(usize, ExitRule)> = Some((0, ExitRule::Rank { links: 1 }));
     #[inline(always)]
     fn vx(&self) -> u32 {
         self.vx

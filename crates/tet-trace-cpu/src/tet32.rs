@@ -10,11 +10,13 @@
 use tet_core::layout::{Tet32, Tet32Mesh};
 
 use crate::kernel::{WalkRecord, WalkTracer, slot_exit_link};
+use crate::lockstep::ExitRule;
 use crate::walk::{DuffF32, DuffF64};
 
 impl WalkRecord for Tet32 {
     const KERNEL: &'static str = "tet32";
     const PREFETCH: bool = true;
+    const WORDS: Option<(usize, ExitRule)> = Some((3, ExitRule::Slot { ids: 0, links: 4 }));
     #[inline(always)]
     fn vx(&self) -> u32 {
         self.vx

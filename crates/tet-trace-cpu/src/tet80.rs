@@ -13,19 +13,49 @@
 //! `m = d × (V_e − o)` computed once per tet (6 mul + 3 sub for `m`, then
 //! 3 sub + 3 mul + 2 add per side product). Exactly two side products decide
 //! the exit face, looked up in a 4 × 4 table ([`EXIT`]) indexed by the entry
-//! face and the two signs (paper: 28 operations per tet). The start tet uses
-//! the three-side-product test of the engine ([`crate::walk::start_exit_face`]).
+//! face and the two signs (paper: 28 operations per tet).
+//!
+//! # Start tet: Algorithm 2 (paper §3.3)
+//!
+//! For a ray whose origin lies strictly inside the start tet,
+//! [`Tet80Tracer::algorithm2_exit_face`] computes one side product with
+//! the edge `V₂ → V₃` shared by `F₀` and `F₁`: the ray must pass left of an
+//! outward edge of its exit face, and `V₂ → V₃` is outward in `F₀` while
+//! `V₃ → V₂` is outward in `F₁`, so a positive product rules out `F₁` and
+//! a negative (or zero) one `F₀`. The ruled-out face then serves as a
+//! *fake entry* for Algorithm 1, which picks the exit among the three faces
+//! around its complement vertex. Operation count: the first side product
+//! `(V₃ − V₂) · (d × (V₂ − o))` is 3 sub + (6 mul + 3 sub) + 3 sub +
+//! (3 mul + 2 add) = 20 operations, then Algorithm 1's 28: **48 operations,
+//! three side products**, against the engine's four-face test (four
+//! projected vertices, 12 sub, then up to 12 triple products
+//! `d · (qₐ × q_b)` of 14 operations each: up to 180, 96 if the six edge
+//! products were shared). Paper ↔ code: `Λr ⊙ V₂V₃` = `s23`, `f` =
+//! the fake entry `entry ∈ {0, 1}`, `ExitTetra(F_f, Λr)` = `exit_face`.
+//!
+//! Algorithm 2 tests the ray's *line*, which is only right when the origin
+//! is inside the tet: an origin on a face, edge or vertex (a camera placed
+//! there, a ray started on a feature) may leave at once through a face the
+//! line does not exit by. So the start first checks, with exact
+//! orientation tests, that the origin is strictly inside the start tet
+//! ([`Tet80Tracer::strictly_inside`]) — once per batch in
+//! [`Tracer::trace_batch`] when the rays share their origin (primary rays),
+//! once per ray otherwise — and falls back to the engine's search over the
+//! tets around the origin ([`crate::walk::start_exit_face`]) when it is not.
 //!
 //! Not watertight by construction: the side product of one edge is computed
 //! in the frame of a different vertex in each tet around it, so two tets can
 //! disagree on a ray that grazes the edge, and zero is simply "right". Maria
 //! et al. report no failures in f32; the tests measure it.
 
+use glam::Vec3;
 use tet_core::layout::{LayoutError, Tet80Face, Tet80Mesh};
+use tet_core::predicates::orient3d;
 use tet_core::{FACE_VERTICES, NO_TET, TetMesh};
 
 use crate::kernel::Tracer;
 use crate::ray::{Failure, Hit, Ray, TraceOutcome};
+use crate::secondary::{ShadowTracer, stops_at};
 use crate::walk::{Start, TripleF32, degenerate_crossing, face_hit, start_exit_face, step_cap};
 
 /// `EXIT[e][2·s₁ + s₂]`: the exit face of a tet entered through face `e`,
@@ -89,7 +119,18 @@ impl<'m> Tet80Tracer<'m> {
         &self.layout
     }
 
-    fn walk(&self, ray: &Ray, mut tet: u32, mut entry: usize, mut visited: u32) -> TraceOutcome {
+    /// The walk from `tet`, entered through face `entry`. `stop(tet)` ends
+    /// it as a [`TraceOutcome::Miss`] on entering `tet` (shadow rays;
+    /// monomorphised away for primary rays).
+    #[inline(always)]
+    fn walk<S: Fn(u32) -> bool>(
+        &self,
+        ray: &Ray,
+        mut tet: u32,
+        mut entry: usize,
+        mut visited: u32,
+        stop: S,
+    ) -> TraceOutcome {
         let tets = &self.layout.tets[..];
         let (o, d) = (ray.origin, ray.direction);
         loop {
@@ -100,14 +141,13 @@ impl<'m> Tet80Tracer<'m> {
                 };
             }
             visited += 1;
+            if stop(tet) {
+                return TraceOutcome::Miss {
+                    tets_visited: visited,
+                };
+            }
             let rec = &tets[tet as usize];
-            let apex = rec.vertex(entry);
-            let m = d.cross(apex - o);
-            let a = FACE_VERTICES[entry][0];
-            let s1 = (rec.vertex(a) - apex).dot(m) > 0.0;
-            let second = SECOND[entry][s1 as usize] as usize;
-            let s2 = (rec.vertex(second) - apex).dot(m) > 0.0;
-            let exit = EXIT[entry][2 * s1 as usize + s2 as usize] as usize;
+            let exit = exit_face(|k| rec.vertex(k), o, d, entry);
             match self.leave(ray, tet, rec.f[exit], visited) {
                 Ok((n, f)) => {
                     tet = n;
@@ -163,14 +203,43 @@ impl<'m> Tet80Tracer<'m> {
     }
 }
 
-impl Tracer for Tet80Tracer<'_> {
-    fn name(&self) -> String {
-        "tet80/f32".into()
+impl Tet80Tracer<'_> {
+    /// Maria et al.'s Algorithm 2 on start tet `tet` (see [`algorithm2`]).
+    #[inline(always)]
+    pub fn algorithm2_exit_face(&self, ray: &Ray, tet: u32) -> usize {
+        let rec = &self.layout.tets[tet as usize];
+        algorithm2(|k| rec.vertex(k), ray.origin, ray.direction)
     }
-    fn mesh(&self) -> &TetMesh {
-        self.mesh
+
+    /// The start of a walk from `Start::Tet(t)`: the start tet and its exit
+    /// face. Algorithm 2 when the origin lies strictly inside `t`
+    /// (`inside`), else the engine's search over the tets around an origin
+    /// on a face, edge or vertex ([`start_exit_face`]).
+    fn start_tet(&self, ray: &Ray, t: u32, inside: bool) -> Option<(u32, usize)> {
+        if inside {
+            Some((t, self.algorithm2_exit_face(ray, t)))
+        } else {
+            start_exit_face::<TripleF32>(self.mesh, ray, t)
+        }
     }
-    fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
+
+    /// True when `p` lies strictly inside tet `t` (exact orientation tests):
+    /// where Algorithm 2 applies.
+    pub fn strictly_inside(&self, t: u32, p: Vec3) -> bool {
+        strictly_inside(self.mesh, t, p)
+    }
+
+    /// [`Tracer::trace`] with a stop predicate (see [`Tet80Tracer::walk`])
+    /// and the start tet's interior test already made (`inside`, for
+    /// `Start::Tet` only).
+    #[inline(always)]
+    fn trace_with<S: Fn(u32) -> bool>(
+        &self,
+        ray: &Ray,
+        start: Start,
+        inside: Option<bool>,
+        stop: S,
+    ) -> TraceOutcome {
         if !ray.is_valid() {
             return TraceOutcome::Failed {
                 failure: Failure::InvalidRay,
@@ -185,7 +254,11 @@ impl Tracer for Tet80Tracer<'_> {
                         tets_visited: 0,
                     };
                 }
-                let Some((t, k)) = start_exit_face::<TripleF32>(self.mesh, ray, t) else {
+                if stop(t) {
+                    return TraceOutcome::Miss { tets_visited: 1 };
+                }
+                let inside = inside.unwrap_or_else(|| self.strictly_inside(t, ray.origin));
+                let Some((t, k)) = self.start_tet(ray, t, inside) else {
                     return TraceOutcome::Failed {
                         failure: Failure::Lost,
                         tets_visited: 1,
@@ -193,7 +266,7 @@ impl Tracer for Tet80Tracer<'_> {
                 };
                 let f = self.layout.tets[t as usize].f[k];
                 match self.leave(ray, t, f, 1) {
-                    Ok((n, e)) => self.walk(ray, n, e, 1),
+                    Ok((n, e)) => self.walk(ray, n, e, 1, stop),
                     Err(out) => out,
                 }
             }
@@ -202,9 +275,10 @@ impl Tracer for Tet80Tracer<'_> {
                     .mesh
                     .constrained
                     .get(face as usize)
-                    .and_then(|cf| cf.side_of(tet));
+                    .and_then(|cf| cf.side_of(tet))
+                    .filter(|_| (tet as usize) < self.layout.tets.len());
                 match side {
-                    Some(s) => self.walk(ray, tet, s.face as usize, 0),
+                    Some(s) => self.walk(ray, tet, s.face as usize, 0, stop),
                     None => TraceOutcome::Failed {
                         failure: Failure::Lost,
                         tets_visited: 0,
@@ -212,5 +286,99 @@ impl Tracer for Tet80Tracer<'_> {
                 }
             }
         }
+    }
+}
+
+/// Algorithm 1 (two side products in the frame of the entry face's
+/// complement vertex `V_e`) in the tet whose slot-`k` vertex is `v(k)`,
+/// entered through face `entry`.
+#[inline(always)]
+fn exit_face(v: impl Fn(usize) -> Vec3, o: Vec3, d: Vec3, entry: usize) -> usize {
+    let apex = v(entry);
+    let m = d.cross(apex - o);
+    let a = FACE_VERTICES[entry][0];
+    let s1 = (v(a) - apex).dot(m) > 0.0;
+    let second = SECOND[entry][s1 as usize] as usize;
+    let s2 = (v(second) - apex).dot(m) > 0.0;
+    EXIT[entry][2 * s1 as usize + s2 as usize] as usize
+}
+
+/// Maria et al.'s Algorithm 2: the exit face of a start tet (slot-`k`
+/// vertex `v(k)`) for a ray `o + t·d` whose origin lies strictly inside it.
+/// One side product with edge `V₂ → V₃` (shared by `F₀` and `F₁`) rules out
+/// one of those two faces as the exit; Algorithm 1 then runs as if the ray
+/// had entered through the ruled-out face (the *fake entry*), which leaves
+/// exactly the three faces around its complement vertex. Three side
+/// products in all.
+#[inline(always)]
+pub fn algorithm2(v: impl Fn(usize) -> Vec3, o: Vec3, d: Vec3) -> usize {
+    let v2 = v(2);
+    // left(V₂ → V₃) = d · ((V₂ − o) × (V₃ − V₂)) = (V₃ − V₂) · (d × (V₂ − o)).
+    let s23 = (v(3) - v2).dot(d.cross(v2 - o));
+    // Exiting through F₀ = (V₁, V₂, V₃) needs the ray left of V₂ → V₃,
+    // through F₁ = (V₀, V₃, V₂) left of V₃ → V₂: `s23 > 0` rules out F₁.
+    let entry = if s23 > 0.0 { 1 } else { 0 };
+    exit_face(v, o, d, entry)
+}
+
+/// True when `p` lies strictly inside tet `t` of `mesh` (exact orientation
+/// tests): where [`algorithm2`] applies.
+pub fn strictly_inside(mesh: &TetMesh, t: u32, p: Vec3) -> bool {
+    let v = mesh.tet_points(t).map(|x| x.as_dvec3());
+    let q = p.as_dvec3();
+    FACE_VERTICES
+        .iter()
+        .all(|s| orient3d(v[s[0]], v[s[1]], v[s[2]], q) < 0.0)
+}
+
+/// The Tet80 walk's start from `Start::Tet(t)` (`t` in range): the start
+/// tet and its exit face, exactly as [`Tet80Tracer`] computes it —
+/// [`algorithm2`] when the origin lies strictly inside `t`, else the
+/// engine's search around an origin on a face, edge or vertex. Shared with
+/// the GPU kernel's host-side start so that both walk the same tets.
+pub fn start_exit(mesh: &TetMesh, ray: &Ray, t: u32) -> Option<(u32, usize)> {
+    if strictly_inside(mesh, t, ray.origin) {
+        let p = mesh.tet_points(t);
+        Some((t, algorithm2(|k| p[k], ray.origin, ray.direction)))
+    } else {
+        start_exit_face::<TripleF32>(mesh, ray, t)
+    }
+}
+
+impl Tracer for Tet80Tracer<'_> {
+    fn name(&self) -> String {
+        "tet80/f32".into()
+    }
+    fn mesh(&self) -> &TetMesh {
+        self.mesh
+    }
+    fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
+        self.trace_with(ray, start, None, |_| false)
+    }
+    /// Rays sharing one origin (primary rays) share the start tet's interior
+    /// test: it is made once per batch.
+    fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
+        let inside = match (start, rays.first()) {
+            (Start::Tet(t), Some(r0))
+                if (t as usize) < self.layout.tets.len()
+                    && r0.origin.is_finite()
+                    && rays.iter().all(|r| r.origin == r0.origin) =>
+            {
+                Some(self.strictly_inside(t, r0.origin))
+            }
+            _ => None,
+        };
+        for (r, o) in rays.iter().zip(out.iter_mut()) {
+            *o = self.trace_with(r, start, inside, |_| false);
+        }
+    }
+}
+
+impl ShadowTracer for Tet80Tracer<'_> {
+    fn mesh(&self) -> &TetMesh {
+        self.mesh
+    }
+    fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
+        self.trace_with(ray, start, None, |t| stops_at(stop, t))
     }
 }

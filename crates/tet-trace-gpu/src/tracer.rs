@@ -11,7 +11,7 @@ use tet_core::scene::Camera;
 use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::{duff_basis, start_exit_face, step_cap};
-use tet_trace_cpu::{DuffF32, Failure, Hit, Ray, Start, TraceOutcome, TripleF32};
+use tet_trace_cpu::{DuffF32, Failure, Hit, Ray, Start, TraceOutcome};
 use wgpu::util::DeviceExt;
 
 use crate::layout::Split;
@@ -420,8 +420,10 @@ impl<'a> GpuTracer<'a> {
         }
     }
 
-    /// Start of a Tet80 walk, as `Tet80Tracer::trace` (triple-product start,
-    /// then `leave` through the exit face; or entering through a face).
+    /// Start of a Tet80 walk, as `Tet80Tracer::trace` (Maria et al.'s
+    /// Algorithm 2 from an interior origin, the triple-product search from an
+    /// origin on a face, edge or vertex, then `leave` through the exit face;
+    /// or entering through a face).
     fn start_record_tet80(&self, ray: &Ray, start: Start) -> StartRec {
         let mesh = self.mesh;
         let rec = |mode, tet, face, visited| StartRec {
@@ -438,7 +440,7 @@ impl<'a> GpuTracer<'a> {
         };
         match start {
             Start::Tet(t) if (t as usize) < mesh.tets.len() => {
-                match start_exit_face::<TripleF32>(mesh, ray, t) {
+                match tet_trace_cpu::tet80::start_exit(mesh, ray, t) {
                     Some((t, k)) => rec(START_EXIT, t, k as u32, 1),
                     None => done(ST_LOST, 1),
                 }

@@ -45,6 +45,9 @@ pub struct MemoryModel {
     pub base_bytes: f64,
     /// Bytes per input element (point or triangle).
     pub bytes_per_element: f64,
+    /// Bytes per *wall* element of a part (a seam-only or box facet, or a
+    /// point used by no scene facet), see [`MemoryModel::predict_part`].
+    pub bytes_per_wall_element: f64,
     /// Predictions are `margin ×` the fitted value (≥ 1).
     pub margin: f64,
 }
@@ -78,18 +81,29 @@ impl MemoryModel {
     /// | 8, 480×24  |  92,168 | 184,332 |   870,468 |  743.9 | 15.50 |
     /// | 27, 240×24 | 155,528 | 311,052 | 1,290,914 | 1188.0 | 25.16 |
     ///
-    /// Fit: 2.35 MB + 2,565 B × (points + triangles); relative residuals
-    /// −10 % … +13 % (the spread at equal size comes from the tet count,
-    /// which depends on the geometry, not only on the input size); margin
-    /// 1.1 × 1.131 = 1.244. Compare the paper's 4.57 kB per input vertex
-    /// (≈ 1.5 kB per element for closed meshes, on a different TetGen build
-    /// and measurement). Issue 8's figures (249 MB for 77k triangles, 1.1 GB
-    /// for 360k, 9 GB for 2.88M, measured differently) are 17–21 % below
-    /// this fit (301 MB, 1.39 GB, 11.1 GB), i.e. the fit is on the safe side.
+    /// The whole-scene fit alone was 2.35 MB + 2,565 B × (points +
+    /// triangles) (relative residuals −10 % … +13 %, margin 1.244). Parts
+    /// of a split cost less per element than that: their seam facets are
+    /// a planar triangulation TetGen meshes cheaply (a 14-slab part of
+    /// Torus Knots in a Box measured 40 MB where that fit predicted 72 MB).
+    /// The seam-aware fit ([`MemoryModel::fit_parts`], 2026-11-22, on the
+    /// six scenes above plus 157 parts of slab and tree splits of 8 and 27
+    /// knots and Torus Knots in a Box at 1/2, 1/3 and 1/5 of the whole
+    /// prediction; `measure_part_memory_model` in `tests/outofcore.rs`) is
+    /// 3.39 MB + 2,324 B × (scene points + scene facets) + 408 B × (wall
+    /// points + wall facets), relative residuals −6 % … +23 % (the worst
+    /// are the finely tessellated single knots of the table), margin
+    /// 1.1 × 1.23 = 1.353. [`MemoryModel::predict`] (whole scenes, no
+    /// walls) uses the scene rate for every element. Compare the paper's
+    /// 4.57 kB per input vertex (≈ 1.5 kB per element for closed meshes, on
+    /// a different TetGen build and measurement). Issue 8's figures (249 MB
+    /// for 77k triangles, 1.1 GB for 360k, 9 GB for 2.88M, measured
+    /// differently) are below this fit, i.e. the fit is on the safe side.
     pub const FITTED: MemoryModel = MemoryModel {
-        base_bytes: 2_350_988.6,
-        bytes_per_element: 2_564.916,
-        margin: 1.244,
+        base_bytes: 3_386_656.9,
+        bytes_per_element: 2_324.144,
+        bytes_per_wall_element: 408.192,
+        margin: 1.353,
     };
 
     /// Input size `X` of a PLC.
@@ -149,15 +163,130 @@ impl MemoryModel {
         Some(MemoryModel {
             base_bytes: base,
             bytes_per_element: slope,
+            bytes_per_wall_element: slope,
             margin: 1.1 * (1.0 + worst),
         })
     }
+
+    /// The fitted value (no margin) for a part whose PLC has
+    /// `scene_elements` scene points + scene facets (pieces of scene
+    /// triangles and the points they use) and `wall_elements` wall facets
+    /// + wall-only points, bytes.
+    pub fn fit_part_bytes(&self, scene_elements: usize, wall_elements: usize) -> f64 {
+        self.base_bytes
+            + self.bytes_per_element * scene_elements as f64
+            + self.bytes_per_wall_element * wall_elements as f64
+    }
+
+    /// Predicted peak of a part with the safety margin, bytes (see
+    /// [`MemoryModel::fit_part_bytes`]).
+    pub fn predict_part(&self, scene_elements: usize, wall_elements: usize) -> u64 {
+        (self.margin * self.fit_part_bytes(scene_elements, wall_elements)).ceil() as u64
+    }
+
+    /// Weighted least-squares fit (weights `1/peak²`) of
+    /// `peak = base + a · scene + b · wall` to part samples, margin as in
+    /// [`MemoryModel::fit`]. A negative wall coefficient is clamped to 0
+    /// and the other two refitted. `None` when the system is singular.
+    pub fn fit_parts(samples: &[PartSample]) -> Option<MemoryModel> {
+        if samples.iter().any(|s| s.peak_bytes == 0) || samples.len() < 3 {
+            return None;
+        }
+        let rows: Vec<([f64; 3], f64, f64)> = samples
+            .iter()
+            .map(|s| {
+                let y = s.peak_bytes as f64;
+                (
+                    [1.0, s.scene_elements as f64, s.wall_elements as f64],
+                    y,
+                    1.0 / (y * y),
+                )
+            })
+            .collect();
+        let solve = |cols: &[usize]| -> Option<Vec<f64>> {
+            let n = cols.len();
+            let mut a = vec![vec![0.0f64; n + 1]; n];
+            for (x, y, w) in &rows {
+                for i in 0..n {
+                    for j in 0..n {
+                        a[i][j] += w * x[cols[i]] * x[cols[j]];
+                    }
+                    a[i][n] += w * x[cols[i]] * y;
+                }
+            }
+            // Gaussian elimination with partial pivoting.
+            for k in 0..n {
+                let p = (k..n).max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))?;
+                a.swap(k, p);
+                if a[k][k].abs() < 1e-300 {
+                    return None;
+                }
+                let pivot = a[k].clone();
+                for row in a.iter_mut().skip(k + 1) {
+                    let f = row[k] / pivot[k];
+                    for (x, p) in row.iter_mut().zip(&pivot).skip(k) {
+                        *x -= f * p;
+                    }
+                }
+            }
+            let mut x = vec![0.0; n];
+            for k in (0..n).rev() {
+                let s: f64 = (k + 1..n).map(|j| a[k][j] * x[j]).sum();
+                x[k] = (a[k][n] - s) / a[k][k];
+            }
+            Some(x)
+        };
+        let c = solve(&[0, 1, 2])?;
+        let (base, scene, wall) = if c[2] >= 0.0 {
+            (c[0], c[1], c[2])
+        } else {
+            let c = solve(&[0, 1])?;
+            (c[0], c[1], 0.0)
+        };
+        let worst = rows
+            .iter()
+            .map(|(x, y, _)| {
+                let f = base + scene * x[1] + wall * x[2];
+                (y - f) / f
+            })
+            .fold(0.0f64, f64::max);
+        Some(MemoryModel {
+            base_bytes: base,
+            bytes_per_element: scene,
+            bytes_per_wall_element: wall,
+            margin: 1.1 * (1.0 + worst),
+        })
+    }
+}
+
+/// One part measurement for [`MemoryModel::fit_parts`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PartSample {
+    /// Scene points + scene facets of the part's PLC.
+    pub scene_elements: usize,
+    /// Wall-only points + wall facets.
+    pub wall_elements: usize,
+    /// Measured peak (bytes).
+    pub peak_bytes: u64,
 }
 
 /// Predicted peak memory (bytes, with safety margin) of a TetGen run on a
 /// PLC of `points` points and `triangles` triangles ([`MemoryModel::FITTED`]).
 pub fn predict_peak_memory(points: usize, triangles: usize) -> u64 {
     MemoryModel::FITTED.predict(points, triangles)
+}
+
+/// Predicted peak memory (bytes, with margin) of a TetGen run on one part
+/// of a split ([`MemoryModel::FITTED`], [`MemoryModel::predict_part`]):
+/// its scene points and facets count at the scene rate, its wall-only
+/// points and wall facets (seam-only triangles, box faces) at the wall rate.
+pub fn predict_part_peak_memory(
+    scene_points: usize,
+    scene_triangles: usize,
+    wall_points: usize,
+    wall_triangles: usize,
+) -> u64 {
+    MemoryModel::FITTED.predict_part(scene_points + scene_triangles, wall_points + wall_triangles)
 }
 
 /// Runs TetGen (`-pYczQ`, in the given isolation, which should be a worker:

@@ -56,5 +56,7 @@
 //!   points with the vertex); [`split::plan_slabs`] avoids such planes.
 
 pub mod memory_model;
+pub mod report;
 pub mod seam;
 pub mod split;
+pub mod tree;

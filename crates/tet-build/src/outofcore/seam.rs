@@ -85,6 +85,40 @@ pub enum SeamError {
         /// Its distance to the plane.
         distance: f64,
     },
+    /// A point made by an earlier cut (or a scene vertex) lies off the
+    /// plane but closer to it than TetGen's tolerance.
+    #[error("point {point:?} is {distance:e} off the plane {plane:?}; move the plane")]
+    PlaneNearPoint {
+        /// The plane.
+        plane: SplitPlane,
+        /// The point.
+        point: Vec3,
+        /// Its distance to the plane.
+        distance: f64,
+    },
+    /// A cut met a nearly degenerate configuration (two planes crossing a
+    /// segment at points closer than f32 rounding, or a clipped piece no
+    /// longer convex after rounding).
+    #[error("degenerate cut by {plane:?} near {point:?} (scene triangle {triangle}): {what}")]
+    DegenerateCut {
+        /// The plane.
+        plane: SplitPlane,
+        /// Where.
+        point: Vec3,
+        /// Cleaned scene triangle involved.
+        triangle: u32,
+        /// What went wrong.
+        what: &'static str,
+    },
+    /// A clipped piece of a scene triangle could not be triangulated
+    /// (rounding made its outline self-intersect).
+    #[error("piece of scene triangle {triangle} with {vertices} vertices cannot be triangulated")]
+    PieceTriangulation {
+        /// Cleaned scene triangle.
+        triangle: u32,
+        /// Vertices of the piece's outline.
+        vertices: usize,
+    },
     /// No slab plan fits the memory limit.
     #[error("no slab plan keeps every part under {limit_bytes} bytes")]
     LimitTooSmall {
@@ -115,6 +149,21 @@ pub enum SeamError {
         part: usize,
         /// TetGen's error.
         source: TetgenError,
+    },
+    /// TetGen found intersecting facets in a part's PLC; the first pair
+    /// found by [`crate::intersect::find_self_intersections`] on the PLC.
+    #[error("part {part}: facets {first:?} and {second:?} intersect ({kind:?}; {pairs} pairs)")]
+    PartSelfIntersects {
+        /// Part index.
+        part: usize,
+        /// One facet (vertices) and what it is (scene triangle or seam).
+        first: ([Vec3; 3], Option<u32>),
+        /// The other.
+        second: ([Vec3; 3], Option<u32>),
+        /// How they meet.
+        kind: crate::intersect::IntersectionKind,
+        /// Intersecting pairs in the part.
+        pairs: usize,
     },
     /// A facet of a part did not come back as exactly one face.
     #[error("part {part}: facet {facet} came back as {faces} faces, expected exactly one")]
@@ -158,15 +207,26 @@ pub struct SeamReport {
     pub seam_vertices: Vec<usize>,
     /// Triangles of each seam triangulation.
     pub seam_triangles: Vec<usize>,
+    /// Each seam: its plane and its rectangle (lower and upper corner; the
+    /// plane's coordinate is the same in both), in the order of
+    /// `seam_vertices`. Used by [`super::report::seam_quality`].
+    pub seams: Vec<(SplitPlane, Vec3, Vec3)>,
     /// Input points of each part's PLC (part `k` lies between planes `k − 1` and `k`).
     pub part_points: Vec<usize>,
     /// Facets of each part's PLC.
     pub part_triangles: Vec<usize>,
+    /// Points of each part's PLC used by no scene facet (wall corners,
+    /// trace points): the part of `part_points` the memory model counts
+    /// at the wall rate.
+    pub part_wall_points: Vec<usize>,
+    /// Facets of each part's PLC that are seam-only or box faces.
+    pub part_wall_triangles: Vec<usize>,
     /// Tets of each part.
     pub part_tets: Vec<usize>,
     /// Peak memory of each part's worker (KiB), when isolated.
     pub part_peak_kib: Vec<Option<u64>>,
-    /// Predicted peak memory of each part's TetGen run (bytes, with margin).
+    /// Predicted peak memory of each part's TetGen run from its real input
+    /// ([`super::memory_model::predict_part_peak_memory`], bytes, with margin).
     pub part_predicted_bytes: Vec<u64>,
 }
 
@@ -196,7 +256,7 @@ pub struct Piece {
 }
 
 /// Exact bits of a point (−0 folded into +0).
-fn key(p: Vec3) -> [u32; 3] {
+pub(super) fn key(p: Vec3) -> [u32; 3] {
     [
         (p.x + 0.0).to_bits(),
         (p.y + 0.0).to_bits(),
@@ -415,7 +475,7 @@ pub fn seam_triangulation(
 
 /// A facet of a part's PLC and what it becomes in the merged mesh.
 #[derive(Clone, Copy, Debug)]
-enum FacetKind {
+pub(super) enum FacetKind {
     /// A scene-triangle piece (cleaned index).
     Scene(u32),
     /// A seam-only face.
@@ -423,13 +483,17 @@ enum FacetKind {
 }
 
 /// One part after TetGen: f32 points, positive tets, constrained faces.
-struct PartMesh {
+pub(super) struct PartMesh {
     points: Vec<Vec3>,
     tets: Vec<[u32; 4]>,
     /// (vertices, cleaned source) in the part's point indices.
     constrained: Vec<([u32; 3], u32)>,
     input_points: usize,
     input_triangles: usize,
+    /// Points used by no scene facet (seam and box corners, trace points).
+    wall_points: usize,
+    /// Facets that are not scene pieces (seam-only and box faces).
+    wall_triangles: usize,
     peak_kib: Option<u64>,
 }
 
@@ -457,6 +521,20 @@ fn run_part(
         triangles.push(t.map(&mut id));
         markers.push(0);
     }
+    let mut on_scene = vec![false; points.len()];
+    for ((_, k), t) in facets.iter().zip(&triangles) {
+        if matches!(k, FacetKind::Scene(_)) {
+            for &v in t {
+                on_scene[v as usize] = true;
+            }
+        }
+    }
+    let wall_points = on_scene.iter().filter(|&&s| !s).count();
+    let wall_triangles = facets
+        .iter()
+        .filter(|(_, k)| matches!(k, FacetKind::Seam))
+        .count()
+        + box_faces.len();
     let input = TetgenInput {
         points: points.iter().map(|p| p.as_dvec3().to_array()).collect(),
         triangles,
@@ -464,8 +542,13 @@ fn run_part(
     };
     let mut topts = options.tetgen.clone();
     topts.preserve_surface = true;
-    let out = tetrahedralize(&input, &topts, &options.isolation)
-        .map_err(|source| SeamError::Tetgen { part, source })?;
+    let out = match tetrahedralize(&input, &topts, &options.isolation) {
+        Ok(out) => out,
+        Err(TetgenError::SelfIntersection) => {
+            return Err(self_intersection(part, facets, &points, &input.triangles));
+        }
+        Err(source) => return Err(SeamError::Tetgen { part, source }),
+    };
     if let Some(i) = (0..input.points.len()).find(|&i| out.points.get(i) != Some(&input.points[i]))
     {
         return Err(SeamError::InputPointChanged { part, point: i });
@@ -522,8 +605,42 @@ fn run_part(
         constrained,
         input_points: input.points.len(),
         input_triangles: input.triangles.len(),
+        wall_points,
+        wall_triangles,
         peak_kib: out.worker_peak_kib,
     })
+}
+
+/// Names the first intersecting pair of a part's PLC (TetGen only says
+/// that there is one).
+fn self_intersection(
+    part: usize,
+    facets: &[([Vec3; 3], FacetKind)],
+    points: &[Vec3],
+    triangles: &[[u32; 3]],
+) -> SeamError {
+    let r = crate::intersect::find_self_intersections(points, triangles);
+    let what = |i: u32| {
+        let t = triangles[i as usize].map(|v| points[v as usize]);
+        let s = match facets.get(i as usize) {
+            Some((_, FacetKind::Scene(s))) => Some(*s),
+            _ => None,
+        };
+        (t, s)
+    };
+    match r.pairs.first() {
+        Some(p) => SeamError::PartSelfIntersects {
+            part,
+            first: what(p.first),
+            second: what(p.second),
+            kind: p.kind,
+            pairs: r.pairs.len(),
+        },
+        None => SeamError::Tetgen {
+            part,
+            source: TetgenError::SelfIntersection,
+        },
+    }
 }
 
 /// Vertices off a cut plane by less than this × the box's largest extent
@@ -668,6 +785,12 @@ pub fn build_slabs(
         let section: [Vec3; 4] = section.try_into().expect("a box has 4 corners per face");
         let seam = seam_triangulation(plane, section, &segments[j], &seam_points[j], &in_plane[j])?;
         report.seam_vertices.push(seam.vertices);
+        {
+            let (mut lo, mut hi) = (b.min, b.max);
+            lo[a] = plane.value;
+            hi[a] = plane.value;
+            report.seams.push((plane, lo, hi));
+        }
         report.seam_triangles.push(seam.triangles.len());
         for (t, src) in seam.triangles.iter().zip(&seam.source) {
             let k = src.map_or(FacetKind::Seam, FacetKind::Scene);
@@ -701,13 +824,33 @@ pub fn build_slabs(
     };
     let faces: Vec<Vec<[Vec3; 3]>> = (0..=n).map(slab_faces).collect();
     let meshes = run_parts(&parts, &faces, options)?;
-    // Merge: exact point dedup, tets concatenated, constrained faces once each.
+    let mesh = merge_parts(
+        &meshes,
+        &cm.triangle_source,
+        scene.triangles.len() as u32,
+        &mut report,
+    )?;
+    Ok((mesh, report))
+}
+
+/// Merges tetrahedralized parts: points deduplicated by their exact f32
+/// bits, tets concatenated, constrained faces listed once each (a face on
+/// a seam carrying an in-plane scene triangle comes from both sides) with
+/// the *input* scene triangle id (`triangle_source` maps cleaned → input),
+/// then [`TetMesh::assemble`] and [`TetMesh::validate`]. Fills the per-part
+/// fields of `report`.
+pub(super) fn merge_parts(
+    meshes: &[PartMesh],
+    triangle_source: &[u32],
+    triangle_count: u32,
+    report: &mut SeamReport,
+) -> Result<TetMesh, SeamError> {
     let mut index: HashMap<[u32; 3], u32> = HashMap::new();
     let mut points = Vec::new();
     let mut tets = Vec::new();
     let mut tris: Vec<([u32; 3], u32)> = Vec::new();
     let mut seen = std::collections::HashSet::new();
-    for m in &meshes {
+    for m in meshes {
         let map: Vec<u32> = m
             .points
             .iter()
@@ -722,23 +865,27 @@ pub fn build_slabs(
         for &(t, s) in &m.constrained {
             let g = t.map(|v| map[v as usize]);
             if seen.insert(face_key(g)) {
-                tris.push((g, cm.triangle_source[s as usize]));
+                tris.push((g, triangle_source[s as usize]));
             }
         }
         report.part_points.push(m.input_points);
         report.part_triangles.push(m.input_triangles);
+        report.part_wall_points.push(m.wall_points);
+        report.part_wall_triangles.push(m.wall_triangles);
         report.part_tets.push(m.tets.len());
         report.part_peak_kib.push(m.peak_kib);
         report
             .part_predicted_bytes
-            .push(super::memory_model::predict_peak_memory(
-                m.input_points,
-                m.input_triangles,
+            .push(super::memory_model::predict_part_peak_memory(
+                m.input_points - m.wall_points,
+                m.input_triangles - m.wall_triangles,
+                m.wall_points,
+                m.wall_triangles,
             ));
     }
-    let mesh = TetMesh::assemble(points, tets, &tris, scene.triangles.len() as u32)?;
+    let mesh = TetMesh::assemble(points, tets, &tris, triangle_count)?;
     mesh.validate()?;
-    Ok((mesh, report))
+    Ok(mesh)
 }
 
 /// Builds `scene` so that every TetGen run's *predicted* peak fits
@@ -763,33 +910,62 @@ pub fn build_with_memory_limit(
     Ok((mesh, report, plan))
 }
 
-/// Runs TetGen on every part, concurrently when `options.parallel_parts > 1`.
-fn run_parts(
+/// Runs TetGen on every part, at most `options.parallel_parts` at a time:
+/// that many threads take the next part from a queue as soon as their
+/// previous one finishes (largest input first, so a big part does not
+/// start last), which keeps both threads busy when parts differ in size.
+/// The first error (in part order) is returned.
+pub(super) fn run_parts(
     parts: &[Vec<([Vec3; 3], FacetKind)>],
     faces: &[Vec<[Vec3; 3]>],
     options: &SeamOptions,
 ) -> Result<Vec<PartMesh>, SeamError> {
-    let width = options.parallel_parts.max(1);
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    let width = options.parallel_parts.max(1).min(parts.len().max(1));
+    let mut order: Vec<usize> = (0..parts.len()).collect();
+    order.sort_by_key(|&k| std::cmp::Reverse(parts[k].len() + faces[k].len()));
+    let results: Vec<Mutex<Option<Result<PartMesh, SeamError>>>> =
+        (0..parts.len()).map(|_| Mutex::new(None)).collect();
+    let next = AtomicUsize::new(0);
+    let failed = AtomicBool::new(false);
+    let work = || {
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            if i >= order.len() || failed.load(Ordering::Relaxed) {
+                break;
+            }
+            let k = order[i];
+            let r = run_part(k, &parts[k], &faces[k], options);
+            if r.is_err() {
+                failed.store(true, Ordering::Relaxed);
+            }
+            *results[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
+        }
+    };
+    if width == 1 {
+        work();
+    } else {
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..width).map(|_| scope.spawn(work)).collect();
+            for h in handles {
+                h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+            }
+        });
+    }
     let mut out = Vec::with_capacity(parts.len());
-    let ids: Vec<usize> = (0..parts.len()).collect();
-    for wave in ids.chunks(width) {
-        let results: Vec<Result<PartMesh, SeamError>> = if wave.len() == 1 {
-            vec![run_part(wave[0], &parts[wave[0]], &faces[wave[0]], options)]
-        } else {
-            std::thread::scope(|scope| {
-                let handles: Vec<_> = wave
-                    .iter()
-                    .map(|&k| scope.spawn(move || run_part(k, &parts[k], &faces[k], options)))
-                    .collect();
-                handles
-                    .into_iter()
-                    .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-                    .collect()
-            })
-        };
-        for r in results {
-            out.push(r?);
+    let mut first_error = None;
+    for r in results {
+        match r.into_inner().unwrap_or_else(|e| e.into_inner()) {
+            Some(Ok(m)) => out.push(m),
+            Some(Err(e)) => {
+                first_error.get_or_insert(e);
+            }
+            None => {}
         }
     }
-    Ok(out)
+    match first_error {
+        Some(e) => Err(e),
+        None => Ok(out),
+    }
 }

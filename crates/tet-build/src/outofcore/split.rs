@@ -20,6 +20,8 @@
 //! plane, plus 8 box corners. Triangles: its triangles, plus 3 per cut
 //! triangle (up to two pieces on one side and about two seam-triangulation
 //! triangles per seam vertex, minus the original), plus 12 box triangles.
+//! The prediction counts the seam-triangulation and box facets at the
+//! model's (lower) wall rate ([`MemoryModel::predict_part`]).
 //! Every ancestor's seam is counted whole, and deeper parts are classified
 //! by the original triangles' vertices (not the clipped pieces), so the
 //! estimates and cut counts below the root are upper bounds.
@@ -62,6 +64,17 @@ impl SplitPlane {
             (false, false) => Side::InPlane,
         }
     }
+}
+
+/// Predicted peak of a part with `points` scene vertices, `triangles`
+/// scene triangles and `seam` triangles cut by the planes bounding it
+/// (each adds about one crossing point and one piece facet on the scene
+/// side, and two seam-triangulation facets on the wall side), plus the 8
+/// corners and 12 facets of its box (at the wall rate).
+fn predict_part(options: &SplitOptions, points: usize, triangles: usize, seam: usize) -> u64 {
+    options
+        .model
+        .predict_part(points + triangles + 2 * seam, 2 * seam + 20)
 }
 
 /// The split plan: a binary tree of parts.
@@ -196,6 +209,21 @@ pub fn choose_plane(
     bounds: (Vec3, Vec3),
     options: &SplitOptions,
 ) -> Option<(SplitPlane, usize)> {
+    choose_plane_avoiding(vertices, triangles, part, bounds, options, 0.0)
+}
+
+/// [`choose_plane`], skipping candidate planes that pass within
+/// `tolerance` of a vertex of the part's triangles without passing through
+/// it (the seams refuse those, [`super::seam::NEAR_PLANE`]); when every
+/// candidate is too close, the plain rule's plane is returned.
+pub fn choose_plane_avoiding(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    part: &[u32],
+    bounds: (Vec3, Vec3),
+    options: &SplitOptions,
+    tolerance: f64,
+) -> Option<(SplitPlane, usize)> {
     let (lo, hi) = bounds;
     let n = part.len() as f64 * 3.0;
     let (mut sum, mut sum2) = ([0f64; 3], [0f64; 3]);
@@ -231,6 +259,16 @@ pub fn choose_plane(
             continue;
         }
         let plane = SplitPlane { axis, value };
+        let near = tolerance > 0.0
+            && part.iter().any(|&t| {
+                triangles[t as usize].iter().any(|&v| {
+                    let d = (vertices[v as usize][axis] as f64 - value as f64).abs();
+                    d > 0.0 && d < tolerance
+                })
+            });
+        if near {
+            continue;
+        }
         let cut = part
             .iter()
             .filter(|&&t| {
@@ -247,7 +285,13 @@ pub fn choose_plane(
             best = Some((plane, cut, dist));
         }
     }
-    best.map(|(p, c, _)| (p, c))
+    match best {
+        Some((p, c, _)) => Some((p, c)),
+        None if tolerance > 0.0 => {
+            choose_plane_avoiding(vertices, triangles, part, bounds, options, 0.0)
+        }
+        None => None,
+    }
 }
 
 /// Plans the recursive split of the scene triangles inside `bounds` (the
@@ -259,9 +303,11 @@ pub fn plan_split(
     options: &SplitOptions,
 ) -> SplitTree {
     let part: Vec<u32> = (0..triangles.len() as u32).collect();
-    plan_part(vertices, triangles, part, 0, bounds, 0, options)
+    let tolerance = super::seam::NEAR_PLANE * (bounds.1 - bounds.0).max_element() as f64;
+    plan_part(vertices, triangles, part, 0, bounds, 0, options, tolerance)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn plan_part(
     vertices: &[Vec3],
     triangles: &[[u32; 3]],
@@ -270,13 +316,14 @@ fn plan_part(
     bounds: (Vec3, Vec3),
     depth: usize,
     options: &SplitOptions,
+    tolerance: f64,
 ) -> SplitTree {
     let mut used: Vec<u32> = part.iter().flat_map(|&t| triangles[t as usize]).collect();
     used.sort_unstable();
     used.dedup();
     let points_estimate = used.len() + seam_vertices + 8;
     let triangles_estimate = part.len() + 3 * seam_vertices + 12;
-    let predicted_bytes = options.model.predict(points_estimate, triangles_estimate);
+    let predicted_bytes = predict_part(options, used.len(), part.len(), seam_vertices);
     let wants_split = depth < options.min_depth
         || (predicted_bytes > options.limit_bytes && depth < options.max_depth);
     let leaf = |part: Vec<u32>| SplitTree::Leaf {
@@ -289,7 +336,9 @@ fn plan_part(
     if !wants_split {
         return leaf(part);
     }
-    let Some((plane, cut)) = choose_plane(vertices, triangles, &part, bounds, options) else {
+    let Some((plane, cut)) =
+        choose_plane_avoiding(vertices, triangles, &part, bounds, options, tolerance)
+    else {
         return leaf(part);
     };
     let (mut below, mut above) = (Vec::new(), Vec::new());
@@ -322,6 +371,7 @@ fn plan_part(
             (lo, mid_hi),
             depth + 1,
             options,
+            tolerance,
         )),
         above: Box::new(plan_part(
             vertices,
@@ -331,6 +381,7 @@ fn plan_part(
             (mid_lo, hi),
             depth + 1,
             options,
+            tolerance,
         )),
     }
 }
@@ -456,11 +507,7 @@ pub fn plan_slabs(
                     .flatten()
                     .map(|j| triangles_cut[j])
                     .sum();
-                predicted.push(
-                    options
-                        .model
-                        .predict(used.len() + seam + 8, tris + 3 * seam + 12),
-                );
+                predicted.push(predict_part(options, used.len(), tris, seam));
             }
             if predicted.iter().all(|&p| p <= options.limit_bytes) {
                 return Some(SlabPlan {

@@ -25,6 +25,9 @@ pub struct TetShimView {
     pub faces: *const i32,
     /// `nfaces` facet markers, or null.
     pub face_markers: *const i32,
+    /// `2 * nfaces` tets on the two sides of each face (`-1` = none), or
+    /// null (TetGen's `adjtetlist`, only with `-nn`).
+    pub face_tets: *const i32,
 }
 
 impl Default for TetShimView {
@@ -38,6 +41,7 @@ impl Default for TetShimView {
             nfaces: 0,
             faces: std::ptr::null(),
             face_markers: std::ptr::null(),
+            face_tets: std::ptr::null(),
         }
     }
 }

@@ -79,6 +79,9 @@ pub struct TetgenOptions {
     pub keep_convex_hull: bool,
     /// `-n`: also output tet neighbours.
     pub neighbors: bool,
+    /// `-nn`: also output, for every output face, the tets on its two sides
+    /// ([`TetgenOutput::face_tets`]); implies [`TetgenOptions::neighbors`].
+    pub face_tets: bool,
 }
 
 impl Default for TetgenOptions {
@@ -90,6 +93,7 @@ impl Default for TetgenOptions {
             preserve_surface: true,
             keep_convex_hull: true,
             neighbors: false,
+            face_tets: false,
         }
     }
 }
@@ -104,7 +108,9 @@ impl TetgenOptions {
         if self.keep_convex_hull {
             s.push('c');
         }
-        if self.neighbors {
+        if self.face_tets {
+            s.push_str("nn");
+        } else if self.neighbors {
             s.push('n');
         }
         if let Some(q) = self.quality {
@@ -173,6 +179,13 @@ pub struct TetgenOutput {
     pub faces: Vec<[u32; 3]>,
     /// Facet marker of each face (`0` for hull faces not on a facet).
     pub face_markers: Vec<i32>,
+    /// TetGen's `adjtetlist` (only with `-nn`, [`TetgenOptions::face_tets`]):
+    /// the tets on the two sides of each face, `-1` = none, *as TetGen
+    /// reports them*. For a face on the convex hull TetGen 1.5 may report
+    /// the unset index of its internal hull tet instead of the real tet
+    /// (seen as large negative or out-of-range values), so check that a
+    /// listed tet has the face before using it.
+    pub face_tets: Option<Vec<[i32; 2]>>,
     /// Peak resident memory (VmHWM, KiB) of the worker process, when isolated.
     pub worker_peak_kib: Option<u64>,
     /// Seconds spent inside TetGen (measured where it ran).
@@ -580,12 +593,20 @@ unsafe fn copy_view(view: &ffi::TetShimView) -> Result<TetgenOutput, TetgenError
     } else {
         slice(view.face_markers, nf)?.to_vec()
     };
+    // Raw values: see `TetgenOutput::face_tets`.
+    let face_tets = if view.face_tets.is_null() || nf == 0 {
+        None
+    } else {
+        let raw = slice(view.face_tets, 2 * nf)?;
+        Some(raw.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+    };
     Ok(TetgenOutput {
         points: pts.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
         tets,
         neighbors,
         faces,
         face_markers,
+        face_tets,
         worker_peak_kib: None,
         seconds: 0.0,
     })

@@ -29,10 +29,10 @@
 //! * Request: `b"TETREQ01"`, switches (u32 length and UTF-8), points (u32
 //!   count, 3 f64 each), triangles (u32 count, 3 u32 each), markers (one i32
 //!   per triangle).
-//! * Reply: `b"TETRES01"`, status i32 (0 = ok, else a shim/TetGen code);
+//! * Reply: `b"TETRES02"`, status i32 (0 = ok, else a shim/TetGen code);
 //!   on success points, tets (u32 count, 4 u32 each), a neighbours flag (u8)
-//!   with 4 i32 per tet, faces (u32 count, 3 u32 each) and one i32 marker per
-//!   face; always followed by TetGen seconds (f64) and the worker's peak
+//!   with 4 i32 per tet, faces (u32 count, 3 u32 each), one i32 marker per
+//!   face and a face-tets flag (u8) with 2 i32 per face; always followed by TetGen seconds (f64) and the worker's peak
 //!   memory in KiB (u64, 0 when unknown).
 //!
 //! TetGen prints its diagnostics with `printf`; [`serve_stdio`] first points
@@ -48,7 +48,7 @@ use super::{
 };
 
 const REQUEST_MAGIC: &[u8; 8] = b"TETREQ01";
-const REPLY_MAGIC: &[u8; 8] = b"TETRES01";
+const REPLY_MAGIC: &[u8; 8] = b"TETRES02";
 /// Status of a reply the worker could not decode a request for.
 const STATUS_BAD_REQUEST: i32 = -100;
 
@@ -140,6 +140,16 @@ pub fn serve<R: Read, W: Write>(input: R, output: W) -> io::Result<()> {
             for m in &out.face_markers {
                 put_i32(&mut w, *m)?;
             }
+            match &out.face_tets {
+                Some(ft) => {
+                    w.write_all(&[1])?;
+                    for f in ft {
+                        put_i32(&mut w, f[0])?;
+                        put_i32(&mut w, f[1])?;
+                    }
+                }
+                None => w.write_all(&[0])?,
+            }
             put_f64(&mut w, out.seconds)?;
         }
         Err(Ok(e)) => {
@@ -226,6 +236,7 @@ fn parse_switches(s: &str) -> Option<TetgenOptions> {
             b'p' | b'z' | b'Q' => {}
             b'Y' => o.preserve_surface = true,
             b'c' => o.keep_convex_hull = true,
+            b'n' if o.neighbors => o.face_tets = true,
             b'n' => o.neighbors = true,
             b'q' => o.quality = Some(number(&mut i).parse().ok()?),
             b'S' => o.max_steiner = Some(number(&mut i).parse().ok()?),
@@ -432,6 +443,21 @@ fn decode_reply(reply: &[u8], switches: &str) -> Result<TetgenOutput, TetgenErro
     for _ in 0..nf {
         face_markers.push(get_i32(&mut r).map_err(proto)?);
     }
+    r.read_exact(&mut flag).map_err(proto)?;
+    let face_tets = if flag[0] == 1 {
+        // Raw values, as in process (see `TetgenOutput::face_tets`).
+        check_len(r, nf, 8)?;
+        let mut v = Vec::with_capacity(nf);
+        for _ in 0..nf {
+            v.push([
+                get_i32(&mut r).map_err(proto)?,
+                get_i32(&mut r).map_err(proto)?,
+            ]);
+        }
+        Some(v)
+    } else {
+        None
+    };
     let seconds = get_f64(&mut r).map_err(proto)?;
     let peak = get_u64(&mut r).map_err(proto)?;
     Ok(TetgenOutput {
@@ -440,6 +466,7 @@ fn decode_reply(reply: &[u8], switches: &str) -> Result<TetgenOutput, TetgenErro
         neighbors,
         faces,
         face_markers,
+        face_tets,
         worker_peak_kib: (peak > 0).then_some(peak),
         seconds,
     })
@@ -507,8 +534,14 @@ mod tests {
                 max_steiner: Some(1000),
                 coplanar_tolerance: Some(1e-9),
                 neighbors: true,
+                face_tets: false,
                 keep_convex_hull: false,
                 preserve_surface: false,
+            },
+            TetgenOptions {
+                neighbors: true,
+                face_tets: true,
+                ..TetgenOptions::default()
             },
         ];
         for o in cases {

@@ -1,0 +1,868 @@
+//! SIMD lockstep walk: `W` rays of one batch walk side by side, one ray per
+//! SIMD lane, one tet per lane per round. This is the
+//! [`Tracer::trace_batch`](crate::Tracer::trace_batch) of every projected
+//! kernel with [`DuffF32`] (Tet20, Tet16, Tet32); the scalar walks
+//! ([`crate::walk::trace`], [`crate::walk::trace_interleaved`], reachable as
+//! [`crate::kernel::Interleaved`]) stay as the reference.
+//!
+//! Each round every lane fetches `VX` of the tet it enters, decodes the new
+//! vertex `idx₃ = idx₀ ⊕ idx₁ ⊕ idx₂ ⊕ VX` and fetches its point; the
+//! projection of `idx₃` ([`DuffF32`]: `p = (u·(P−o), v·(P−o))`), the three
+//! edge determinants `det(p₃, pᵢ)` of Algorithm 1, the exit slot
+//! ([`crate::walk::EXIT_SLOT`]), the replacement of the exiting vertex and the
+//! exit link (rank of the exit vertex for Tet20 — Algorithm 5 —, two ranks
+//! and two xors for Tet16 — Algorithm 7 —, the slot compare for Tet32 —
+//! Algorithm 3 —, see [`ExitRule`]) run across the lanes as SIMD arithmetic,
+//! compares and blends: no branches and no variable-indexed stores. A lane
+//! that needs a rare path (a constrained face or the boundary, the step cap,
+//! a decoded vertex out of range) is handed to the scalar engine's
+//! `finish_step`; a finished lane is refilled at once from the batch, so
+//! lanes idle only at the batch's tail.
+//!
+//! # Dispatch
+//!
+//! * x86-64 with AVX2 (detected at run time) and a layout that exposes its
+//!   records as words ([`crate::walk::Topology::record_words`]): 8-lane AVX2
+//!   intrinsics, all five loads of a step (`VX`, the point's x, y, z, the
+//!   link) as `vpgatherdd`/`vgatherdps`, two packs of 8 lanes in flight per
+//!   thread so that the core overlaps their gather chains;
+//! * x86-64 with AVX2, other layouts: the portable lane loops below compiled
+//!   for AVX2 (8 lanes, scalar loads through [`Topology`]);
+//! * otherwise: the portable lane loops with 4 lanes on the baseline target
+//!   (SSE2 on x86-64), [`trace_lockstep_portable`].
+//!
+//! Why intrinsics and `unsafe`: the same lane loops left to the
+//! auto-vectoriser (the portable path compiled for AVX2, 8 lanes) measured
+//! 135 instructions per step against 112 for the scalar interleaved walk and
+//! 0.95× its speed — the scalar loads and the transposition of 8 points into
+//! SoA vectors cost more than the SIMD arithmetic saves —, while the
+//! intrinsics with gathers measured 43.5 and about 2× (below). The only
+//! `unsafe` is the call into the `avx2` functions after the run-time
+//! check and the gathers, whose indices are clamped in-register to the
+//! arrays (`next ≤ tets − 1`, `idx₃ ≤ points − 1`, ranks and slots ≤ 3,
+//! offsets checked once per batch by `RecordWords::gatherable`), so no
+//! layout, valid or not, can make them read out of bounds. A corrupt layout
+//! whose links point past the tet array makes the scalar walk panic on the
+//! index; the gather path then reads a clamped record instead (a wrong walk,
+//! never an out-of-bounds read); [`tet_core::layout::LayoutMesh::from_mesh`]
+//! validates the mesh, so neither happens for a tracer built by `new`.
+//!
+//! # Identical to the scalar walk
+//!
+//! Every lane evaluates exactly the scalar formulas of [`DuffF32`] and
+//! `Face2::left_mask`: the same IEEE operations on the same operands in the
+//! same order, `x = (uₓqₓ + u_y q_y) + u_z q_z` with `q = P − o`, and
+//! `det = p₃.x·yᵢ − p₃.y·xᵢ`, with no fused multiply-add (Rust never
+//! contracts, and FMA is not enabled here). A zero determinant takes the
+//! scalar tie rule for that lane. So every lane visits the same tets and
+//! ends with the same outcome as [`crate::walk::trace`] (bit for bit, tested
+//! in `tests/lockstep.rs`), and the watertightness argument of
+//! [`crate::walk`] carries over unchanged.
+//!
+//! # Measured (Torus Knots, 318 584 tets, 57.6 tets per ray)
+//!
+//! Instructions per tet step (callgrind, 80×60, one thread, the whole
+//! `trace_batch` including ray set-up and hit records), scalar interleaved →
+//! lockstep: Tet20 112.4 → 43.5, Tet16 120.8 → 44.2, Tet32 99.1 → 45.4
+//! (ScTP, interleaved only: 160.6). Of Tet20's 43.5, the 8-lane round is
+//! about 24 per lane-step; the rest is per ray (start tet, f64 hit record)
+//! and the lane refills. 1920×1440, 2 threads, rays per CPU-second in the
+//! same run (a loaded shared machine): Tet20 ×2.0, Tet16 ×1.9, Tet32 ×2.4
+//! against the interleaved scalar walk. Two packs in flight against one:
+//! +2–6 % per CPU-second (noisy; four: no further gain); prefetching the
+//! next records (as the scalar walk does) measured no gain and is off
+//! (`avx2::PREFETCH`). Rerun: `benches/walk_step.rs`.
+
+use glam::{Vec2, Vec3};
+use tet_core::{Link, TetMesh};
+
+use crate::ray::{Ray, TraceOutcome};
+use crate::walk::{Advance, DuffF32, Face2, Lane, Start, State, Topology, finish_step, next_lane};
+
+/// Lanes of the AVX2 lockstep walk (256-bit vectors of f32 / u32).
+pub const WIDE: usize = 8;
+/// Lanes of the portable lockstep walk (128-bit vectors).
+pub const NARROW: usize = 4;
+
+/// How the lockstep walk finds a tet's exit link among its record's 32-bit
+/// words (offsets in words within a record).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExitRule {
+    /// Tet20 (Algorithm 5): the link at word `links + rank(exiting)`.
+    Rank {
+        /// Word of the rank-0 link.
+        links: usize,
+    },
+    /// Tet16 (Algorithm 7): `entry ⊕ NX(rank(idx₃)) ⊕ NX(rank(exiting))`
+    /// with `NX_r` at word `links + r` and `NX_3 = 0`.
+    RankXor {
+        /// Word of `NX_0`.
+        links: usize,
+    },
+    /// Tet32 (Algorithm 3): the slot `k` of the exiting vertex among the ids
+    /// at words `ids..ids + 3` (3 when none of them), link at `links + k`.
+    Slot {
+        /// Word of the slot-0 vertex id.
+        ids: usize,
+        /// Word of the slot-0 link.
+        links: usize,
+    },
+}
+
+/// A layout's records as 32-bit words, for the gathers of the AVX2 lockstep
+/// walk ([`crate::walk::Topology::record_words`]).
+#[derive(Clone, Copy, Debug)]
+pub struct RecordWords<'a> {
+    /// All records, word by word (`stride` words per tet).
+    pub words: &'a [u32],
+    /// Words per record.
+    pub stride: usize,
+    /// Word of `VX` within a record.
+    pub vx: usize,
+    /// Where the exit link is.
+    pub rule: ExitRule,
+}
+
+impl RecordWords<'_> {
+    /// True when every gather index the walk can form fits in an `i32` and
+    /// stays inside a record (`next` and the decoded vertex are clamped to
+    /// the arrays, ranks and slots to 0..=3).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    fn gatherable(&self, points: usize) -> bool {
+        let s = self.stride;
+        let inside = match self.rule {
+            ExitRule::Rank { links } => links + 3 < s,
+            ExitRule::RankXor { links } => links + 2 < s,
+            ExitRule::Slot { ids, links } => ids + 2 < s && links + 3 < s,
+        };
+        inside
+            && self.vx < s
+            && s > 0
+            && self.words.len().is_multiple_of(s)
+            && !self.words.is_empty()
+            && self.words.len() <= i32::MAX as usize
+            && points > 0
+            && points <= i32::MAX as usize / 3
+    }
+}
+
+/// Traces `rays` from `start` (at most `cap` tets each) with [`DuffF32`]
+/// lanes in lockstep; `out[i]` is exactly
+/// [`crate::walk::trace`]`::<DuffF32, T>` of `rays[i]`. `out.len()` must
+/// equal `rays.len()` (the shorter length is used otherwise).
+pub fn trace_lockstep<T: Topology>(
+    mesh: &TetMesh,
+    topo: &T,
+    rays: &[Ray],
+    start: Start,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        match topo.record_words() {
+            Some(rw) if rw.gatherable(mesh.points.len()) => {
+                // SAFETY (all three): the `avx2` functions only require the
+                // CPU to support AVX2, which was detected just above.
+                match rw.rule {
+                    ExitRule::Rank { .. } => unsafe {
+                        avx2::run_gather::<RANK>(mesh, rw, rays, start, cap, out)
+                    },
+                    ExitRule::RankXor { .. } => unsafe {
+                        avx2::run_gather::<RANK_XOR>(mesh, rw, rays, start, cap, out)
+                    },
+                    ExitRule::Slot { .. } => unsafe {
+                        avx2::run_gather::<SLOT>(mesh, rw, rays, start, cap, out)
+                    },
+                }
+            }
+            // SAFETY: as above.
+            _ => unsafe { trace_avx2(mesh, topo, rays, start, cap, out) },
+        }
+        return;
+    }
+    run::<T, NARROW>(mesh, topo, rays, start, cap, out);
+}
+
+/// [`trace_lockstep`] with `W` lanes compiled for the baseline target (no
+/// run-time dispatch): the portable fallback, public so that tests cover it
+/// on machines with AVX2 too.
+pub fn trace_lockstep_portable<T: Topology, const W: usize>(
+    mesh: &TetMesh,
+    topo: &T,
+    rays: &[Ray],
+    start: Start,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    run::<T, W>(mesh, topo, rays, start, cap, out);
+}
+
+/// The lockstep walk with AVX2 code generation (8 lanes).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn trace_avx2<T: Topology>(
+    mesh: &TetMesh,
+    topo: &T,
+    rays: &[Ray],
+    start: Start,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    run::<T, WIDE>(mesh, topo, rays, start, cap, out);
+}
+
+/// `W` walks in structure-of-arrays form: entry `[l]` of every field is
+/// lane `l`.
+#[derive(Clone, Copy)]
+struct Pack<const W: usize> {
+    /// Ray origin `o` (x, y, z).
+    o: [[f32; W]; 3],
+    /// Duff basis columns: `c[0] = (uₓ, vₓ)`, `c[1] = (u_y, v_y)`,
+    /// `c[2] = (u_z, v_z)`, as `[axis][coordinate][lane]`.
+    c: [[[f32; W]; 2]; 3],
+    /// Entry face ids `idx₀..₂` (counter-clockwise).
+    ids: [[u32; W]; 3],
+    /// Their projections.
+    xs: [[f32; W]; 3],
+    ys: [[f32; W]; 3],
+    /// Tet entered next.
+    next: [u32; W],
+    /// Raw link it is entered through.
+    entry: [u32; W],
+    /// Tets visited so far.
+    visited: [u32; W],
+    /// Lane holds a walk (else parked: its state is frozen, its loads stay
+    /// in range, its results are ignored).
+    live: [bool; W],
+    /// Index of the lane's ray in the batch.
+    ray: [usize; W],
+    /// The lane's projection (cold: rebuilding the scalar lane).
+    proj: [DuffF32; W],
+}
+
+/// What a round left for the cold path, per lane: the exit link and whether
+/// the decoded vertex was out of range.
+struct Round<const W: usize> {
+    raw: [u32; W],
+    lost: [bool; W],
+    capped: [bool; W],
+}
+
+impl<const W: usize> Pack<W> {
+    /// Loads the scalar lane `lane` (ray `ray`) into slot `l`.
+    fn set(&mut self, l: usize, ray: usize, lane: &Lane<DuffF32>) {
+        let p = lane.proj;
+        self.o[0][l] = p.o.x;
+        self.o[1][l] = p.o.y;
+        self.o[2][l] = p.o.z;
+        for (axis, col) in [p.cx, p.cy, p.cz].iter().enumerate() {
+            self.c[axis][0][l] = col.x;
+            self.c[axis][1][l] = col.y;
+        }
+        for k in 0..3 {
+            self.ids[k][l] = lane.st.ids[k];
+            self.xs[k][l] = lane.st.p.xs[k];
+            self.ys[k][l] = lane.st.p.ys[k];
+        }
+        self.next[l] = lane.next;
+        self.entry[l] = lane.entry_raw;
+        self.visited[l] = lane.st.visited;
+        self.live[l] = true;
+        self.ray[l] = ray;
+        self.proj[l] = p;
+    }
+
+    /// Slot `l` as a scalar lane; `tet` and `link` as the scalar `advance`
+    /// leaves them for `finish_step` (the tet entered, its exit link).
+    fn get(&self, l: usize, link: u32) -> Lane<DuffF32> {
+        let pt = |k: usize| Vec2::new(self.xs[k][l], self.ys[k][l]);
+        Lane {
+            proj: self.proj[l],
+            st: State {
+                tet: self.next[l],
+                ids: [self.ids[0][l], self.ids[1][l], self.ids[2][l]],
+                p: Face2::new([pt(0), pt(1), pt(2)]),
+                link,
+                visited: self.visited[l],
+            },
+            next: self.next[l],
+            entry_raw: self.entry[l],
+        }
+    }
+
+    /// Parks slot `l`: tet 0 (exists whenever a walk started) keeps its
+    /// loads in range.
+    fn park(&mut self, l: usize) {
+        self.live[l] = false;
+        self.next[l] = 0;
+    }
+}
+
+/// The lockstep driver (see the module docs).
+#[inline(always)]
+fn run<T: Topology, const W: usize>(
+    mesh: &TetMesh,
+    topo: &T,
+    rays: &[Ray],
+    start: Start,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    let n = rays.len().min(out.len());
+    let (rays, out) = (&rays[..n], &mut out[..n]);
+    let mut queued = 0;
+    let (mut pk, mut live) = fill::<W>(mesh, rays, start, &mut queued, out);
+    // A walk started only if the mesh has points and tets (its start tet
+    // and vertices exist), so the loads of `step` have something to clamp to.
+    if live == 0 || mesh.points.is_empty() {
+        return;
+    }
+    let points = &mesh.points[..];
+    while live > 0 {
+        let (events, round) = step(&mut pk, points, topo, cap);
+        if events != 0 {
+            live -= lane_events(mesh, rays, start, &mut queued, out, &mut pk, events, &round);
+        }
+    }
+}
+
+/// `W` lanes filled with the first walks of the batch that do not end in
+/// their start tet (the others are written to `out`), parked when there are
+/// fewer; and the number of live lanes.
+fn fill<const W: usize>(
+    mesh: &TetMesh,
+    rays: &[Ray],
+    start: Start,
+    queued: &mut usize,
+    out: &mut [TraceOutcome],
+) -> (Pack<W>, usize) {
+    let mut pk = Pack::<W> {
+        o: [[0.0; W]; 3],
+        c: [[[0.0; W]; 2]; 3],
+        ids: [[0; W]; 3],
+        xs: [[0.0; W]; 3],
+        ys: [[0.0; W]; 3],
+        next: [0; W],
+        entry: [0; W],
+        visited: [0; W],
+        live: [false; W],
+        ray: [0; W],
+        proj: [DuffF32::default(); W],
+    };
+    let mut live = 0;
+    for l in 0..W {
+        match next_lane::<DuffF32>(mesh, rays, start, queued, out) {
+            Some((i, lane)) => {
+                pk.set(l, i, &lane);
+                live += 1;
+            }
+            None => pk.park(l),
+        }
+    }
+    (pk, live)
+}
+
+/// One round: every live lane enters its next tet and, in the common case,
+/// moves on to the exit neighbour. Returns the bit mask of live lanes that
+/// need the cold path (the step cap, an out-of-range vertex, a non-tet exit
+/// link) with what it needs.
+// Lane loops index several structure-of-arrays fields by lane and slot,
+// written for the auto-vectoriser.
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+fn step<T: Topology, const W: usize>(
+    pk: &mut Pack<W>,
+    points: &[Vec3],
+    topo: &T,
+    cap: u32,
+) -> (u32, Round<W>) {
+    let last = points.len() - 1;
+    // Loads: `VX` of the next tet, the new vertex id and its point.
+    let mut d = [0u32; W];
+    let mut lost = [false; W];
+    let mut q = [[0f32; W]; 3];
+    for l in 0..W {
+        let dv = pk.ids[0][l] ^ pk.ids[1][l] ^ pk.ids[2][l] ^ topo.vx(pk.next[l]);
+        d[l] = dv;
+        lost[l] = dv as usize > last;
+        let p = points[(dv as usize).min(last)];
+        q[0][l] = p.x;
+        q[1][l] = p.y;
+        q[2][l] = p.z;
+    }
+    // Projection (`DuffF32::project`, lane by lane the same operations).
+    let mut px = [0f32; W];
+    let mut py = [0f32; W];
+    for l in 0..W {
+        let qx = q[0][l] - pk.o[0][l];
+        let qy = q[1][l] - pk.o[1][l];
+        let qz = q[2][l] - pk.o[2][l];
+        px[l] = pk.c[0][0][l] * qx + pk.c[1][0][l] * qy + pk.c[2][0][l] * qz;
+        py[l] = pk.c[0][1][l] * qx + pk.c[1][1][l] * qy + pk.c[2][1][l] * qz;
+    }
+    // Algorithm 1's edge tests `det(p₃, pᵢ)` (`Face2::left_mask`).
+    let mut left = [[false; W]; 3];
+    let mut tie = [false; W];
+    for l in 0..W {
+        for k in 0..3 {
+            let det = px[l] * pk.ys[k][l] - py[l] * pk.xs[k][l];
+            left[k][l] = det > 0.0;
+            tie[l] |= det == 0.0;
+        }
+    }
+    if tie.iter().any(|&t| t) {
+        ties(pk, &d, &px, &py, &tie, &mut left);
+    }
+    // Exit slot (`EXIT_SLOT`): 2 when left of d→a and right of d→b, 1 when
+    // right of d→a and left of d→c, else 0; the exiting vertex.
+    let mut s1 = [false; W];
+    let mut s2 = [false; W];
+    let mut exiting = [0u32; W];
+    for l in 0..W {
+        s2[l] = left[0][l] & !left[1][l];
+        s1[l] = !left[0][l] & left[2][l];
+        exiting[l] = if s1[l] {
+            pk.ids[1][l]
+        } else if s2[l] {
+            pk.ids[2][l]
+        } else {
+            pk.ids[0][l]
+        };
+    }
+    // Exit links, per lane from the layout.
+    let mut raw = [0u32; W];
+    for l in 0..W {
+        let face = [pk.ids[0][l], pk.ids[1][l], pk.ids[2][l]];
+        raw[l] = topo.exit_link(pk.next[l], face, d[l], exiting[l], pk.entry[l]);
+    }
+    // Commit: replace the exiting vertex, count the tet, move on.
+    let mut events = 0u32;
+    let mut capped = [false; W];
+    for l in 0..W {
+        capped[l] = pk.visited[l] >= cap;
+        let go = pk.live[l] & !capped[l] & !lost[l];
+        let sel = [go & !s1[l] & !s2[l], go & s1[l], go & s2[l]];
+        for k in 0..3 {
+            pk.ids[k][l] = if sel[k] { d[l] } else { pk.ids[k][l] };
+            pk.xs[k][l] = if sel[k] { px[l] } else { pk.xs[k][l] };
+            pk.ys[k][l] = if sel[k] { py[l] } else { pk.ys[k][l] };
+        }
+        pk.visited[l] += go as u32;
+        let moving = go & (raw[l] < Link::BOUNDARY.0);
+        pk.entry[l] = if moving { pk.next[l] } else { pk.entry[l] };
+        pk.next[l] = if moving { raw[l] } else { pk.next[l] };
+        events |= ((pk.live[l] & !moving) as u32) << l;
+    }
+    // A prefetch never faults: parked and stopped lanes prefetch harmlessly.
+    for &r in &raw {
+        topo.prefetch(r);
+    }
+    (events, Round { raw, lost, capped })
+}
+
+/// The scalar tie rule (`Face2::left_mask_ties`) for the lanes with a zero
+/// determinant.
+#[cold]
+#[inline(never)]
+fn ties<const W: usize>(
+    pk: &Pack<W>,
+    d: &[u32; W],
+    px: &[f32; W],
+    py: &[f32; W],
+    tie: &[bool; W],
+    left: &mut [[bool; W]; 3],
+) {
+    for l in 0..W {
+        if !tie[l] {
+            continue;
+        }
+        let pt = |k: usize| Vec2::new(pk.xs[k][l], pk.ys[k][l]);
+        let face = Face2::new([pt(0), pt(1), pt(2)]);
+        let ids = [pk.ids[0][l], pk.ids[1][l], pk.ids[2][l]];
+        let m = face.left_mask_ties(Vec2::new(px[l], py[l]), d[l], &ids);
+        for (k, lk) in left.iter_mut().enumerate() {
+            lk[l] = m >> k & 1 != 0;
+        }
+    }
+}
+
+/// The cold part of a round: each lane in `events` stopped; finish its
+/// step with the scalar engine, and when its walk ended store the outcome
+/// and refill the lane (or park it). Returns the number of lanes parked.
+#[cold]
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn lane_events<const W: usize>(
+    mesh: &TetMesh,
+    rays: &[Ray],
+    start: Start,
+    queued: &mut usize,
+    out: &mut [TraceOutcome],
+    pk: &mut Pack<W>,
+    events: u32,
+    round: &Round<W>,
+) -> usize {
+    let mut parked = 0;
+    for l in 0..W {
+        if events >> l & 1 == 0 {
+            continue;
+        }
+        // The order of the scalar `advance`: cap, then range, then face.
+        let adv = if round.capped[l] {
+            Advance::Cap
+        } else if round.lost[l] {
+            Advance::Lost
+        } else {
+            Advance::Face
+        };
+        let i = pk.ray[l];
+        let mut lane = pk.get(l, round.raw[l]);
+        match finish_step(mesh, &rays[i], &mut lane, adv) {
+            None => pk.set(l, i, &lane),
+            Some(o) => {
+                out[i] = o;
+                match next_lane::<DuffF32>(mesh, rays, start, queued, out) {
+                    Some((j, lane)) => pk.set(l, j, &lane),
+                    None => {
+                        pk.park(l);
+                        parked += 1;
+                    }
+                }
+            }
+        }
+    }
+    parked
+}
+
+#[cfg(target_arch = "x86_64")]
+const RANK: u8 = 0;
+#[cfg(target_arch = "x86_64")]
+const RANK_XOR: u8 = 1;
+#[cfg(target_arch = "x86_64")]
+const SLOT: u8 = 2;
+
+/// The 8-lane lockstep walk in AVX2 intrinsics, with the record words, the
+/// new vertices' points and the exit links fetched by gathers.
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use std::arch::x86_64::*;
+
+    use super::*;
+
+    /// [`Pack`] in registers (the hot fields only).
+    #[derive(Clone, Copy)]
+    struct V8 {
+        o: [__m256; 3],
+        c: [[__m256; 2]; 3],
+        ids: [__m256i; 3],
+        xs: [__m256; 3],
+        ys: [__m256; 3],
+        next: __m256i,
+        entry: __m256i,
+        visited: __m256i,
+        /// All ones in live lanes.
+        live: __m256i,
+    }
+
+    impl V8 {
+        fn load(pk: &Pack<8>) -> V8 {
+            let f = |a: [f32; 8]| bytemuck::cast::<[f32; 8], __m256>(a);
+            let u = |a: [u32; 8]| bytemuck::cast::<[u32; 8], __m256i>(a);
+            V8 {
+                o: pk.o.map(f),
+                c: pk.c.map(|a| a.map(f)),
+                ids: pk.ids.map(u),
+                xs: pk.xs.map(f),
+                ys: pk.ys.map(f),
+                next: u(pk.next),
+                entry: u(pk.entry),
+                visited: u(pk.visited),
+                live: u(pk.live.map(|b| if b { u32::MAX } else { 0 })),
+            }
+        }
+
+        /// Writes the hot fields back (lane bookkeeping stays in `pk`).
+        fn store(&self, pk: &mut Pack<8>) {
+            let f = |a: __m256| bytemuck::cast::<__m256, [f32; 8]>(a);
+            let u = |a: __m256i| bytemuck::cast::<__m256i, [u32; 8]>(a);
+            pk.o = self.o.map(f);
+            pk.c = self.c.map(|a| a.map(f));
+            pk.ids = self.ids.map(u);
+            pk.xs = self.xs.map(f);
+            pk.ys = self.ys.map(f);
+            pk.next = u(self.next);
+            pk.entry = u(self.entry);
+            pk.visited = u(self.visited);
+        }
+    }
+
+    /// Array bases and bounds of the gathers.
+    struct Geo<'a> {
+        points: &'a [Vec3],
+        words: &'a [u32],
+        last_point: i32,
+        last_tet: i32,
+        stride: i32,
+        vx: i32,
+        ids: i32,
+        links: i32,
+    }
+
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn splat(x: i32) -> __m256i {
+        _mm256_set1_epi32(x)
+    }
+
+    /// Gathers `words[idx]` per lane.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn gather_words(g: &Geo<'_>, idx: __m256i) -> __m256i {
+        // SAFETY: every caller forms `idx = min(next, last_tet) · stride + k`
+        // with `0 ≤ k < stride` (checked by `RecordWords::gatherable`), so
+        // each lane reads a word inside `g.words`.
+        unsafe { _mm256_i32gather_epi32::<4>(g.words.as_ptr() as *const i32, idx) }
+    }
+
+    /// Gathers coordinate `axis` (0..=2) of `points[i]` per lane, `i ≤ last_point`.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn gather_points(g: &Geo<'_>, i3: __m256i, axis: usize) -> __m256 {
+        // `Vec3` is `#[repr(C)]` `{x, y, z}`: 3 f32 words per point.
+        let base = g.points.as_ptr() as *const f32;
+        // SAFETY: `i3 = 3·i` with `i ≤ last_point = points.len() − 1` per
+        // lane, so word `i3 + axis` (axis ≤ 2) lies inside `points`;
+        // `wrapping_add` only forms the base address.
+        unsafe { _mm256_i32gather_ps::<4>(base.wrapping_add(axis), i3) }
+    }
+
+    /// What the cold path needs after a round with events.
+    struct Cold {
+        events: u32,
+        round: Round<8>,
+    }
+
+    /// One round of the walk (see `super::step`, the same decisions).
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn step<const RULE: u8>(v: &mut V8, g: &Geo<'_>, cap: u32) -> Option<Cold> {
+        let zero = _mm256_setzero_ps();
+        let ones = _mm256_set1_epi32(-1);
+        // Loads: `VX`, the new vertex `d = idx₀ ⊕ idx₁ ⊕ idx₂ ⊕ VX`, its point.
+        let tet = _mm256_min_epu32(v.next, splat(g.last_tet));
+        let base = _mm256_mullo_epi32(tet, splat(g.stride));
+        let vxw = gather_words(g, _mm256_add_epi32(base, splat(g.vx)));
+        let d = _mm256_xor_si256(
+            _mm256_xor_si256(v.ids[0], v.ids[1]),
+            _mm256_xor_si256(v.ids[2], vxw),
+        );
+        let dc = _mm256_min_epu32(d, splat(g.last_point));
+        let lost = _mm256_xor_si256(_mm256_cmpeq_epi32(dc, d), ones);
+        let i3 = _mm256_add_epi32(_mm256_add_epi32(dc, dc), dc);
+        let qx = _mm256_sub_ps(gather_points(g, i3, 0), v.o[0]);
+        let qy = _mm256_sub_ps(gather_points(g, i3, 1), v.o[1]);
+        let qz = _mm256_sub_ps(gather_points(g, i3, 2), v.o[2]);
+        // Projection: `(c₀·qₓ + c₁·q_y) + c₂·q_z`, no FMA.
+        let proj = |k: usize| {
+            _mm256_add_ps(
+                _mm256_add_ps(_mm256_mul_ps(v.c[0][k], qx), _mm256_mul_ps(v.c[1][k], qy)),
+                _mm256_mul_ps(v.c[2][k], qz),
+            )
+        };
+        let (px, py) = (proj(0), proj(1));
+        // `det(p₃, pᵢ) = p₃.x·yᵢ − p₃.y·xᵢ`.
+        let det = |k: usize| _mm256_sub_ps(_mm256_mul_ps(px, v.ys[k]), _mm256_mul_ps(py, v.xs[k]));
+        let dets = [det(0), det(1), det(2)];
+        let mut left = dets.map(|x| _mm256_cmp_ps::<_CMP_GT_OQ>(x, zero));
+        let tie = _mm256_or_ps(
+            _mm256_or_ps(
+                _mm256_cmp_ps::<_CMP_EQ_OQ>(dets[0], zero),
+                _mm256_cmp_ps::<_CMP_EQ_OQ>(dets[1], zero),
+            ),
+            _mm256_cmp_ps::<_CMP_EQ_OQ>(dets[2], zero),
+        );
+        let tie = _mm256_and_ps(tie, _mm256_castsi256_ps(v.live));
+        if _mm256_movemask_ps(tie) != 0 {
+            left = ties8(v, d, px, py, tie, left);
+        }
+        // Exit slot and exiting vertex (`EXIT_SLOT`).
+        let s2 = _mm256_castps_si256(_mm256_andnot_ps(left[1], left[0]));
+        let s1 = _mm256_castps_si256(_mm256_andnot_ps(left[0], left[2]));
+        let s0 = _mm256_xor_si256(_mm256_or_si256(s1, s2), ones);
+        let e = _mm256_blendv_epi8(_mm256_blendv_epi8(v.ids[0], v.ids[2], s2), v.ids[1], s1);
+        // Exit link. Ids are < 2³¹ (`gatherable`), so signed compares order
+        // them; `a > b` is −1, so a sum of compares is minus a count.
+        let rank = |x: __m256i, of: [__m256i; 4]| {
+            let c = of.map(|y| _mm256_cmpgt_epi32(x, y));
+            let n = _mm256_add_epi32(_mm256_add_epi32(c[0], c[1]), _mm256_add_epi32(c[2], c[3]));
+            _mm256_min_epu32(_mm256_sub_epi32(_mm256_setzero_si256(), n), splat(3))
+        };
+        let links = _mm256_add_epi32(base, splat(g.links));
+        let link = match RULE {
+            RANK => {
+                let r = rank(e, [v.ids[0], v.ids[1], v.ids[2], d]);
+                gather_words(g, _mm256_add_epi32(links, r))
+            }
+            RANK_XOR => {
+                // `rank(d)` among the entry face (d itself never counts).
+                let rd = rank(d, [v.ids[0], v.ids[1], v.ids[2], d]);
+                let re = rank(e, [v.ids[0], v.ids[1], v.ids[2], d]);
+                let nx = |r: __m256i| {
+                    let m = _mm256_cmpgt_epi32(splat(3), r);
+                    let idx = _mm256_and_si256(_mm256_add_epi32(links, r), m);
+                    // Lanes with rank 3 read word 0 (in range) and drop it.
+                    _mm256_and_si256(gather_words(g, _mm256_blendv_epi8(base, idx, m)), m)
+                };
+                _mm256_xor_si256(_mm256_xor_si256(v.entry, nx(rd)), nx(re))
+            }
+            _ => {
+                let ids = _mm256_add_epi32(base, splat(g.ids));
+                let vid = |k: i32| gather_words(g, _mm256_add_epi32(ids, splat(k)));
+                let mut slot = splat(3);
+                for k in (0..3).rev() {
+                    let hit = _mm256_cmpeq_epi32(e, vid(k));
+                    slot = _mm256_blendv_epi8(slot, splat(k), hit);
+                }
+                gather_words(g, _mm256_add_epi32(links, slot))
+            }
+        };
+        // Commit.
+        let capped = _mm256_cmpeq_epi32(
+            _mm256_min_epu32(v.visited, splat(cap as i32)),
+            splat(cap as i32),
+        );
+        let go = _mm256_andnot_si256(_mm256_or_si256(capped, lost), v.live);
+        for (k, s) in [s0, s1, s2].into_iter().enumerate() {
+            let sel = _mm256_and_si256(go, s);
+            let self_ps = _mm256_castsi256_ps(sel);
+            v.ids[k] = _mm256_blendv_epi8(v.ids[k], d, sel);
+            v.xs[k] = _mm256_blendv_ps(v.xs[k], px, self_ps);
+            v.ys[k] = _mm256_blendv_ps(v.ys[k], py, self_ps);
+        }
+        v.visited = _mm256_sub_epi32(v.visited, go);
+        let boundary = splat(Link::BOUNDARY.0 as i32);
+        let is_tet = _mm256_xor_si256(
+            _mm256_cmpeq_epi32(_mm256_min_epu32(link, boundary), boundary),
+            ones,
+        );
+        let moving = _mm256_and_si256(go, is_tet);
+        v.entry = _mm256_blendv_epi8(v.entry, v.next, moving);
+        v.next = _mm256_blendv_epi8(v.next, link, moving);
+        let raw = bytemuck::cast::<__m256i, [u32; 8]>(link);
+        if PREFETCH {
+            for &r in &raw {
+                crate::walk::prefetch_index(g.words, r.wrapping_mul(g.stride as u32));
+            }
+        }
+        let events = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_andnot_si256(moving, v.live)));
+        if events == 0 {
+            return None;
+        }
+        let flags = |m: __m256i| bytemuck::cast::<__m256i, [u32; 8]>(m).map(|x| x != 0);
+        Some(Cold {
+            events: events as u32,
+            round: Round {
+                raw,
+                lost: flags(lost),
+                capped: flags(capped),
+            },
+        })
+    }
+
+    /// Prefetch the next tets' records (measured: see the module docs).
+    const PREFETCH: bool = false;
+
+    /// The scalar tie rule for the lanes with a zero determinant (`tie`).
+    #[target_feature(enable = "avx2")]
+    #[inline(never)]
+    #[cold]
+    fn ties8(
+        v: &V8,
+        d: __m256i,
+        px: __m256,
+        py: __m256,
+        tie: __m256,
+        left: [__m256; 3],
+    ) -> [__m256; 3] {
+        let f = |a: __m256| bytemuck::cast::<__m256, [f32; 8]>(a);
+        let u = |a: __m256i| bytemuck::cast::<__m256i, [u32; 8]>(a);
+        let (xs, ys, ids) = (v.xs.map(f), v.ys.map(f), v.ids.map(u));
+        let (d, px, py, tie) = (u(d), f(px), f(py), f(tie));
+        let mut left = left.map(f);
+        for l in 0..8 {
+            if tie[l].to_bits() == 0 {
+                continue;
+            }
+            let pt = |k: usize| Vec2::new(xs[k][l], ys[k][l]);
+            let face = Face2::new([pt(0), pt(1), pt(2)]);
+            let id = [ids[0][l], ids[1][l], ids[2][l]];
+            let m = face.left_mask_ties(Vec2::new(px[l], py[l]), d[l], &id);
+            for (k, lk) in left.iter_mut().enumerate() {
+                lk[l] = f32::from_bits(if m >> k & 1 != 0 { u32::MAX } else { 0 });
+            }
+        }
+        left.map(bytemuck::cast::<[f32; 8], __m256>)
+    }
+
+    /// The AVX2 lockstep driver with exit rule `RULE`; `rw` must be
+    /// [`RecordWords::gatherable`] for `mesh.points`.
+    #[target_feature(enable = "avx2")]
+    pub(super) fn run_gather<const RULE: u8>(
+        mesh: &TetMesh,
+        rw: RecordWords<'_>,
+        rays: &[Ray],
+        start: Start,
+        cap: u32,
+        out: &mut [TraceOutcome],
+    ) {
+        let n = rays.len().min(out.len());
+        let (rays, out) = (&rays[..n], &mut out[..n]);
+        // The dispatcher checked it; the gathers' bounds rest on it.
+        assert!(
+            rw.gatherable(mesh.points.len()),
+            "record words not gatherable"
+        );
+        let (ids, links) = match rw.rule {
+            ExitRule::Rank { links } | ExitRule::RankXor { links } => (0, links),
+            ExitRule::Slot { ids, links } => (ids, links),
+        };
+        let g = Geo {
+            points: &mesh.points,
+            words: rw.words,
+            last_point: (mesh.points.len() - 1) as i32,
+            last_tet: (rw.words.len() / rw.stride - 1) as i32,
+            stride: rw.stride as i32,
+            vx: rw.vx as i32,
+            ids: ids as i32,
+            links: links as i32,
+        };
+        let mut queued = 0;
+        // `GROUPS` independent packs of 8 lanes, stepped in turn: the
+        // out-of-order core overlaps their dependent gather chains.
+        let mut pks: [(Pack<8>, usize); GROUPS] =
+            std::array::from_fn(|_| fill::<8>(mesh, rays, start, &mut queued, out));
+        let mut vs: [V8; GROUPS] = std::array::from_fn(|k| V8::load(&pks[k].0));
+        loop {
+            let mut any = false;
+            for (v, (pk, live)) in vs.iter_mut().zip(pks.iter_mut()) {
+                if *live == 0 {
+                    continue;
+                }
+                any = true;
+                if let Some(c) = step::<RULE>(v, &g, cap) {
+                    v.store(pk);
+                    *live -=
+                        lane_events(mesh, rays, start, &mut queued, out, pk, c.events, &c.round);
+                    *v = V8::load(pk);
+                }
+            }
+            if !any {
+                break;
+            }
+        }
+    }
+
+    /// Packs of 8 lanes in flight per thread (measured: see the module docs).
+    const GROUPS: usize = 2;
+}
