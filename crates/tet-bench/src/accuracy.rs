@@ -309,19 +309,12 @@ fn check(
 pub fn parse_methods(s: &str) -> Result<Vec<Method>> {
     use clap::ValueEnum;
     if s == "all" {
-        return Ok(vec![
-            Method::Sctp,
-            Method::Tet80,
-            Method::Tet32,
-            Method::Tet20,
-            Method::Tet16,
-            Method::Obvhs,
-        ]);
+        return Ok(crate::methods::cpu_methods());
     }
     s.split(',')
         .map(|m| {
             Method::from_str(m.trim(), true).map_err(|_| {
-                anyhow::anyhow!("unknown method `{m}` (expected sctp, tet80, tet32, tet20, tet16, obvhs, brute or all)")
+                anyhow::anyhow!("unknown method `{m}` (expected sctp, tet80, tet32, tet20, tet16, obvhs, embree, embree8, brute or all)")
             })
         })
         .collect()

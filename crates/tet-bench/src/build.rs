@@ -95,7 +95,17 @@ pub fn run(args: &BuildArgs, json: bool) -> Result<()> {
             )
         }
     };
-    tet_core::format::save(output, &loaded.mesh)
+    // The scene's own camera and lights travel with the mesh, so that
+    // `render FILE` sees what `render SCENE` sees.
+    let stored = tet_core::scene::SceneInfo {
+        camera: loaded.scene.as_ref().and_then(|s| s.camera),
+        lights: loaded
+            .scene
+            .as_ref()
+            .map(|s| s.lights.clone())
+            .unwrap_or_default(),
+    };
+    tet_core::format::save_with_scene(output, &loaded.mesh, &stored)
         .with_context(|| format!("cannot write {}", output.display()))?;
     let file_bytes = std::fs::metadata(output).map(|m| m.len()).unwrap_or(0);
     let doc = BuildDoc {

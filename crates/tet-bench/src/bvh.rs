@@ -169,30 +169,34 @@ impl<'m> BvhTracer<'m> {
             }
         }
     }
+}
 
-    fn hit_record(&self, ray: &Ray, face: u32, t: f32) -> Hit {
-        let cf = &self.mesh.constrained[face as usize];
-        let [p0, p1, p2] = cf.vertices.map(|v| self.mesh.points[v as usize]);
-        let n = (p1 - p0).cross(p2 - p0);
-        let p = ray.at(t);
-        let area = n.length_squared().max(f32::MIN_POSITIVE);
-        let b1 = (p0 - p).cross(p2 - p).dot(n) / area;
-        let b2 = (p1 - p).cross(p0 - p).dot(n) / area;
-        let from_front = ray.direction.dot(n) < 0.0;
-        let (near, far) = if from_front {
-            (cf.front.tet, cf.back.tet)
-        } else {
-            (cf.back.tet, cf.front.tet)
-        };
-        Hit {
-            triangle: cf.triangle,
-            face,
-            t,
-            barycentrics: [1.0 - b1 - b2, b1, b2],
-            tet: near,
-            far_tet: far,
-            tets_visited: 0,
-        }
+/// The hit record of a BVH-style tracer that found constrained face `face`
+/// at distance `t` along `ray`: barycentrics and the tets on both sides
+/// recomputed from the mesh (so every method reports the same record;
+/// `tets_visited` is 0).
+pub fn face_hit(mesh: &TetMesh, ray: &Ray, face: u32, t: f32) -> Hit {
+    let cf = &mesh.constrained[face as usize];
+    let [p0, p1, p2] = cf.vertices.map(|v| mesh.points[v as usize]);
+    let n = (p1 - p0).cross(p2 - p0);
+    let p = ray.at(t);
+    let area = n.length_squared().max(f32::MIN_POSITIVE);
+    let b1 = (p0 - p).cross(p2 - p).dot(n) / area;
+    let b2 = (p1 - p).cross(p0 - p).dot(n) / area;
+    let from_front = ray.direction.dot(n) < 0.0;
+    let (near, far) = if from_front {
+        (cf.front.tet, cf.back.tet)
+    } else {
+        (cf.back.tet, cf.front.tet)
+    };
+    Hit {
+        triangle: cf.triangle,
+        face,
+        t,
+        barycentrics: [1.0 - b1 - b2, b1, b2],
+        tet: near,
+        far_tet: far,
+        tets_visited: 0,
     }
 }
 
@@ -225,7 +229,7 @@ impl Tracer for BvhTracer<'_> {
             let (best, nodes) = self.count_trace(&r, |id| self.faces[id] != skip);
             return match best {
                 Some((id, t)) => {
-                    let mut h = self.hit_record(ray, self.faces[id], t);
+                    let mut h = face_hit(self.mesh, ray, self.faces[id], t);
                     h.tets_visited = nodes;
                     TraceOutcome::Hit(h)
                 }
@@ -244,7 +248,7 @@ impl Tracer for BvhTracer<'_> {
         });
         if found {
             let face = self.faces[hit.primitive_id as usize];
-            TraceOutcome::Hit(self.hit_record(ray, face, hit.t))
+            TraceOutcome::Hit(face_hit(self.mesh, ray, face, hit.t))
         } else {
             TraceOutcome::Miss { tets_visited: 0 }
         }

@@ -112,6 +112,10 @@ pub enum Method {
     Tet16,
     /// BVH baseline (obvhs, BVH2).
     Obvhs,
+    /// Embree 3, one `rtcIntersect1` per ray (needs the `embree` feature).
+    Embree,
+    /// Embree 3, `rtcIntersect8` on packets of 8 rays (needs the `embree` feature).
+    Embree8,
     /// f64 brute force over all triangles (reference; slow).
     Brute,
     /// Tet20 walk as a wgpu compute shader (needs the `gpu` feature).
@@ -134,6 +138,8 @@ impl Method {
             Method::Tet20 => "tet20",
             Method::Tet16 => "tet16",
             Method::Obvhs => "obvhs",
+            Method::Embree => "embree",
+            Method::Embree8 => "embree8",
             Method::Brute => "brute",
             Method::GpuTet20 => "gpu-tet20",
             Method::GpuTet32 => "gpu-tet32",

@@ -77,9 +77,15 @@ pub struct CleaningSummary {
 pub fn load(spec: &str, flags: &BuildFlags, quiet: bool) -> Result<Loaded> {
     let path = Path::new(spec);
     if path.extension().is_some_and(|e| e == MESH_EXTENSION) {
-        let mesh = tet_core::format::load(path)?;
-        let camera = framing_camera(&mesh);
-        let lights = vec![light_at(camera.position)];
+        // The camera and lights stored with the mesh (`tet-bench build`
+        // writes the scene's), else a camera framing the mesh.
+        let (mesh, stored) = tet_core::format::load_with_scene(path)?;
+        let camera = stored.camera.unwrap_or_else(|| framing_camera(&mesh));
+        let lights = if stored.lights.is_empty() {
+            vec![light_at(camera.position)]
+        } else {
+            stored.lights
+        };
         return Ok(Loaded {
             name: path
                 .file_stem()
@@ -195,14 +201,13 @@ pub fn build_scene_in(
     };
     options.tetgen.quality = flags.quality;
     options.tetgen.max_steiner = flags.max_steiner;
-    let (mut mesh, report) = build(scene, &options)
-        .with_context(|| format!("cannot build a tetrahedral mesh of `{}`", scene.name))?;
-    let reorder_start = Instant::now();
     if !flags.no_sort {
-        spinner.set_message(format!("building {}: Hilbert reordering", scene.name));
-        tet_core::reorder::hilbert_reorder(&mut mesh)?;
+        // Hilbert order inside the pipeline: parallel, one gather per array.
+        options.reorder = tet_build::pipeline::Reorder::Hilbert;
     }
-    let reorder_s = reorder_start.elapsed().as_secs_f64();
+    let (mesh, report) = build(scene, &options)
+        .with_context(|| format!("cannot build a tetrahedral mesh of `{}`", scene.name))?;
+    let reorder_s = report.times.reorder.as_secs_f64();
     spinner.finish_and_clear();
     let t = report.times;
     let summary = BuildSummary {

@@ -6,6 +6,8 @@ mod brute;
 mod build;
 mod bvh;
 mod cli;
+#[cfg(feature = "embree")]
+mod embree;
 mod exitface;
 mod extremes;
 mod gpu;

@@ -24,6 +24,16 @@ pub fn tracer<'m>(method: Method, f64: bool, mesh: &'m TetMesh) -> Result<Box<dy
         (Method::Tet16, false) => Box::new(<Tet16Tracer<'_>>::new(mesh)?),
         (Method::Tet16, true) => Box::new(Tet16TracerF64::new(mesh)?),
         (Method::Obvhs, false) => Box::new(BvhTracer::new(mesh)),
+        #[cfg(feature = "embree")]
+        (Method::Embree, false) => Box::new(crate::embree::EmbreeTracer::new(mesh, false)?),
+        #[cfg(feature = "embree")]
+        (Method::Embree8, false) => Box::new(crate::embree::EmbreeTracer::new(mesh, true)?),
+        #[cfg(not(feature = "embree"))]
+        (Method::Embree | Method::Embree8, _) => bail!(
+            "method {} needs tet-bench built with `--features embree` (and the system Embree 3 \
+             library: `apt-get install libembree-dev`)",
+            method.name()
+        ),
         (Method::Brute, _) => Box::new(crate::brute::BruteTracer { mesh }),
         (m, true) => bail!("method {} has no f64 variant", m.name()),
         (m, false) => bail!("{} runs on the GPU: only `render` supports it", m.name()),
@@ -36,4 +46,22 @@ pub fn has_f64(method: Method) -> bool {
         method,
         Method::Tet32 | Method::Tet20 | Method::Tet16 | Method::Brute
     )
+}
+
+/// The CPU methods every comparison runs (`tables`, `accuracy --methods
+/// all`): the tet walks, the obvhs BVH and, when built with the `embree`
+/// feature, Embree's single rays and packets.
+pub fn cpu_methods() -> Vec<Method> {
+    let mut m = vec![
+        Method::Tet20,
+        Method::Tet16,
+        Method::Tet32,
+        Method::Tet80,
+        Method::Sctp,
+        Method::Obvhs,
+    ];
+    if cfg!(feature = "embree") {
+        m.extend([Method::Embree, Method::Embree8]);
+    }
+    m
 }

@@ -438,3 +438,32 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
     assert_eq!(marks("mrays_per_method.svg"), (0, 4 * methods));
     assert_eq!(marks("figure8_sorted_vs_unsorted.svg"), (0, 2 * 4));
 }
+
+/// `build` stores the scene's camera and lights in the mesh file, and
+/// `render FILE` uses them: the file renders exactly the image of the scene
+/// (same hits), which a camera framing the mesh would not.
+#[test]
+fn mesh_files_carry_the_scene_camera_and_lights() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = tiny_scenes(dir.path());
+    let spec = format!("{}#Octa Zoom 1", scenes.display());
+    let file = dir.path().join("zoom1.tmesh");
+    let file = file.to_str().unwrap();
+    json(&["build", &spec, "-o", file]);
+    let (mesh, stored) = tet_core::format::load_with_scene(std::path::Path::new(file)).unwrap();
+    assert!(!mesh.tets.is_empty());
+    let cam = stored.camera.expect("the scene's camera is stored");
+    // Orbit distance 9 around the origin (scenes.json convention).
+    assert!((cam.position.length() - 9.0).abs() < 1e-4, "{cam:?}");
+    assert_eq!(stored.lights.len(), 1);
+    assert_eq!(stored.lights[0].position, glam::Vec3::new(3.0, 4.0, 5.0));
+    let render = |s: &str| {
+        json(&[
+            "render", s, "--method", "tet20", "--width", "40", "--height", "30", "--frames", "1",
+        ])
+    };
+    let (a, b) = (render(&spec), render(file));
+    assert!(a["hits"].as_u64().unwrap() > 0);
+    assert_eq!(a["hits"], b["hits"]);
+    assert_eq!(a["tets_per_ray"], b["tets_per_ray"]);
+}
