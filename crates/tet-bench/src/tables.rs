@@ -52,13 +52,14 @@ const PAPER_ZOOM: [(f64, f64, f64, f64); 6] = [
 
 /// neptun (the authors' C++ code) on a 2-core machine, Torus Knots,
 /// 1920×1440 primary rays, 2 threads, Mrays/s (issue 4 of this project).
-const NEPTUN_TORUS_KNOTS_MRAYS: [(Method, f64); 6] = [
+const NEPTUN_TORUS_KNOTS_MRAYS: [(Method, f64); 7] = [
     (Method::Tet20, 5.23),
     (Method::Tet16, 4.84),
     (Method::Tet32, 2.31),
     (Method::Tet80, 1.65),
     (Method::Sctp, 2.79),
     (Method::Obvhs, 4.92),
+    (Method::Embree, 11.3),
 ];
 
 /// Seed 000 Table 4, Torus Knots, MB per layout (their Tet80 column is the
@@ -68,16 +69,6 @@ const PAPER_TABLE4_TORUS_KNOTS_MB: [(&str, f64); 4] = [
     ("tet20", 9.2),
     ("tet16", 8.2),
     ("tet80", 20.6),
-];
-
-/// Methods rendered, in table order.
-const METHODS: [Method; 6] = [
-    Method::Tet20,
-    Method::Tet16,
-    Method::Tet32,
-    Method::Tet80,
-    Method::Sctp,
-    Method::Obvhs,
 ];
 
 /// The machine and settings every table states.
@@ -376,7 +367,8 @@ fn measure_scene(
     drop(crate::bvh::BvhTracer::new(&loaded.mesh));
     let bvh_build_s = bvh_start.elapsed().as_secs_f64();
     let mut renders = Vec::new();
-    for m in METHODS {
+    let methods = crate::methods::cpu_methods();
+    for &m in &methods {
         eprintln!("  {spec}: rendering with {}", m.name());
         renders.push(time_method(&loaded, m, opts, frames, pool)?.0);
     }
@@ -386,7 +378,7 @@ fn measure_scene(
         (1024, 100_000)
     };
     eprintln!("  {spec}: accuracy ({side}² camera rays + {rays} random rays)");
-    let accuracy = run_case("as-is", &loaded, &METHODS, Precision::F32, side, rays, 1)?;
+    let accuracy = run_case("as-is", &loaded, &methods, Precision::F32, side, rays, 1)?;
     eprintln!("  {spec}: unsorted mesh for Figure 8");
     let unsorted = cache
         .load(
