@@ -929,19 +929,7 @@ fn assemble_from_tetgen(
                 });
             }
             *link = Link::constrained(c as u32);
-            let tet = tets[t as usize];
-            let s = FACE_VERTICES[k];
-            let outward = [tet[s[0]], tet[s[1]], tet[s[2]]];
-            let side = FaceSide {
-                tet: t,
-                face: k as u32,
-            };
-            // Triangle normal points out of t: t lies behind the triangle.
-            if same_cyclic_order(vertices, outward) {
-                cf.back = side;
-            } else {
-                cf.front = side;
-            }
+            cf.attach_side(tets[t as usize], t, k);
         }
         constrained.push(cf);
     }
@@ -953,11 +941,6 @@ fn assemble_from_tetgen(
         triangle_count,
         attributes: Attributes::default(),
     }))
-}
-
-/// True when `b` is a cyclic rotation of `a`.
-fn same_cyclic_order(a: [u32; 3], b: [u32; 3]) -> bool {
-    a == b || a == [b[1], b[2], b[0]] || a == [b[2], b[0], b[1]]
 }
 
 /// Sorts `(key, index)` pairs (in parallel) and returns the indices: the
@@ -1453,60 +1436,13 @@ fn check_tet_links(m: &TetMesh, t: u32) -> Result<(usize, usize), MeshError> {
     Ok((tet_links, pairs))
 }
 
-/// The constrained-face table, entry by entry, as in [`TetMesh::validate`].
+/// The constrained-face table, entry by entry and in parallel, with
+/// [`TetMesh::validate`]'s own rules ([`TetMesh::check_constrained_face`]).
 fn check_constrained_sides(m: &TetMesh) -> Result<(), MeshError> {
-    m.constrained
-        .par_iter()
-        .enumerate()
+    (0..m.constrained.len())
+        .into_par_iter()
         .with_min_len(4096)
-        .try_for_each(|(c, cf)| {
-            let index = c as u32;
-            let bad = |detail: String| Err(MeshError::ConstrainedBackReference { index, detail });
-            if cf.triangle >= m.triangle_count {
-                return bad(format!(
-                    "triangle id {} is not below the triangle count {}",
-                    cf.triangle, m.triangle_count
-                ));
-            }
-            if !cf.front.exists() && !cf.back.exists() {
-                return bad("has no tet on either side".into());
-            }
-            if cf.front.exists() && cf.front.tet == cf.back.tet {
-                return bad(format!("tet {} is on both sides", cf.front.tet));
-            }
-            for (name, side, is_front) in [("front", cf.front, true), ("back", cf.back, false)] {
-                if !side.exists() {
-                    continue;
-                }
-                if side.tet as usize >= m.tets.len() || side.face >= 4 {
-                    return bad(format!(
-                        "{name} side (tet {}, face {}) is out of bounds",
-                        side.tet, side.face
-                    ));
-                }
-                let link = m.neighbors[side.tet as usize][side.face as usize];
-                if link.as_constrained() != Some(index) {
-                    return bad(format!(
-                        "{name} tet {} face {} links to {link:?}, not back to it",
-                        side.tet, side.face
-                    ));
-                }
-                let outward = m.face_vertices(side.tet, side.face as usize);
-                if face_key(outward) != face_key(cf.vertices) {
-                    return bad(format!(
-                        "vertices {:?} differ from {name} tet {} face {} {:?}",
-                        cf.vertices, side.tet, side.face, outward
-                    ));
-                }
-                if same_cyclic_order(cf.vertices, outward) == is_front {
-                    return bad(format!(
-                        "tet {} is recorded as the {name} side but lies on the other side of the triangle's winding",
-                        side.tet
-                    ));
-                }
-            }
-            Ok(())
-        })
+        .try_for_each(|c| m.check_constrained_face(c))
 }
 
 /// Face manifoldness from class representatives (see [`check_construction`];

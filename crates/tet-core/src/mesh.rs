@@ -58,6 +58,21 @@ pub struct ConstrainedFace {
 }
 
 impl ConstrainedFace {
+    /// Records tet `t` (vertices `tet`), whose face `k` is this face, as the
+    /// front or the back side according to the face's winding: the
+    /// triangle's normal points out of the back tet. Shared by every
+    /// builder of the table so the rule exists once.
+    pub fn attach_side(&mut self, tet: [u32; 4], t: u32, k: usize) {
+        let s = FACE_VERTICES[k];
+        let outward = [tet[s[0]], tet[s[1]], tet[s[2]]];
+        let side = FaceSide { tet: t, face: k as u32 };
+        if same_cyclic_order(self.vertices, outward) {
+            self.back = side;
+        } else {
+            self.front = side;
+        }
+    }
+
     /// The side on which `tet` lies, if it is one of the two.
     pub fn side_of(&self, tet: u32) -> Option<FaceSide> {
         if self.front.tet == tet {
@@ -293,19 +308,7 @@ impl TetMesh {
                     });
                 }
                 *link = Link::constrained(index);
-                let tet = tets[t as usize];
-                let s = FACE_VERTICES[f as usize];
-                let outward = [tet[s[0]], tet[s[1]], tet[s[2]]];
-                let side = FaceSide {
-                    tet: t,
-                    face: f as u32,
-                };
-                // Triangle normal points out of t: t lies behind the triangle.
-                if same_cyclic_order(vertices, outward) {
-                    cf.back = side;
-                } else {
-                    cf.front = side;
-                }
+                cf.attach_side(tets[t as usize], t, f as usize);
             }
             constrained.push(cf);
         }

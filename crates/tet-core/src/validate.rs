@@ -153,7 +153,19 @@ fn shared_or_empty(m: &TetMesh, n: u32, t: u32) -> [u32; 3] {
 }
 
 fn check_constrained_table(m: &TetMesh) -> Result<(), MeshError> {
-    for (c, cf) in m.constrained.iter().enumerate() {
+    (0..m.constrained.len()).try_for_each(|c| m.check_constrained_face(c))
+}
+
+impl TetMesh {
+    /// Checks entry `c` of the constrained-face table exactly as
+    /// [`TetMesh::validate`] does (triangle id, sides in bounds and linking
+    /// back, same vertices, winding agreeing with front/back). Public so
+    /// that a builder can check the table in parallel, entry by entry,
+    /// without re-implementing the rules. `c` must be below
+    /// `self.constrained.len()`.
+    pub fn check_constrained_face(&self, c: usize) -> Result<(), MeshError> {
+        let m = self;
+        let cf = &m.constrained[c];
         let index = c as u32;
         let bad = |detail: String| Err(MeshError::ConstrainedBackReference { index, detail });
         if cf.triangle >= m.triangle_count {
@@ -200,8 +212,8 @@ fn check_constrained_table(m: &TetMesh) -> Result<(), MeshError> {
                 ));
             }
         }
+        Ok(())
     }
-    Ok(())
 }
 
 /// Each face key appears at most twice; twice only between linked tets (or
