@@ -197,6 +197,43 @@ pub fn kuhn_grid(spec: &GridSpec) -> TetMesh {
     TetMesh::assemble(points, tets, &triangles, count).expect("Kuhn grid is conforming")
 }
 
+/// `grid` (a mesh without constrained faces, e.g. an unjittered
+/// [`kuhn_grid`]) with every face whose three vertex positions satisfy `on`
+/// made a constrained face, one scene triangle id per face (in the order
+/// met). With `facing = Some(n)` each triangle is wound so that its normal
+/// has a non-negative dot product with `n`; with `None` it keeps the
+/// outward order of the first tet met. For tests that need constrained
+/// planes, slabs or boxes at exact coordinates.
+///
+/// # Panics
+/// If the marked faces do not form a valid constrained-face table (the
+/// caller built a grid with constrained faces already).
+pub fn constrain_faces(
+    grid: TetMesh,
+    on: impl Fn([Vec3; 3]) -> bool,
+    facing: Option<Vec3>,
+) -> TetMesh {
+    let mut tris = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    for tet in &grid.tets {
+        for s in FACE_VERTICES {
+            let f = [tet[s[0]], tet[s[1]], tet[s[2]]];
+            let v = f.map(|i| grid.points[i as usize]);
+            if on(v) && seen.insert(crate::mesh::face_key(f)) {
+                let flip = facing.is_some_and(|n| (v[1] - v[0]).cross(v[2] - v[0]).dot(n) < 0.0);
+                let f = if flip { [f[0], f[2], f[1]] } else { f };
+                tris.push((f, tris.len() as u32));
+            }
+        }
+    }
+    let n = tris.len() as u32;
+    let m = TetMesh::assemble(grid.points, grid.tets, &tris, n)
+        .expect("marked faces of a grid form a valid table");
+    m.validate()
+        .expect("marked faces of a grid form a valid mesh");
+    m
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

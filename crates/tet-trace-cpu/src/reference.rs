@@ -257,3 +257,15 @@ pub fn axis_ray(rng: &mut SplitMix64, lo: Vec3, hi: Vec3) -> Ray {
     d[axis % 3] = if axis < 3 { 1.0 } else { -1.0 };
     Ray::new(o, d)
 }
+
+/// The outcome of `tracer` on the ray from `origin` along `direction`,
+/// started in the tet that contains `origin` (located from tet 0): a
+/// primary ray as a test writes it in one line.
+pub fn trace_from(
+    tracer: &dyn crate::Tracer,
+    origin: Vec3,
+    direction: Vec3,
+) -> Result<crate::TraceOutcome, crate::LocateError> {
+    let start = crate::locate(tracer.mesh(), origin, 0)?;
+    Ok(tracer.trace(&Ray::new(origin, direction), crate::Start::Tet(start)))
+}

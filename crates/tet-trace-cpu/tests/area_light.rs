@@ -4,48 +4,29 @@
 
 use glam::{DVec3, Vec3};
 use tet_core::scene::Camera;
-use tet_core::synthetic::{GridSpec, kuhn_grid};
-use tet_core::{FACE_VERTICES, TetMesh};
+use tet_core::synthetic::{GridSpec, constrain_faces, kuhn_grid};
+use tet_core::TetMesh;
 use tet_trace_cpu::area_light::{AreaLight, AreaLightError, geometry, irradiance, strata};
-use tet_trace_cpu::reference::edge_distance;
+use tet_trace_cpu::reference::{edge_distance, trace_from};
 use tet_trace_cpu::render::{Lights, RenderOptions, render_scene, render_scene_with};
 use tet_trace_cpu::secondary::{MeshWalker, ShadowTracer, hit_point};
 use tet_trace_cpu::tet20::Tet20Tracer;
 use tet_trace_cpu::tet80::Tet80Tracer;
-use tet_trace_cpu::{DuffF32, Hit, Ray, Start, Tracer, locate};
+use tet_trace_cpu::{DuffF32, Hit, Start, Tracer, locate};
 
 /// The unjittered 4³ grid with the tet faces whose three vertices satisfy
-/// `on` marked constrained, one scene triangle per face.
+/// `on` marked constrained, one scene triangle per face, wound to face +z.
 fn grid_with(on: impl Fn(Vec3) -> bool) -> TetMesh {
     let g = kuhn_grid(&GridSpec {
         cells: [4, 4, 4],
         jitter: 0.0,
         ..Default::default()
     });
-    let mut tris = Vec::new();
-    let mut seen = std::collections::HashSet::new();
-    for tet in &g.tets {
-        for s in FACE_VERTICES {
-            let f = [tet[s[0]], tet[s[1]], tet[s[2]]];
-            if f.iter().all(|&i| on(g.points[i as usize])) && seen.insert(tet_core::face_key(f)) {
-                // Horizontal triangles wound to face +z.
-                let v = f.map(|i| g.points[i as usize]);
-                let up = (v[1] - v[0]).cross(v[2] - v[0]).z >= 0.0;
-                let f = if up { f } else { [f[0], f[2], f[1]] };
-                tris.push((f, tris.len() as u32));
-            }
-        }
-    }
-    let n = tris.len() as u32;
-    let m = TetMesh::assemble(g.points, g.tets, &tris, n).unwrap();
-    m.validate().unwrap();
-    m
+    constrain_faces(g, |v| v.iter().all(|&p| on(p)), Some(Vec3::Z))
 }
 
 fn hit_of(t: &dyn Tracer, origin: Vec3, dir: Vec3) -> Hit {
-    let ray = Ray::new(origin, dir);
-    let s = locate(t.mesh(), origin, 0).unwrap();
-    *t.trace(&ray, Start::Tet(s)).hit().expect("hit")
+    *trace_from(t, origin, dir).unwrap().hit().expect("hit")
 }
 
 /// Irradiance at a point whose normal passes through a corner of a parallel

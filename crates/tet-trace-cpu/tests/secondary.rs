@@ -2,8 +2,8 @@
 //! slab, and a shadow occluder, all planes of an unjittered 4×4×4 grid.
 
 use glam::Vec3;
-use tet_core::synthetic::{GridSpec, kuhn_grid};
-use tet_core::{FACE_VERTICES, TetMesh};
+use tet_core::synthetic::{GridSpec, constrain_faces, kuhn_grid};
+use tet_core::TetMesh;
 use tet_trace_cpu::secondary::{light_visible, reflect, refract};
 use tet_trace_cpu::tet16::Tet16Tracer;
 use tet_trace_cpu::tet20::Tet20Tracer;
@@ -19,23 +19,8 @@ fn planes(list: &[(usize, f32)]) -> TetMesh {
         jitter: 0.0,
         ..Default::default()
     });
-    let mut tris = Vec::new();
-    let mut seen = std::collections::HashSet::new();
-    for tet in &g.tets {
-        for s in FACE_VERTICES {
-            let f = [tet[s[0]], tet[s[1]], tet[s[2]]];
-            let on = list
-                .iter()
-                .any(|&(a, v)| f.iter().all(|&i| g.points[i as usize][a] == v));
-            if on && seen.insert(tet_core::face_key(f)) {
-                tris.push((f, tris.len() as u32));
-            }
-        }
-    }
-    let n = tris.len() as u32;
-    let m = TetMesh::assemble(g.points, g.tets, &tris, n).unwrap();
-    m.validate().unwrap();
-    m
+    let on = |v: [Vec3; 3]| list.iter().any(|&(a, x)| v.iter().all(|p| p[a] == x));
+    constrain_faces(g, on, None)
 }
 
 fn tracers(m: &TetMesh) -> Vec<Box<dyn Tracer + '_>> {
