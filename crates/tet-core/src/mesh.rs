@@ -65,7 +65,10 @@ impl ConstrainedFace {
     pub fn attach_side(&mut self, tet: [u32; 4], t: u32, k: usize) {
         let s = FACE_VERTICES[k];
         let outward = [tet[s[0]], tet[s[1]], tet[s[2]]];
-        let side = FaceSide { tet: t, face: k as u32 };
+        let side = FaceSide {
+            tet: t,
+            face: k as u32,
+        };
         if same_cyclic_order(self.vertices, outward) {
             self.back = side;
         } else {
