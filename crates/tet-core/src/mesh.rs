@@ -203,8 +203,17 @@ impl TetMesh {
     pub fn face_towards(&self, tet: u32, other: u32) -> Option<usize> {
         let a = self.tets[tet as usize];
         let b = self.tets[other as usize];
-        let missing: Vec<usize> = (0..4).filter(|&i| !b.contains(&a[i])).collect();
-        (missing.len() == 1).then(|| missing[0])
+        // Exactly one vertex of `tet` must be missing from `other`.
+        let mut missing = None;
+        for (i, v) in a.iter().enumerate() {
+            if !b.contains(v) {
+                if missing.is_some() {
+                    return None;
+                }
+                missing = Some(i);
+            }
+        }
+        missing
     }
 
     /// The tet across face `face` of `tet`, crossing constrained faces too
