@@ -71,6 +71,12 @@ const PAPER_TABLE4_TORUS_KNOTS_MB: [(&str, f64); 4] = [
     ("tet80", 20.6),
 ];
 
+/// True for the scene the papers' Torus Knots numbers belong to: the
+/// procedural `torus-knots` or a scenes.json's "Torus Knots".
+fn is_torus_knots(spec: &str) -> bool {
+    spec == "torus-knots" || spec.ends_with("#Torus Knots")
+}
+
 /// The machine and settings every table states.
 #[derive(Clone, Debug, Serialize)]
 pub struct Setup {
@@ -776,7 +782,7 @@ pub fn markdown(doc: &TablesDoc) -> String {
             let paper = NEPTUN_TORUS_KNOTS_MRAYS
                 .iter()
                 .find(|(pm, _)| *pm == r.method)
-                .filter(|_| sc.spec == "torus-knots")
+                .filter(|_| is_torus_knots(&sc.spec))
                 .map_or("–".to_string(), |(_, v)| format!("{:.2}", v / 4.92));
             let (tets, nodes) = match r.nodes_per_ray {
                 Some(n) => ("–".to_string(), format!("{n:.1}")),
@@ -817,7 +823,7 @@ pub fn markdown(doc: &TablesDoc) -> String {
                 let paper = PAPER_TABLE4_TORUS_KNOTS_MB
                     .iter()
                     .find(|(n, _)| *n == l.name)
-                    .filter(|_| sc.spec == "torus-knots")
+                    .filter(|_| is_torus_knots(&sc.spec))
                     .map_or("–".to_string(), |(_, v)| format!("{v:.1}"));
                 let _ = writeln!(
                     m,
