@@ -34,7 +34,7 @@ use tet_trace_cpu::reference::{Aim, edge_distance, random_ray, ray_triangle};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Start;
 
-use crate::cli::{AccuracyArgs, Method, Precision};
+use crate::cli::{AccuracyArgs, BuildFlags, Method, Precision};
 use crate::load::{Loaded, load, require_tets};
 use crate::methods::{has_f64, tracer};
 
@@ -363,35 +363,25 @@ pub fn run_case(
     })
 }
 
-/// `tet-bench accuracy`.
-pub fn run(args: &AccuracyArgs, json: bool) -> Result<()> {
-    let methods = parse_methods(&args.methods)?;
-    if methods.is_empty() {
-        bail!("no methods given");
-    }
-    let loaded = load(&args.scene, &args.build, json)?;
-    require_tets(&loaded)?;
-    let mut cases = vec![run_case(
-        "as-is",
-        &loaded,
-        &methods,
-        args.precision,
-        args.image,
-        args.rays,
-        args.seed,
-    )?];
-    if args.extremes {
-        for (name, result) in crate::extremes::cases(&loaded, &args.build, json) {
+/// The scene as given and, with `extremes` (the build flags to rebuild
+/// with), the extreme cases of [`crate::extremes::cases`]; a case that
+/// cannot be built is reported as skipped with its error.
+#[allow(clippy::too_many_arguments)]
+pub fn all_cases(
+    loaded: &Loaded,
+    methods: &[Method],
+    precision: Precision,
+    side: u32,
+    n: usize,
+    seed: u64,
+    extremes: Option<&BuildFlags>,
+    quiet: bool,
+) -> Result<Vec<CaseAccuracy>> {
+    let mut cases = vec![run_case("as-is", loaded, methods, precision, side, n, seed)?];
+    if let Some(flags) = extremes {
+        for (name, result) in crate::extremes::cases(loaded, flags, quiet) {
             cases.push(match result {
-                Ok(l) => run_case(
-                    &name,
-                    &l,
-                    &methods,
-                    args.precision,
-                    args.image,
-                    args.rays,
-                    args.seed,
-                )?,
+                Ok(l) => run_case(&name, &l, methods, precision, side, n, seed)?,
                 Err(e) => CaseAccuracy {
                     case: name,
                     tets: 0,
@@ -404,6 +394,27 @@ pub fn run(args: &AccuracyArgs, json: bool) -> Result<()> {
             });
         }
     }
+    Ok(cases)
+}
+
+/// `tet-bench accuracy`.
+pub fn run(args: &AccuracyArgs, json: bool) -> Result<()> {
+    let methods = parse_methods(&args.methods)?;
+    if methods.is_empty() {
+        bail!("no methods given");
+    }
+    let loaded = load(&args.scene, &args.build, json)?;
+    require_tets(&loaded)?;
+    let cases = all_cases(
+        &loaded,
+        &methods,
+        args.precision,
+        args.image,
+        args.rays,
+        args.seed,
+        args.extremes.then_some(&args.build),
+        json,
+    )?;
     let doc = AccuracyDoc {
         scene: loaded.name.clone(),
         seed: args.seed,

@@ -209,12 +209,65 @@ pub struct TablesDoc {
     pub scenes: Vec<SceneResult>,
     /// Exit-face search (seed 001 Table 5), single thread.
     pub exit_face: Option<ExitFaceTable>,
+    /// Speed against accuracy per method and precision on the first scene,
+    /// as given and at the extremes (scaled, translated, slivers).
+    pub speed_accuracy: Option<SpeedAccuracy>,
     /// Why there is no out-of-core table, if there is none.
     pub out_of_core_note: Option<String>,
     /// SVG figures written (paths).
     pub figures: Vec<String>,
     /// Wall time of the whole run, s.
     pub total_s: f64,
+}
+
+/// Speed against accuracy (issue 5, "New"): every CPU method in f32 and,
+/// where it has one, f64, on the first scene as given and on its extreme
+/// cases ([`crate::extremes`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct SpeedAccuracy {
+    /// The scene's spec.
+    pub scene: String,
+    /// `as-is`, then the extreme cases (JSON as `accuracy`'s `cases[]`).
+    pub cases: Vec<CaseAccuracy>,
+    /// Why it is missing, when the scene could not be loaded.
+    pub error: Option<String>,
+}
+
+/// Runs the speed-against-accuracy cases on `spec`.
+fn speed_accuracy(spec: &str, quick: bool) -> SpeedAccuracy {
+    let flags = BuildFlags {
+        quality: None,
+        max_steiner: None,
+        time_limit: 600.0,
+        no_box: false,
+        no_sort: false,
+    };
+    let (side, rays) = if quick { (128, 5_000) } else { (512, 50_000) };
+    let run = || -> Result<Vec<CaseAccuracy>> {
+        let loaded = crate::load::load(spec, &flags, true)?;
+        crate::accuracy::all_cases(
+            &loaded,
+            &crate::methods::cpu_methods(),
+            Precision::Both,
+            side,
+            rays,
+            7,
+            Some(&flags),
+            true,
+        )
+    };
+    match run() {
+        Ok(cases) => SpeedAccuracy {
+            scene: spec.to_string(),
+            cases,
+            error: None,
+        },
+        Err(e) => SpeedAccuracy {
+            scene: spec.to_string(),
+            cases: Vec::new(),
+            error: Some(crate::error_chain(&e)),
+        },
+    }
 }
 
 fn scene_specs(args: &TablesArgs) -> Result<Vec<String>> {
@@ -599,10 +652,15 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
         sizes.tets, sizes.rays_per_tet, sizes.walk_rays
     );
     let exit_face = Some(crate::exitface::run(sizes)?);
+    let speed_accuracy = scene_specs(args)?.first().map(|spec| {
+        eprintln!("speed vs accuracy: {spec}, f32 and f64, as given and at the extremes");
+        speed_accuracy(spec, args.quick)
+    });
     let mut doc = TablesDoc {
         setup,
         scenes,
         exit_face,
+        speed_accuracy,
         out_of_core_note: args.quick.then(|| {
             "skipped in --quick mode: each scene is built twice more, in parts (run without --quick)"
                 .to_string()
@@ -633,6 +691,50 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
         );
     }
     Ok(())
+}
+
+fn speed_accuracy_markdown(m: &mut String, x: &SpeedAccuracy) {
+    let _ = writeln!(
+        m,
+        "\n## Speed vs accuracy: precision and extreme scenes ({})\n",
+        x.scene
+    );
+    let _ = writeln!(
+        m,
+        "Per case, the same camera and random interior rays for every method; failures as above (per 1024² rays); Mrays/s of one pass over these rays (all threads), so speeds compare within a case. Cases: the scene as given, scaled by 1e-4 and 1e4, translated by 1e5, and a sliver-heavy jittered grid.\n"
+    );
+    if let Some(e) = &x.error {
+        let _ = writeln!(m, "Not measured: {e}\n");
+        return;
+    }
+    let _ = writeln!(
+        m,
+        "| case | method | precision | rays | wrong | false miss | false hit | cap | lost + NaN | failures per 1024² | Mrays/s |"
+    );
+    let _ = writeln!(m, "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for c in &x.cases {
+        if let Some(why) = &c.skipped {
+            let _ = writeln!(m, "| {} | skipped: {why} | | | | | | | | | |", c.case);
+            continue;
+        }
+        for r in &c.methods {
+            let _ = writeln!(
+                m,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} |",
+                c.case,
+                r.method,
+                r.precision,
+                r.rays,
+                r.wrong_triangle,
+                r.false_misses,
+                r.false_hits,
+                r.step_cap,
+                r.lost + r.nans,
+                r.failures_per_1024_squared,
+                r.mrays_per_s
+            );
+        }
+    }
 }
 
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
@@ -1008,6 +1110,9 @@ pub fn markdown(doc: &TablesDoc) -> String {
                 );
             }
         }
+    }
+    if let Some(x) = &doc.speed_accuracy {
+        speed_accuracy_markdown(&mut m, x);
     }
     if let Some(x) = &doc.exit_face {
         exit_face_markdown(&mut m, x);

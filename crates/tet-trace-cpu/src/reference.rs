@@ -156,14 +156,18 @@ pub fn random_direction(rng: &mut SplitMix64) -> Vec3 {
 /// A random point inside a random tet (by random barycentrics), with the tet.
 pub fn random_point_inside(mesh: &TetMesh, rng: &mut SplitMix64) -> (Vec3, u32) {
     let t = (rng.next_u64() % mesh.tets.len() as u64) as u32;
-    let p = mesh.tet_points(t);
-    let mut w = [0f32; 4];
+    let p = mesh.tet_points(t).map(|x| x.as_dvec3());
+    let mut w = [0f64; 4];
     for x in &mut w {
-        *x = -(rng.next_f64().max(1e-12).ln()) as f32;
+        *x = -rng.next_f64().max(1e-12).ln();
     }
-    let s: f32 = w.iter().sum();
-    let q = p[0] * w[0] + p[1] * w[1] + p[2] * w[2] + p[3] * w[3];
-    (q / s, t)
+    let s: f64 = w.iter().sum();
+    let q = (p[0] * w[0] + p[1] * w[1] + p[2] * w[2] + p[3] * w[3]) / s;
+    // Rounded to f32, a point of a small tet far from the origin can fall
+    // outside it (the ulp at 1e5 is 0.008): the start tet is then the one
+    // that contains the rounded point, found by an exact walk from `t`.
+    let q = q.as_vec3();
+    (q, crate::locate(mesh, q, t).unwrap_or(t))
 }
 
 /// What a generated ray is aimed at.
