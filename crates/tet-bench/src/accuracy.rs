@@ -377,7 +377,9 @@ pub fn all_cases(
     extremes: Option<&BuildFlags>,
     quiet: bool,
 ) -> Result<Vec<CaseAccuracy>> {
-    let mut cases = vec![run_case("as-is", loaded, methods, precision, side, n, seed)?];
+    let mut cases = vec![run_case(
+        "as-is", loaded, methods, precision, side, n, seed,
+    )?];
     if let Some(flags) = extremes {
         for (name, result) in crate::extremes::cases(loaded, flags, quiet) {
             cases.push(match result {

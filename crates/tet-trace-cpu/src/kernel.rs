@@ -32,6 +32,18 @@ pub trait Tracer: Sync {
             *o = self.trace(r, start);
         }
     }
+
+    /// A shadow ray: [`Tracer::trace`], except that a tet walk reports
+    /// [`TraceOutcome::Miss`] as soon as it enters a tet of `stop` (sorted;
+    /// the light's tets, see [`crate::secondary::LightTarget`]), start tet
+    /// included. The default ignores `stop`, which is right for tracers
+    /// without tets (a BVH): the ray then runs to its `t_max`, the light's
+    /// distance. The tet kernels override it so that a render's shadow rays
+    /// are walked by the kernel being measured.
+    fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
+        let _ = stop;
+        self.trace(ray, start)
+    }
 }
 
 /// Walks interleaved per thread by [`WalkTracer::trace_batch`].
@@ -89,6 +101,9 @@ impl<L: Topology, P: Projection> Tracer for WalkTracer<'_, L, P> {
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
         P::trace_batch(self.mesh, &self.layout, rays, start, self.cap, out)
+    }
+    fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
+        crate::secondary::ShadowTracer::trace_until(self, ray, start, stop)
     }
 }
 

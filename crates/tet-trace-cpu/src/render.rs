@@ -22,10 +22,12 @@
 //! [`render_scene`]) add `E/π` per hit (a white Lambertian surface), with
 //! `E` estimated from [`RenderOptions::area_samples`] stratified samples per
 //! hit, jittered from [`RenderOptions::seed`] mixed with the pixel index.
-//! A scene without area lights takes none of that path. Shadow rays walk
-//! the [`ShadowTracer`] given to [`render_scene_with`] (the primary kernel
-//! itself, to measure it), or the canonical-mesh walker ([`MeshWalker`])
-//! from [`render`] and [`render_scene`], which accept any [`Tracer`].
+//! A scene without area lights takes none of that path. Shadow rays are
+//! traced by the primary tracer itself in [`render`] and [`render_scene`]
+//! ([`Tracer::trace_until`]: a tet kernel measures itself on them, a
+//! tracer without tets runs them to the light's distance), or by the
+//! [`ShadowTracer`] given to [`render_scene_with`] (e.g. the canonical-mesh
+//! walker [`crate::secondary::MeshWalker`]).
 
 use std::io::Write;
 use std::path::Path;
@@ -41,7 +43,7 @@ use crate::area_light::{AreaLight, irradiance, irradiance_unshadowed};
 use crate::kernel::Tracer;
 use crate::locate::{LocateError, locate};
 use crate::ray::{Hit, Ray, TraceOutcome};
-use crate::secondary::{LightTarget, MeshWalker, ShadowTracer, face_normal, trace_shadow};
+use crate::secondary::{LightTarget, OwnShadows, ShadowTracer, face_normal, trace_shadow};
 use crate::walk::Start;
 
 /// Tile edge in pixels.
@@ -266,7 +268,9 @@ struct FrameLights<'a> {
 
 /// Renders one frame with `tracer`. The camera is located once (from tet 0);
 /// every primary ray starts in its tet. Point lights only; shadow rays (when
-/// [`RenderOptions::shadows`]) walk the canonical mesh ([`MeshWalker`]).
+/// [`RenderOptions::shadows`]) are traced by `tracer` itself
+/// ([`Tracer::trace_until`]: tet kernels stop at the light's tets, a BVH
+/// runs to the light's distance).
 pub fn render<T: Tracer + ?Sized>(
     tracer: &T,
     camera: &Camera,
@@ -287,13 +291,7 @@ pub fn render_scene<T: Tracer + ?Sized>(
     lights: &Lights<'_>,
     opts: &RenderOptions,
 ) -> Result<Frame, RenderError> {
-    render_scene_with(
-        tracer,
-        &MeshWalker::new(tracer.mesh()),
-        camera,
-        lights,
-        opts,
-    )
+    render_scene_with(tracer, &OwnShadows(tracer), camera, lights, opts)
 }
 
 /// [`render_scene`] with shadow rays walked by `shadow` (e.g. the primary

@@ -317,6 +317,20 @@ pub trait ShadowTracer: Sync {
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome;
 }
 
+/// Any [`Tracer`] as a [`ShadowTracer`], through [`Tracer::trace_until`]:
+/// the shadow rays of a render walked by its own primary tracer.
+#[derive(Clone, Copy)]
+pub struct OwnShadows<'a, T: ?Sized>(pub &'a T);
+
+impl<T: Tracer + ?Sized> ShadowTracer for OwnShadows<'_, T> {
+    fn mesh(&self) -> &TetMesh {
+        self.0.mesh()
+    }
+    fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
+        self.0.trace_until(ray, start, stop)
+    }
+}
+
 /// Shadow rays walked on the canonical mesh with the f32 2-D projection
 /// (the watertight engine of [`crate::walk`]): usable with any primary
 /// tracer, including ones that are not tet walks.

@@ -355,6 +355,9 @@ impl Tracer for Tet80Tracer<'_> {
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
         self.trace_with(ray, start, None, |_| false)
     }
+    fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
+        ShadowTracer::trace_until(self, ray, start, stop)
+    }
     /// Rays sharing one origin (primary rays) share the start tet's interior
     /// test: it is made once per batch.
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {

@@ -3,9 +3,9 @@
 //! independent f64 brute-force visibility per sample.
 
 use glam::{DVec3, Vec3};
+use tet_core::TetMesh;
 use tet_core::scene::Camera;
 use tet_core::synthetic::{GridSpec, constrain_faces, kuhn_grid};
-use tet_core::TetMesh;
 use tet_trace_cpu::area_light::{AreaLight, AreaLightError, geometry, irradiance, strata};
 use tet_trace_cpu::reference::{edge_distance, trace_from};
 use tet_trace_cpu::render::{Lights, RenderOptions, render_scene, render_scene_with};

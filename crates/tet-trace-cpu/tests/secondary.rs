@@ -2,8 +2,8 @@
 //! slab, and a shadow occluder, all planes of an unjittered 4×4×4 grid.
 
 use glam::Vec3;
-use tet_core::synthetic::{GridSpec, constrain_faces, kuhn_grid};
 use tet_core::TetMesh;
+use tet_core::synthetic::{GridSpec, constrain_faces, kuhn_grid};
 use tet_trace_cpu::secondary::{light_visible, reflect, refract};
 use tet_trace_cpu::tet16::Tet16Tracer;
 use tet_trace_cpu::tet20::Tet20Tracer;
