@@ -1193,7 +1193,7 @@ fn out_of_core_markdown(m: &mut String, doc: &TablesDoc) {
     }
     let _ = writeln!(
         m,
-        "Limits are ½ and ⅓ of the in-core TetGen worker's measured peak; the scene is cut into slabs whose *predicted* peaks fit, built by parallel workers (as many at once as fit the limit together) with exact seams, merged and Hilbert-sorted. Peaks are the workers' measured `VmHWM`; aspect ratio = longest edge ÷ smallest height (seed 003 Table 3).\n"
+        "Limits are ½ and ⅓ of the in-core TetGen worker's measured peak; the scene is split recursively (seed 003's planes, or slabs when no tree fits) until the parts' *predicted* peaks fit, built by parallel workers (as many at once as fit the limit together) with exact seams, merged and Hilbert-sorted. Parts are given as count, workers at once, planner and depth. Peaks are the workers' measured `VmHWM`; aspect ratio = longest edge ÷ smallest height (seed 003 Table 3).\n"
     );
     let _ = writeln!(
         m,
@@ -1238,10 +1238,12 @@ fn out_of_core_markdown(m: &mut String, doc: &TablesDoc) {
                 (Some(mem), _) => {
                     let _ = writeln!(
                         m,
-                        "| {name} | {label} | {:.1} | {} ({}) | {} | {:.2} | {:.2} | {} | {} | {} | {:.2} |",
+                        "| {name} | {label} | {:.1} | {} ({} at once, {} depth {}) | {} | {:.2} | {:.2} | {} | {} | {} | {:.2} |",
                         mem.limit_bytes as f64 / (1024.0 * 1024.0),
                         mem.parts,
                         mem.parallel_parts,
+                        mem.planner,
+                        mem.depth,
                         mem.triangles_cut,
                         mem.total_s,
                         mem.total_s / r.in_core_s,

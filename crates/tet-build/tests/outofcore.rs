@@ -679,8 +679,10 @@ fn trade_torus_knots() {
         };
         for div in [2u64, 3, 4] {
             let limit = peak / div;
+            // Parts run `parallel_parts` at a time, so each is planned
+            // under that share of the limit: together they fit it.
             let split = SplitOptions {
-                limit_bytes: limit,
+                limit_bytes: limit / options.parallel_parts as u64,
                 ..SplitOptions::default()
             };
             let t = Instant::now();
