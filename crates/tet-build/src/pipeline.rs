@@ -1411,26 +1411,7 @@ fn check_tet_links(m: &TetMesh, t: u32) -> Result<(usize, usize), MeshError> {
                     });
                 }
             }
-            LinkKind::Constrained(c) => {
-                let Some(cf) = m.constrained.get(c as usize) else {
-                    return Err(MeshError::ConstrainedOutOfBounds {
-                        tet: t,
-                        face,
-                        index: c,
-                        count: m.constrained.len(),
-                    });
-                };
-                let me = FaceSide {
-                    tet: t,
-                    face: k as u32,
-                };
-                if cf.front != me && cf.back != me {
-                    return Err(MeshError::ConstrainedBackReference {
-                        index: c,
-                        detail: format!("tet {t} face {k} links to it but is neither side"),
-                    });
-                }
-            }
+            LinkKind::Constrained(c) => m.check_constrained_link(t, k, c)?,
         }
     }
     Ok((tet_links, pairs))

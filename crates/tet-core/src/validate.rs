@@ -118,26 +118,7 @@ fn check_links(m: &TetMesh) -> Result<(), MeshError> {
                         });
                     }
                 }
-                LinkKind::Constrained(c) => {
-                    let Some(cf) = m.constrained.get(c as usize) else {
-                        return Err(MeshError::ConstrainedOutOfBounds {
-                            tet: t,
-                            face,
-                            index: c,
-                            count: m.constrained.len(),
-                        });
-                    };
-                    let me = FaceSide {
-                        tet: t,
-                        face: k as u32,
-                    };
-                    if cf.front != me && cf.back != me {
-                        return Err(MeshError::ConstrainedBackReference {
-                            index: c,
-                            detail: format!("tet {t} face {k} links to it but is neither side"),
-                        });
-                    }
-                }
+                LinkKind::Constrained(c) => m.check_constrained_link(t, k, c)?,
             }
         }
     }
@@ -157,6 +138,32 @@ fn check_constrained_table(m: &TetMesh) -> Result<(), MeshError> {
 }
 
 impl TetMesh {
+    /// Checks that face `k` of tet `t`, linked to constrained face `c`,
+    /// names an existing table entry that has `(t, k)` as one of its sides,
+    /// as [`TetMesh::validate`] does; shared with builders that check links
+    /// their own way.
+    pub fn check_constrained_link(&self, t: u32, k: usize, c: u32) -> Result<(), MeshError> {
+        let Some(cf) = self.constrained.get(c as usize) else {
+            return Err(MeshError::ConstrainedOutOfBounds {
+                tet: t,
+                face: k as u8,
+                index: c,
+                count: self.constrained.len(),
+            });
+        };
+        let me = FaceSide {
+            tet: t,
+            face: k as u32,
+        };
+        if cf.front != me && cf.back != me {
+            return Err(MeshError::ConstrainedBackReference {
+                index: c,
+                detail: format!("tet {t} face {k} links to it but is neither side"),
+            });
+        }
+        Ok(())
+    }
+
     /// Checks entry `c` of the constrained-face table exactly as
     /// [`TetMesh::validate`] does (triangle id, sides in bounds and linking
     /// back, same vertices, winding agreeing with front/back). Public so
