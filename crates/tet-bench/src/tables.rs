@@ -220,6 +220,16 @@ pub struct TablesDoc {
     pub total_s: f64,
 }
 
+/// How every scene of the tables is built: TetGen `-pY` in a box, Hilbert
+/// order, the default time limit.
+const TABLE_FLAGS: BuildFlags = BuildFlags {
+    quality: None,
+    max_steiner: None,
+    time_limit: 600.0,
+    no_box: false,
+    no_sort: false,
+};
+
 /// Speed against accuracy (issue 5, "New"): every CPU method in f32 and,
 /// where it has one, f64, on the first scene as given and on its extreme
 /// cases ([`crate::extremes`]).
@@ -235,13 +245,7 @@ pub struct SpeedAccuracy {
 
 /// Runs the speed-against-accuracy cases on `spec`.
 fn speed_accuracy(spec: &str, quick: bool) -> SpeedAccuracy {
-    let flags = BuildFlags {
-        quality: None,
-        max_steiner: None,
-        time_limit: 600.0,
-        no_box: false,
-        no_sort: false,
-    };
+    let flags = TABLE_FLAGS;
     let (side, rays) = if quick { (128, 5_000) } else { (512, 50_000) };
     let run = || -> Result<Vec<CaseAccuracy>> {
         let loaded = crate::load::load(spec, &flags, true)?;
@@ -406,13 +410,7 @@ fn measure_scene(
     pool: &rayon::ThreadPool,
 ) -> Result<SceneResult> {
     let spec = planned.spec.as_str();
-    let flags = BuildFlags {
-        quality: None,
-        max_steiner: None,
-        time_limit: 600.0,
-        no_box: false,
-        no_sort: false,
-    };
+    let flags = TABLE_FLAGS;
     let quiet = false;
     let (loaded, mesh_reused) = cache.load(planned, &flags, quiet)?;
     if mesh_reused {

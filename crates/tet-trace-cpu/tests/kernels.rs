@@ -4,7 +4,7 @@
 use glam::Vec3;
 use proptest::prelude::*;
 use tet_core::TetMesh;
-use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
+use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::reference::{
     Aim, axis_ray, closest_hit, grazes_an_edge, random_ray, ray_from_feature,
 };
@@ -15,24 +15,14 @@ use tet_trace_cpu::tet32::{Tet32Tracer, Tet32TracerF64};
 use tet_trace_cpu::tet80::Tet80Tracer;
 use tet_trace_cpu::{OriginF32, Ray, Start, TraceOutcome, Tracer, locate};
 
+mod common;
+use common::grid;
+
 /// Hits closer than this to an edge of the reference triangle (in units of
 /// the grid cell, i.e. ~1/1000 of a cell) may legitimately land on the
 /// neighbouring triangle in f32; hits closer than this to the origin or to a
 /// second hit are ambiguous too.
 const EDGE_TOL: f64 = 1e-3;
-
-fn grid(cells: u32, jitter: f32, fraction: f64, shell: bool, seed: u64) -> TetMesh {
-    let m = kuhn_grid(&GridSpec {
-        cells: [cells; 3],
-        jitter,
-        constrained_fraction: fraction,
-        shell: shell.then_some(([1; 3], [cells - 1; 3])),
-        seed,
-        ..Default::default()
-    });
-    m.validate().unwrap();
-    m
-}
 
 fn all_f32(mesh: &TetMesh) -> Vec<Box<dyn Tracer + '_>> {
     vec![

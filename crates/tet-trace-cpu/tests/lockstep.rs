@@ -9,25 +9,15 @@
 use glam::Vec3;
 use proptest::prelude::*;
 use tet_core::TetMesh;
-use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
+use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::kernel::{Interleaved, WalkTracer};
 use tet_trace_cpu::lockstep::trace_lockstep_portable;
 use tet_trace_cpu::reference::{Aim, random_direction, random_point_inside, ray_from_feature};
 use tet_trace_cpu::walk::Topology;
 use tet_trace_cpu::{DuffF32, Ray, Start, TraceOutcome, Tracer, locate};
 
-fn grid(cells: u32, jitter: f32, fraction: f64, shell: bool, seed: u64) -> TetMesh {
-    let m = kuhn_grid(&GridSpec {
-        cells: [cells; 3],
-        jitter,
-        constrained_fraction: fraction,
-        shell: shell.then_some(([1; 3], [cells - 1; 3])),
-        seed,
-        ..Default::default()
-    });
-    m.validate().unwrap();
-    m
-}
+mod common;
+use common::grid;
 
 /// Every bit of an outcome (f32 fields as bits, so `-0.0 ≠ 0.0`).
 fn bits(o: &TraceOutcome) -> (u8, [u32; 9]) {

@@ -37,6 +37,7 @@
 use std::collections::HashMap;
 
 use glam::{DVec2, DVec3, Vec3};
+use spade::handles::FixedVertexHandle;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 use tet_core::{MeshError, TetMesh, face_key};
 use thiserror::Error;
@@ -423,16 +424,7 @@ pub fn seam_triangulation(
     }
     for e in &edges {
         let (h0, h1) = (insert(&mut cdt, e[0])?, insert(&mut cdt, e[1])?);
-        if h0 == h1 || cdt.exists_constraint(h0, h1) {
-            continue;
-        }
-        if !cdt.can_add_constraint(h0, h1) {
-            return Err(SeamError::SeamConstraintsCross {
-                from: e[0],
-                to: e[1],
-            });
-        }
-        cdt.add_constraint(h0, h1);
+        add_seam_constraint(&mut cdt, (e[0], h0), (e[1], h1))?;
     }
     let orient2 = |a: DVec2, b: DVec2, c: DVec2| {
         robust::orient2d(
@@ -831,6 +823,25 @@ pub fn build_slabs(
         &mut report,
     )?;
     Ok((mesh, report))
+}
+
+/// Adds the segment between the already inserted seam points `a` and `b`
+/// (with their CDT handles) as a constraint, unless it is degenerate or
+/// already there. Two constraints that cross mean the seam cannot be
+/// triangulated conformingly: an error naming the segment.
+pub(super) fn add_seam_constraint(
+    cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>,
+    (a, h0): (Vec3, FixedVertexHandle),
+    (b, h1): (Vec3, FixedVertexHandle),
+) -> Result<(), SeamError> {
+    if h0 == h1 || cdt.exists_constraint(h0, h1) {
+        return Ok(());
+    }
+    if !cdt.can_add_constraint(h0, h1) {
+        return Err(SeamError::SeamConstraintsCross { from: a, to: b });
+    }
+    cdt.add_constraint(h0, h1);
+    Ok(())
 }
 
 /// Merges tetrahedralized parts: points deduplicated by their exact f32

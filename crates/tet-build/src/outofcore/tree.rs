@@ -51,8 +51,8 @@ use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 use tet_core::TetMesh;
 
 use super::seam::{
-    FacetKind, NEAR_PLANE, PartMesh, SeamError, SeamOptions, SeamReport, crossing_point, key,
-    merge_parts, run_parts,
+    FacetKind, NEAR_PLANE, PartMesh, SeamError, SeamOptions, SeamReport, add_seam_constraint,
+    crossing_point, key, merge_parts, run_parts,
 };
 use super::split::{SplitPlane, SplitTree};
 use crate::bbox::EnclosingBox;
@@ -843,16 +843,7 @@ fn triangulate_wall(
     for l in &polylines {
         for e in l.windows(2) {
             let (h0, h1) = (insert(&mut cdt, e[0])?, insert(&mut cdt, e[1])?);
-            if h0 == h1 || cdt.exists_constraint(h0, h1) {
-                continue;
-            }
-            if !cdt.can_add_constraint(h0, h1) {
-                return Err(SeamError::SeamConstraintsCross {
-                    from: e[0],
-                    to: e[1],
-                });
-            }
-            cdt.add_constraint(h0, h1);
+            add_seam_constraint(&mut cdt, (e[0], h0), (e[1], h1))?;
         }
     }
     let to3 = |p: Point2<f64>| {
