@@ -27,8 +27,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 use tet_core::TetMesh;
 use tet_core::synthetic::SplitMix64;
+use tet_trace_cpu::Viewpoint;
 use tet_trace_cpu::kernel::Tracer;
-use tet_trace_cpu::locate::locate;
 use tet_trace_cpu::ray::{Failure, Ray, TraceOutcome};
 use tet_trace_cpu::reference::{Aim, edge_distance, random_ray, ray_triangle};
 use tet_trace_cpu::render::PinholeCamera;
@@ -215,9 +215,12 @@ pub struct AccuracyDoc {
     pub cases: Vec<CaseAccuracy>,
 }
 
-/// A batch of rays with their start.
+/// A batch of rays with their start (`None`: a camera ray, started from
+/// `view` by each tracer; see `tet_trace_cpu::entry` for a camera outside
+/// the mesh).
 pub struct RaySet {
-    rays: Vec<(Ray, Start)>,
+    rays: Vec<(Ray, Option<Start>)>,
+    view: Option<Viewpoint>,
 }
 
 /// Camera rays of a `side × side` image plus `n` rays from random interior
@@ -225,13 +228,16 @@ pub struct RaySet {
 /// midpoints, 10 % at face centroids.
 pub fn ray_set(loaded: &Loaded, mesh: &TetMesh, side: u32, n: usize, seed: u64) -> Result<RaySet> {
     let mut rays = Vec::with_capacity((side * side) as usize + n);
+    let mut view = None;
     if side > 0 {
-        let start = locate(mesh, loaded.camera.position, 0)
-            .map_err(|e| anyhow::anyhow!("camera {}: {e}", loaded.camera.position))?;
+        view = Some(
+            Viewpoint::locate(mesh, loaded.camera.position)
+                .map_err(|e| anyhow::anyhow!("camera {}: {e}", loaded.camera.position))?,
+        );
         let cam = PinholeCamera::new(&loaded.camera, side, side, true);
         for j in 0..side {
             for i in 0..side {
-                rays.push((cam.ray(i, j), Start::Tet(start)));
+                rays.push((cam.ray(i, j), None));
             }
         }
     }
@@ -244,9 +250,9 @@ pub fn ray_set(loaded: &Loaded, mesh: &TetMesh, side: u32, n: usize, seed: u64) 
             _ => Aim::Random,
         };
         let (ray, tet) = random_ray(mesh, &mut rng, aim);
-        rays.push((ray, Start::Tet(tet)));
+        rays.push((ray, Some(Start::Tet(tet))));
     }
-    Ok(RaySet { rays })
+    Ok(RaySet { rays, view })
 }
 
 /// Checks one tracer against the reference.
@@ -258,7 +264,25 @@ fn check(
     set: &RaySet,
 ) -> MethodAccuracy {
     let start = Instant::now();
-    let outcomes: Vec<TraceOutcome> = set.rays.par_iter().map(|(r, s)| t.trace(r, *s)).collect();
+    let outcomes: Vec<TraceOutcome> = set
+        .rays
+        .par_iter()
+        .map(|(r, s)| {
+            // Camera rays always come with their viewpoint.
+            let start = match (s, &set.view) {
+                (Some(s), _) => Ok(*s),
+                (None, Some(view)) => view.start(t, r),
+                (None, None) => Err(TraceOutcome::Failed {
+                    failure: Failure::Lost,
+                    tets_visited: 0,
+                }),
+            };
+            match start {
+                Ok(s) => t.trace(r, s),
+                Err(done) => done,
+            }
+        })
+        .collect();
     let secs = start.elapsed().as_secs_f64();
     let mut m = MethodAccuracy {
         method: t.name(),

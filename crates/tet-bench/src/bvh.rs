@@ -214,10 +214,7 @@ impl Tracer for BvhTracer<'_> {
     }
 
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
-        let skip = match start {
-            Start::Face { face, .. } => face,
-            Start::Tet(_) => u32::MAX,
-        };
+        let skip = start.on_face().unwrap_or(u32::MAX);
         let mut r = BvhRay::new(
             a(ray.origin),
             a(ray.direction),

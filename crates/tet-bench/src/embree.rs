@@ -163,10 +163,7 @@ impl Tracer for EmbreeTracer<'_> {
     }
 
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
-        let skip = match start {
-            Start::Face { face, .. } => face,
-            Start::Tet(_) => u32::MAX,
-        };
+        let skip = start.on_face().unwrap_or(u32::MAX);
         if !ray.is_valid() {
             return TraceOutcome::Failed {
                 failure: Failure::InvalidRay,

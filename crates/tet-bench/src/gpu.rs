@@ -30,13 +30,13 @@ pub fn time_gpu(
     let ctx = GpuContext::new()?;
     let tracer = GpuTracer::new(&ctx, &loaded.mesh, layout)?;
     let setup_s = setup.elapsed().as_secs_f64();
-    let start = tet_trace_cpu::locate::locate(&loaded.mesh, loaded.camera.position, 0)
+    let view = tet_trace_cpu::Viewpoint::locate(&loaded.mesh, loaded.camera.position)
         .map_err(|e| anyhow::anyhow!("camera {}: {e}", loaded.camera.position))?;
-    let mut frame = tracer.render(&loaded.camera, width, height, false, start)?;
+    let mut frame = tracer.render_view(&loaded.camera, width, height, false, &view)?;
     let mut ms = Vec::new();
     let mut best = frame.stats.clone();
     for _ in 0..frames.max(1) {
-        frame = tracer.render(&loaded.camera, width, height, false, start)?;
+        frame = tracer.render_view(&loaded.camera, width, height, false, &view)?;
         if frame.stats.ms() < best.ms() || ms.is_empty() {
             best = frame.stats.clone();
         }

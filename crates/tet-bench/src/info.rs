@@ -4,7 +4,7 @@ use anyhow::Result;
 use serde::Serialize;
 use tet_core::TetMesh;
 use tet_core::memory::MemoryReport;
-use tet_core::regions::{compute_regions, locate_seeds_brute, prune_unreachable};
+use tet_core::regions::{compute_regions, locate_brute, locate_seeds_brute, prune_unreachable};
 
 use crate::cli::InfoArgs;
 use crate::load::{BuildSummary, Loaded, load};
@@ -126,7 +126,18 @@ pub fn info(loaded: &Loaded, prune: bool) -> Result<Info> {
         let mut copy = mesh.clone();
         let mut points = vec![loaded.camera.position];
         points.extend(loaded.lights.iter().map(|l| l.position));
-        let seeds = locate_seeds_brute(&copy, &points)?;
+        // A camera or light outside the mesh (tight enclosing box) sees it
+        // through its boundary: every tet on the boundary seeds its region.
+        let (inside, outside): (Vec<glam::Vec3>, Vec<glam::Vec3>) = points
+            .iter()
+            .partition(|p| !p.is_finite() || locate_brute(&copy, **p).is_some());
+        let mut seeds = locate_seeds_brute(&copy, &inside)?;
+        if !outside.is_empty() {
+            seeds.extend(
+                (0..copy.tets.len() as u32)
+                    .filter(|&t| (0..4).any(|k| copy.is_boundary_face(t, k))),
+            );
+        }
         let p = prune_unreachable(&mut copy, &seeds)?;
         Some(PruneSummary {
             regions_kept: p.regions_kept,

@@ -127,24 +127,33 @@ pub fn with_mesh(scene: Scene, mesh: TetMesh, build: Option<BuildSummary>) -> Lo
     }
 }
 
-/// The enclosing box: scene, camera, lights and `extra` points (the
-/// cameras and lights of other scenes sharing this mesh) grown by 10 % of
-/// the largest extent on every side, so that primary and shadow rays start
-/// inside the mesh.
+/// Relative margin of the tight enclosing box (of the scene's largest
+/// extent): thin, so that few tets lie between the box and the scene.
+pub const TIGHT_BOX_MARGIN: f32 = 0.01;
+
+/// The enclosing box. By default it holds the scene only, grown by
+/// [`TIGHT_BOX_MARGIN`] of its largest extent: cameras and lights may lie
+/// outside, where primary rays enter the mesh through its boundary
+/// (`tet_trace_cpu::entry`) and shadow rays leave it unoccluded. With
+/// `wide`, it also holds the camera, the lights and `extra` points (the
+/// cameras and lights of other scenes sharing this mesh), grown by 10 %:
+/// every ray then starts inside the mesh and walks the empty space
+/// between the camera and the scene (the layout of the papers' meshes).
 #[cfg(feature = "tetgen")]
-pub fn enclosing_box(scene: &Scene, extra: &[Vec3]) -> tet_build::bbox::BoxSpec {
+pub fn enclosing_box(scene: &Scene, extra: &[Vec3], wide: bool) -> tet_build::bbox::BoxSpec {
     let mut pts: Vec<Vec3> = scene.vertices.clone();
-    if let Some(c) = scene.camera {
-        pts.push(c.position);
+    if wide {
+        pts.extend(scene.camera.iter().map(|c| c.position));
+        pts.extend(scene.lights.iter().map(|l| l.position));
+        pts.extend_from_slice(extra);
     }
-    pts.extend(scene.lights.iter().map(|l| l.position));
-    pts.extend_from_slice(extra);
     let (min, max) = pts
         .iter()
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
             (a.min(*p), b.max(*p))
         });
-    let margin = ((max - min).max_element() * 0.1)
+    let relative = if wide { 0.1 } else { TIGHT_BOX_MARGIN };
+    let margin = ((max - min).max_element() * relative)
         .max(1e-3 * max.abs().max(min.abs()).max_element())
         .max(1e-6);
     tet_build::bbox::BoxSpec::Fixed {
@@ -193,7 +202,7 @@ pub fn build_scene_in(
     let name = scene.name.clone();
     let mut options = BuildOptions {
         isolation: worker_isolation(flags.time_limit)?,
-        enclosing_box: (!flags.no_box).then(|| enclosing_box(scene, extra)),
+        enclosing_box: (!flags.no_box).then(|| enclosing_box(scene, extra, flags.wide_box)),
         progress: Some(Arc::new(move |p: &tet_build::pipeline::Progress| {
             pb.set_message(format!("building {name}: {:?}", p.stage));
         })),

@@ -237,7 +237,7 @@ pub fn build_limited(
     let (cleaned, cm) = tet_build::clean::clean_scene(scene)
         .map_err(|e| anyhow::anyhow!("cannot clean `{}`: {e}", scene.name))?;
     let clean_s = clean_start.elapsed().as_secs_f64();
-    let box_spec = crate::load::enclosing_box(scene, extra);
+    let box_spec = crate::load::enclosing_box(scene, extra, flags.wide_box);
     let b = EnclosingBox::new(cleaned.bounds(), box_spec)
         .with_context(|| format!("cannot build the enclosing box of `{}`", scene.name))?;
     // One worker at a time: slabs predicted under the limit. With `p`

@@ -227,6 +227,7 @@ const TABLE_FLAGS: BuildFlags = BuildFlags {
     max_steiner: None,
     time_limit: 600.0,
     no_box: false,
+    wide_box: false,
     no_sort: false,
 };
 

@@ -193,6 +193,17 @@ impl TetMesh {
         [v[s[0]], v[s[1]], v[s[2]]]
     }
 
+    /// True when face `face` (0..=3) of tet `tet` exists and lies on the mesh
+    /// boundary (its link is [`Link::BOUNDARY`]): where a ray from outside
+    /// may enter (`Start::Entry` of the trace crates).
+    #[inline]
+    pub fn is_boundary_face(&self, tet: u32, face: u8) -> bool {
+        self.neighbors
+            .get(tet as usize)
+            .and_then(|n| n.get(face as usize))
+            .is_some_and(|l| *l == Link::BOUNDARY)
+    }
+
     /// Positions of the four vertices of `tet`.
     #[inline]
     pub fn tet_points(&self, tet: u32) -> [Vec3; 4] {

@@ -9,10 +9,11 @@ use tet_core::TetMesh;
 use tet_core::layout::{LayoutError, LayoutMesh, LayoutRecord};
 use tet_core::link::Link;
 
+use crate::entry::{BoundaryEntry, EntryHint};
 use crate::lockstep::{ExitRule, RecordWords};
 use crate::ray::{Ray, TraceOutcome};
 use crate::walk::{
-    Projection, Start, Topology, prefetch_index, step_cap, trace, trace_interleaved,
+    Projection, Start, Starts, Topology, prefetch_index, step_cap, trace, trace_interleaved,
 };
 
 /// A ray-traversal method over one mesh.
@@ -31,6 +32,30 @@ pub trait Tracer: Sync {
         for (r, o) in rays.iter().zip(out.iter_mut()) {
             *o = self.trace(r, start);
         }
+    }
+
+    /// Traces many rays, ray `i` from `starts[i]`, into `out` (all three of
+    /// the same length), e.g. the primary rays of a tile entering the mesh
+    /// from a viewpoint outside it ([`crate::entry`]). Kernels may
+    /// interleave walks; the results equal [`Tracer::trace`] ray by ray.
+    fn trace_batch_each(&self, rays: &[Ray], starts: &[Start], out: &mut [TraceOutcome]) {
+        for ((r, s), o) in rays.iter().zip(starts).zip(out.iter_mut()) {
+            *o = self.trace(r, *s);
+        }
+    }
+
+    /// How a ray whose origin lies outside the mesh begins (see
+    /// [`BoundaryEntry::start_with`]): the entering boundary face decided
+    /// with this tracer's own edge test, so that entry and walk agree on
+    /// every boundary edge. The default decides with [`crate::DuffF32`],
+    /// the projection of the f32 kernels.
+    fn start_outside(
+        &self,
+        entry: &BoundaryEntry,
+        ray: &Ray,
+        hint: &mut EntryHint,
+    ) -> Result<Start, TraceOutcome> {
+        entry.start_with::<crate::DuffF32>(self.mesh(), ray, hint)
     }
 
     /// A shadow ray: [`Tracer::trace`], except that a tet walk reports
@@ -100,10 +125,37 @@ impl<L: Topology, P: Projection> Tracer for WalkTracer<'_, L, P> {
         trace::<P, L>(self.mesh, &self.layout, ray, start, self.cap)
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
-        P::trace_batch(self.mesh, &self.layout, rays, start, self.cap, out)
+        P::trace_batch(
+            self.mesh,
+            &self.layout,
+            rays,
+            Starts::Same(start),
+            self.cap,
+            out,
+        )
+    }
+    fn trace_batch_each(&self, rays: &[Ray], starts: &[Start], out: &mut [TraceOutcome]) {
+        let n = rays.len().min(starts.len()).min(out.len());
+        let (rays, starts, out) = (&rays[..n], &starts[..n], &mut out[..n]);
+        P::trace_batch(
+            self.mesh,
+            &self.layout,
+            rays,
+            Starts::Each(starts),
+            self.cap,
+            out,
+        )
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
         crate::secondary::ShadowTracer::trace_until(self, ray, start, stop)
+    }
+    fn start_outside(
+        &self,
+        entry: &BoundaryEntry,
+        ray: &Ray,
+        hint: &mut EntryHint,
+    ) -> Result<Start, TraceOutcome> {
+        entry.start_with::<P>(self.mesh, ray, hint)
     }
 }
 
@@ -125,7 +177,7 @@ impl<L: Topology, P: Projection> Tracer for Interleaved<'_, '_, L, P> {
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
         let w = self.0;
-        trace_interleaved::<P, L, LANES>(w.mesh, &w.layout, rays, start, w.cap, out)
+        trace_interleaved::<P, L, LANES>(w.mesh, &w.layout, rays, Starts::Same(start), w.cap, out)
     }
 }
 

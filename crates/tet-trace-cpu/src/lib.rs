@@ -6,6 +6,7 @@
 //!
 //! * [`ray`]: [`Ray`], [`Hit`], [`TraceOutcome`] (hit / miss / reported failure);
 //! * [`mod@locate`]: exact point location (seed 000 §4.2);
+//! * [`entry`]: rays from a viewpoint outside the mesh enter through its boundary;
 //! * [`walk`]: the watertight traversal engine and its projections;
 //! * [`scaled`]: the scaled basis of Eq. 1–3, specialised per direction case;
 //! * kernels, one per method: [`sctp`], [`tet32`], [`tet20`], [`tet16`], [`tet80`];
@@ -16,6 +17,7 @@
 #![deny(missing_docs)]
 
 pub mod area_light;
+pub mod entry;
 pub mod kernel;
 pub mod locate;
 pub mod lockstep;
@@ -31,7 +33,8 @@ pub mod tet32;
 pub mod tet80;
 pub mod walk;
 
+pub use entry::{Viewpoint, ViewpointError};
 pub use kernel::{Tracer, WalkTracer};
 pub use locate::{LocateError, locate};
 pub use ray::{Failure, Hit, Ray, TraceOutcome};
-pub use walk::{DuffF32, DuffF64, OriginF32, Projection, Start, TripleF32};
+pub use walk::{DuffF32, DuffF64, OriginF32, Projection, Start, Starts, TripleF32};

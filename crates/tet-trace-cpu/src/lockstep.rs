@@ -77,7 +77,7 @@ use glam::{Vec2, Vec3};
 use tet_core::{Link, TetMesh};
 
 use crate::ray::{Ray, TraceOutcome};
-use crate::walk::{Advance, DuffF32, Face2, Lane, Start, State, Topology, finish_step, next_lane};
+use crate::walk::{Advance, DuffF32, Face2, Lane, Starts, State, Topology, finish_step, next_lane};
 
 /// Lanes of the AVX2 lockstep walk (256-bit vectors of f32 / u32).
 pub const WIDE: usize = 8;
@@ -154,7 +154,7 @@ pub fn trace_lockstep<T: Topology>(
     mesh: &TetMesh,
     topo: &T,
     rays: &[Ray],
-    start: Start,
+    start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
 ) {
@@ -191,7 +191,7 @@ pub fn trace_lockstep_portable<T: Topology, const W: usize>(
     mesh: &TetMesh,
     topo: &T,
     rays: &[Ray],
-    start: Start,
+    start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
 ) {
@@ -205,7 +205,7 @@ fn trace_avx2<T: Topology>(
     mesh: &TetMesh,
     topo: &T,
     rays: &[Ray],
-    start: Start,
+    start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
 ) {
@@ -305,7 +305,7 @@ fn run<T: Topology, const W: usize>(
     mesh: &TetMesh,
     topo: &T,
     rays: &[Ray],
-    start: Start,
+    start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
 ) {
@@ -333,7 +333,7 @@ fn run<T: Topology, const W: usize>(
 fn fill<const W: usize>(
     mesh: &TetMesh,
     rays: &[Ray],
-    start: Start,
+    start: Starts<'_>,
     queued: &mut usize,
     out: &mut [TraceOutcome],
 ) -> (Pack<W>, usize) {
@@ -496,7 +496,7 @@ fn ties<const W: usize>(
 fn lane_events<const W: usize>(
     mesh: &TetMesh,
     rays: &[Ray],
-    start: Start,
+    start: Starts<'_>,
     queued: &mut usize,
     out: &mut [TraceOutcome],
     pk: &mut Pack<W>,
@@ -812,7 +812,7 @@ mod avx2 {
         mesh: &TetMesh,
         rw: RecordWords<'_>,
         rays: &[Ray],
-        start: Start,
+        start: Starts<'_>,
         cap: u32,
         out: &mut [TraceOutcome],
     ) {

@@ -15,6 +15,11 @@
 //! `n` the interpolated vertex normal when the mesh has normals, else the
 //! face normal from the source triangle's winding.
 //!
+//! Primary rays start in the camera's tet, or, when the camera lies outside
+//! the mesh (a tight enclosing box), each enters through the boundary face
+//! its line crosses and a ray that misses the mesh visits no tet
+//! ([`crate::entry`]).
+//!
 //! Shadows (seed 000 §6): each point light is located once per frame, from
 //! the camera's tet ([`LightTarget::locate_or_outside`]), and its shadow rays
 //! stop when they enter the light's tet (rule in [`crate::secondary`]).
@@ -40,11 +45,11 @@ use tet_core::scene::{Camera, PointLight};
 use thiserror::Error;
 
 use crate::area_light::{AreaLight, irradiance, irradiance_unshadowed};
+use crate::entry::{Viewpoint, ViewpointError};
 use crate::kernel::Tracer;
-use crate::locate::{LocateError, locate};
+use crate::locate::LocateError;
 use crate::ray::{Hit, Ray, TraceOutcome};
 use crate::secondary::{LightTarget, OwnShadows, ShadowTracer, face_normal, trace_shadow};
-use crate::walk::Start;
 
 /// Tile edge in pixels.
 pub const TILE: u32 = 16;
@@ -52,13 +57,13 @@ pub const TILE: u32 = 16;
 /// Rendering errors.
 #[derive(Debug, Error)]
 pub enum RenderError {
-    /// The camera could not be located in the mesh.
+    /// No ray can be started from the camera (see [`Viewpoint::locate`]).
     #[error("camera at {position:?}: {source}")]
     Camera {
         /// Camera position.
         position: Vec3,
         /// Why.
-        source: LocateError,
+        source: ViewpointError,
     },
     /// Width or height is zero.
     #[error("image size {width}×{height} is empty")]
@@ -312,10 +317,16 @@ pub fn render_scene_with<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
     }
     let t0 = Instant::now();
     let mesh = tracer.mesh();
-    let start = locate(mesh, camera.position, 0).map_err(|source| RenderError::Camera {
+    let view = Viewpoint::locate(mesh, camera.position).map_err(|source| RenderError::Camera {
         position: camera.position,
         source,
     })?;
+    // Lights are located from the camera's tet, or from tet 0 when the
+    // camera is outside the mesh.
+    let start = match view {
+        Viewpoint::Inside(t) => t,
+        Viewpoint::Outside(_) => 0,
+    };
     let mut points = Vec::with_capacity(lights.points.len());
     for (index, light) in lights.points.iter().enumerate() {
         // Located only when shadow rays need the star.
@@ -352,7 +363,7 @@ pub fn render_scene_with<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
                 }
             }
             let mut outcomes = vec![TraceOutcome::Miss { tets_visited: 0 }; rays.len()];
-            tracer.trace_batch(&rays, Start::Tet(start), &mut outcomes);
+            view.trace_batch(tracer, &rays, &mut outcomes);
             let out = rays
                 .iter()
                 .zip(outcomes)

@@ -31,7 +31,7 @@ use tet_core::layout::LayoutError;
 
 use crate::kernel::{LANES, Tracer, WalkTracer};
 use crate::ray::{Failure, Ray, TraceOutcome};
-use crate::walk::{DuffF32, Projection, Start, Topology, trace, trace_interleaved};
+use crate::walk::{DuffF32, Projection, Start, Starts, Topology, trace, trace_interleaved};
 
 /// The compile-time case of a ray direction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -251,7 +251,14 @@ impl<L: Topology> Tracer for ScaledTracer<'_, L> {
             with_case!(
                 case,
                 P,
-                trace_interleaved::<P, L, LANES>(w.mesh, &w.layout, r, start, w.cap, o)
+                trace_interleaved::<P, L, LANES>(
+                    w.mesh,
+                    &w.layout,
+                    r,
+                    Starts::Same(start),
+                    w.cap,
+                    o
+                )
             );
             i = j;
         }

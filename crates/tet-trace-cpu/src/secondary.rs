@@ -354,7 +354,7 @@ impl<'m> MeshWalker<'m> {
 fn starts_in(start: Start, stop: &[u32]) -> bool {
     match start {
         Start::Tet(t) => stops_at(stop, t),
-        Start::Face { tet, .. } => stops_at(stop, tet),
+        Start::Face { tet, .. } | Start::Entry { tet, .. } => stops_at(stop, tet),
     }
 }
 

@@ -285,6 +285,16 @@ impl Tet80Tracer<'_> {
                     },
                 }
             }
+            Start::Entry { tet, face } => {
+                if self.mesh.is_boundary_face(tet, face) {
+                    self.walk(ray, tet, face as usize, 0, stop)
+                } else {
+                    TraceOutcome::Failed {
+                        failure: Failure::Lost,
+                        tets_visited: 0,
+                    }
+                }
+            }
         }
     }
 }

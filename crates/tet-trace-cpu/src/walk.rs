@@ -124,11 +124,11 @@ pub trait Projection: Copy + Send + Sync {
         mesh: &TetMesh,
         topo: &T,
         rays: &[Ray],
-        start: Start,
+        starts: Starts<'_>,
         cap: u32,
         out: &mut [TraceOutcome],
     ) {
-        trace_interleaved::<Self, T, { crate::kernel::LANES }>(mesh, topo, rays, start, cap, out)
+        trace_interleaved::<Self, T, { crate::kernel::LANES }>(mesh, topo, rays, starts, cap, out)
     }
 }
 
@@ -315,11 +315,11 @@ impl Projection for DuffF32 {
         mesh: &TetMesh,
         topo: &T,
         rays: &[Ray],
-        start: Start,
+        starts: Starts<'_>,
         cap: u32,
         out: &mut [TraceOutcome],
     ) {
-        crate::lockstep::trace_lockstep(mesh, topo, rays, start, cap, out)
+        crate::lockstep::trace_lockstep(mesh, topo, rays, starts, cap, out)
     }
     #[inline(always)]
     fn left(&self, a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
@@ -522,6 +522,50 @@ pub enum Start {
         /// The side to walk into.
         tet: u32,
     },
+    /// Entering the mesh from outside: the ray's origin lies outside the
+    /// mesh and its line enters `tet` through that tet's boundary face
+    /// `face` (0..=3, opposite vertex slot `face`, linked to
+    /// [`Link::BOUNDARY`]), ahead of the origin. Nothing lies outside the
+    /// mesh, so the walk starts there; see [`crate::entry`], which finds it
+    /// (and resolves a constrained face on the boundary itself).
+    Entry {
+        /// The tet entered.
+        tet: u32,
+        /// Its face on the mesh boundary (0..=3).
+        face: u8,
+    },
+}
+
+impl Start {
+    /// The constrained face the ray starts on ([`Start::Face`]), which a
+    /// tracer without tets must skip.
+    pub fn on_face(&self) -> Option<u32> {
+        match *self {
+            Start::Face { face, .. } => Some(face),
+            Start::Tet(_) | Start::Entry { .. } => None,
+        }
+    }
+}
+
+/// The starts of a batch of rays: one for all (primary rays from a viewpoint
+/// inside the mesh) or one per ray.
+#[derive(Clone, Copy, Debug)]
+pub enum Starts<'a> {
+    /// Every ray starts from this.
+    Same(Start),
+    /// Ray `i` starts from element `i` (same length as the rays).
+    Each(&'a [Start]),
+}
+
+impl Starts<'_> {
+    /// The start of ray `i`.
+    #[inline(always)]
+    pub fn of(&self, i: usize) -> Start {
+        match self {
+            Starts::Same(s) => *s,
+            Starts::Each(s) => s[i],
+        }
+    }
 }
 
 /// Which slot of the counter-clockwise entry face `(a, b, c)` the new vertex
@@ -686,7 +730,7 @@ pub fn trace<P: Projection, T: Topology>(
     }
 }
 
-/// Traces many rays from one start with `K` walks interleaved on one thread:
+/// Traces many rays (ray `i` from `starts.of(i)`) with `K` walks interleaved on one thread:
 /// each round advances every lane by one tet, so the CPU overlaps the
 /// dependent load → project → decide → load chains of independent rays
 /// (memory-level parallelism without SIMD). Each step prefetches the record
@@ -697,7 +741,7 @@ pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
     mesh: &TetMesh,
     topo: &T,
     rays: &[Ray],
-    start: Start,
+    start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
 ) {
@@ -737,7 +781,7 @@ pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
 fn lane_event<P: Projection>(
     mesh: &TetMesh,
     rays: &[Ray],
-    start: Start,
+    start: Starts<'_>,
     queued: &mut usize,
     out: &mut [TraceOutcome],
     lanes: &mut Vec<(usize, Lane<P>)>,
@@ -767,14 +811,14 @@ fn lane_event<P: Projection>(
 pub(crate) fn next_lane<P: Projection>(
     mesh: &TetMesh,
     rays: &[Ray],
-    start: Start,
+    start: Starts<'_>,
     queued: &mut usize,
     out: &mut [TraceOutcome],
 ) -> Option<(usize, Lane<P>)> {
     while *queued < rays.len() {
         let i = *queued;
         *queued += 1;
-        match begin::<P>(mesh, &rays[i], start) {
+        match begin::<P>(mesh, &rays[i], start.of(i)) {
             Ok(l) => return Some((i, l)),
             Err(o) => out[i] = o,
         }
@@ -794,7 +838,6 @@ fn begin<P: Projection>(mesh: &TetMesh, ray: &Ray, start: Start) -> Result<Lane<
         });
     }
     let proj = P::setup(ray);
-    let points = &mesh.points[..];
     let st: State<P> = match start {
         Start::Tet(t) => {
             if t as usize >= mesh.tets.len() {
@@ -827,24 +870,28 @@ fn begin<P: Projection>(mesh: &TetMesh, ray: &Ray, start: Start) -> Result<Lane<
                     tets_visited: 0,
                 });
             };
-            let v = mesh.tets[tet as usize];
-            let [a, b, c] = FACE_VERTICES[side.face as usize];
-            // Entering `tet` through this face: counter-clockwise = inward order.
-            let ids = [v[a], v[c], v[b]];
-            let st = State {
-                tet: NO_TET,
-                p: P::face(ids.map(|i| proj.project(points[i as usize]))),
-                ids,
-                link: Link::constrained(face).0,
-                visited: 0,
-            };
-            let entry_raw = st.link;
-            return Ok(Lane {
+            return Ok(enter_through(
+                mesh,
                 proj,
-                st,
-                next: tet,
-                entry_raw,
-            });
+                tet,
+                side.face as usize,
+                Link::constrained(face),
+            ));
+        }
+        Start::Entry { tet, face } => {
+            if !mesh.is_boundary_face(tet, face) {
+                return Err(TraceOutcome::Failed {
+                    failure: Failure::Lost,
+                    tets_visited: 0,
+                });
+            }
+            return Ok(enter_through(
+                mesh,
+                proj,
+                tet,
+                face as usize,
+                Link::BOUNDARY,
+            ));
         }
     };
     // Resolve the start tet's exit link.
@@ -872,7 +919,35 @@ fn begin<P: Projection>(mesh: &TetMesh, ray: &Ray, start: Start) -> Result<Lane<
     }
 }
 
-enum Resolved {
+/// A lane about to enter `tet` through its face `face` (slot index), whose
+/// raw link on the far side is `behind` (the constrained face crossed, or
+/// the boundary): the entry face in counter-clockwise (= inward) order.
+fn enter_through<P: Projection>(
+    mesh: &TetMesh,
+    proj: P,
+    tet: u32,
+    face: usize,
+    behind: Link,
+) -> Lane<P> {
+    let v = mesh.tets[tet as usize];
+    let [a, b, c] = FACE_VERTICES[face & 3];
+    let ids = [v[a], v[c], v[b]];
+    let st = State {
+        tet: NO_TET,
+        p: P::face(ids.map(|i| proj.project(mesh.points[i as usize]))),
+        ids,
+        link: behind.0,
+        visited: 0,
+    };
+    Lane {
+        proj,
+        st,
+        next: tet,
+        entry_raw: behind.0,
+    }
+}
+
+pub(crate) enum Resolved {
     Done(TraceOutcome),
     Cross(u32),
 }
@@ -881,46 +956,60 @@ enum Resolved {
 /// miss beyond `t_max`, or crossing when before `t_min`).
 #[inline(never)]
 fn resolve_face<P: Projection>(mesh: &TetMesh, ray: &Ray, st: &State<P>, link: Link) -> Resolved {
-    let Some(c) = link.as_constrained() else {
-        return Resolved::Done(TraceOutcome::Miss {
+    match link.as_constrained() {
+        Some(c) => resolve_constrained(mesh, ray, c, st.ids, st.tet, st.visited),
+        None => Resolved::Done(TraceOutcome::Miss {
             tets_visited: st.visited,
-        });
-    };
+        }),
+    }
+}
+
+/// The ray reached constrained face `c` (vertices `ids`) from tet `tet`
+/// (`NO_TET`: from outside the mesh) after `visited` tets: a hit, a miss
+/// beyond `t_max`, or a crossing into the far side when before `t_min`.
+pub(crate) fn resolve_constrained(
+    mesh: &TetMesh,
+    ray: &Ray,
+    c: u32,
+    ids: [u32; 3],
+    tet: u32,
+    visited: u32,
+) -> Resolved {
     let cf = &mesh.constrained[c as usize];
-    let (t, w) = face_hit(mesh, ray, st.ids);
+    let (t, w) = face_hit(mesh, ray, ids);
     if t < ray.t_min as f64 {
-        return match cf.other_side(st.tet) {
+        return match cf.other_side(tet) {
             Some(s) if s.exists() => Resolved::Cross(s.tet),
             _ => Resolved::Done(TraceOutcome::Miss {
-                tets_visited: st.visited,
+                tets_visited: visited,
             }),
         };
     }
     if t > ray.t_max as f64 {
         return Resolved::Done(TraceOutcome::Miss {
-            tets_visited: st.visited,
+            tets_visited: visited,
         });
     }
     let mut bary = [0f32; 3];
     for (k, &vk) in cf.vertices.iter().enumerate() {
-        let j = st.ids.iter().position(|&x| x == vk).unwrap_or(k);
+        let j = ids.iter().position(|&x| x == vk).unwrap_or(k);
         bary[k] = w[j] as f32;
     }
     if degenerate_crossing(t, &bary) {
         return Resolved::Done(TraceOutcome::Failed {
             failure: Failure::Lost,
-            tets_visited: st.visited,
+            tets_visited: visited,
         });
     }
-    let far = cf.other_side(st.tet).map_or(NO_TET, |s| s.tet);
+    let far = cf.other_side(tet).map_or(NO_TET, |s| s.tet);
     Resolved::Done(TraceOutcome::Hit(Hit {
         triangle: cf.triangle,
         face: c,
         t: t as f32,
         barycentrics: bary,
-        tet: st.tet,
+        tet,
         far_tet: far,
-        tets_visited: st.visited,
+        tets_visited: visited,
     }))
 }
 

@@ -14,7 +14,7 @@ use tet_trace_cpu::kernel::{Interleaved, WalkTracer};
 use tet_trace_cpu::lockstep::trace_lockstep_portable;
 use tet_trace_cpu::reference::{Aim, random_direction, random_point_inside, ray_from_feature};
 use tet_trace_cpu::walk::Topology;
-use tet_trace_cpu::{DuffF32, Ray, Start, TraceOutcome, Tracer, locate};
+use tet_trace_cpu::{DuffF32, Ray, Start, Starts, TraceOutcome, Tracer, locate};
 
 mod common;
 use common::grid;
@@ -107,13 +107,13 @@ fn check_batch<L: Topology>(t: &WalkTracer<'_, L, DuffF32>, rays: &[Ray], start:
     t.trace_batch(rays, start, &mut lock);
     let (mesh, topo, cap) = (t.mesh(), t.layout(), t.step_cap());
     let mut p1 = fresh();
-    trace_lockstep_portable::<L, 1>(mesh, topo, rays, start, cap, &mut p1);
+    trace_lockstep_portable::<L, 1>(mesh, topo, rays, Starts::Same(start), cap, &mut p1);
     let mut p3 = fresh();
-    trace_lockstep_portable::<L, 3>(mesh, topo, rays, start, cap, &mut p3);
+    trace_lockstep_portable::<L, 3>(mesh, topo, rays, Starts::Same(start), cap, &mut p3);
     let mut p4 = fresh();
-    trace_lockstep_portable::<L, 4>(mesh, topo, rays, start, cap, &mut p4);
+    trace_lockstep_portable::<L, 4>(mesh, topo, rays, Starts::Same(start), cap, &mut p4);
     let mut p8 = fresh();
-    trace_lockstep_portable::<L, 8>(mesh, topo, rays, start, cap, &mut p8);
+    trace_lockstep_portable::<L, 8>(mesh, topo, rays, Starts::Same(start), cap, &mut p8);
     for (i, r) in rays.iter().enumerate() {
         let want = bits(&single[i]);
         for (name, got) in [

@@ -25,10 +25,7 @@ impl Tracer for Brute<'_> {
         self.0
     }
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
-        let skip = match start {
-            Start::Face { face, .. } => face,
-            Start::Tet(_) => u32::MAX,
-        };
+        let skip = start.on_face().unwrap_or(u32::MAX);
         let mut best: Option<(f64, u32, [f64; 3])> = None;
         for (i, cf) in self.0.constrained.iter().enumerate() {
             if i as u32 == skip {

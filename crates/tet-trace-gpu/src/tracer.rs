@@ -11,7 +11,7 @@ use tet_core::scene::Camera;
 use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::{duff_basis, start_exit_face, step_cap};
-use tet_trace_cpu::{DuffF32, Failure, Hit, Ray, Start, TraceOutcome};
+use tet_trace_cpu::{DuffF32, Failure, Hit, Ray, Start, TraceOutcome, Viewpoint};
 use wgpu::util::DeviceExt;
 
 use crate::layout::Split;
@@ -417,6 +417,21 @@ impl<'a> GpuTracer<'a> {
                     next: tet,
                 }
             }
+            Start::Entry { tet, face } => {
+                if !mesh.is_boundary_face(tet, face) {
+                    return done(ST_LOST);
+                }
+                let v = mesh.tets[tet as usize];
+                let [a, b, c] = FACE_VERTICES[(face & 3) as usize];
+                StartRec {
+                    mode: START_ENTER,
+                    ids: [v[a], v[c], v[b]],
+                    tet: NO_TET,
+                    link: Link::BOUNDARY.0,
+                    visited: 0,
+                    next: tet,
+                }
+            }
         }
     }
 
@@ -457,6 +472,10 @@ impl<'a> GpuTracer<'a> {
                     None => done(ST_LOST, 0),
                 }
             }
+            Start::Entry { tet, face } if mesh.is_boundary_face(tet, face) => {
+                rec(START_ENTER, tet, face as u32, 0)
+            }
+            Start::Entry { .. } => done(ST_LOST, 0),
         }
     }
 
@@ -635,6 +654,68 @@ impl<'a> GpuTracer<'a> {
             outcomes,
             stats,
             retraced: lost.len() as u64,
+        })
+    }
+
+    /// [`GpuTracer::render`] from a located viewpoint: the GPU's own camera
+    /// rays when the camera is inside the mesh; from outside, the rays are
+    /// made on the host, each starts through the boundary face it enters by
+    /// (`tet_trace_cpu::entry`, host side, like the starts of
+    /// [`GpuTracer::trace_batch`]) and a ray that misses the mesh is a miss
+    /// that visits no tet.
+    pub fn render_view(
+        &self,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        pixel_centers: bool,
+        view: &Viewpoint,
+    ) -> Result<GpuFrame, GpuError> {
+        let entry = match view {
+            Viewpoint::Inside(t) => return self.render(camera, width, height, pixel_centers, *t),
+            Viewpoint::Outside(entry) => entry,
+        };
+        let pixels = width as u64 * height as u64;
+        if width == 0 || height == 0 || pixels > u32::MAX as u64 {
+            return Err(GpuError::Camera {
+                detail: format!("image size {width}x{height} is empty or too large"),
+            });
+        }
+        let t0 = Instant::now();
+        let cam = PinholeCamera::new(camera, width, height, pixel_centers);
+        let mut outcomes = vec![TraceOutcome::Miss { tets_visited: 0 }; pixels as usize];
+        let (mut rays, mut starts, mut index) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, o) in outcomes.iter_mut().enumerate() {
+            let ray = cam.ray(i as u32 % width, i as u32 / width);
+            match entry.start(self.mesh, &ray) {
+                Ok(s) => {
+                    rays.push(ray);
+                    starts.push(s);
+                    index.push(i);
+                }
+                Err(done) => *o = done,
+            }
+        }
+        let (traced, s) = self.trace_batch(&rays, &starts)?;
+        for (i, o) in index.into_iter().zip(traced) {
+            outcomes[i] = o;
+        }
+        // Counted again below over every pixel.
+        let mut stats = DispatchStats {
+            rays: 0,
+            hits: 0,
+            failures: 0,
+            tets_visited: 0,
+            ..s
+        };
+        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        stats.count(&outcomes);
+        Ok(GpuFrame {
+            width,
+            height,
+            outcomes,
+            stats,
+            retraced: 0,
         })
     }
 
