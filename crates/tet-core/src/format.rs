@@ -72,9 +72,28 @@
 //!
 //! [`save`] writes to a temporary file in the target's directory, syncs it
 //! and renames it over the target, so a reader never sees a partial file.
+//!
+//! # Streaming
+//!
+//! A mesh larger than memory is written and read a piece at a time:
+//!
+//! * [`StreamWriter`] appends element slices to the sections in table order
+//!   (points, tets, neighbors, constrained, then the optional ones),
+//!   hashing the payload as it goes; [`StreamWriter::finish`] writes the
+//!   header last (counts and section table from what was written) and
+//!   renames the temporary file into place. A writer dropped unfinished
+//!   removes its temporary file and leaves the target untouched. For the
+//!   same mesh the file is byte for byte what [`save`] writes ([`save`] is a
+//!   [`StreamWriter`] given whole sections).
+//! * [`SectionReader`] opens a file with the header checks of [`load`]
+//!   (against the real file length), then reads any range of one section
+//!   without reading the rest; [`SectionReader::verify_payload`] checks the
+//!   payload CRC in one streaming pass of bounded memory. Element *values*
+//!   (vertex ids, links) are not checked: a caller indexing with them checks
+//!   them ([`load`] runs [`TetMesh::validate`] on the whole mesh instead).
 
-use std::fs::{self, File, OpenOptions};
-use std::io::{self, BufReader, BufWriter, Read, Write};
+use std::fs::File;
+use std::io::{self, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -87,6 +106,12 @@ use crate::error::MeshError;
 use crate::link::{Link, MAX_TETS};
 use crate::mesh::{Attributes, ConstrainedFace, TetMesh};
 use crate::scene::{Camera, PointLight, SceneInfo, SceneInfoError};
+
+mod section_reader;
+mod stream_writer;
+
+pub use section_reader::SectionReader;
+pub use stream_writer::{OptionalSections, StreamWriter};
 
 /// The first eight bytes of every file.
 pub const MAGIC: [u8; 8] = *b"TETMESH\0";
@@ -238,6 +263,32 @@ pub enum FormatError {
         record: usize,
         /// What is wrong.
         detail: String,
+    },
+    /// A [`StreamWriter`] was asked to write a section out of table order,
+    /// or one the file does not have.
+    #[error("{path}: cannot write section {section}: {detail}", path = .path.display())]
+    SectionOrder {
+        /// The file being written.
+        path: PathBuf,
+        /// The section.
+        section: &'static str,
+        /// Why not.
+        detail: String,
+    },
+    /// A [`SectionReader`] was asked for elements the section does not
+    /// have (or for a section the file does not have: `count` 0).
+    #[error("{path}: elements {start}..{end} of section {section} requested, it has {count}", path = .path.display())]
+    SectionRange {
+        /// The file.
+        path: PathBuf,
+        /// The section.
+        section: &'static str,
+        /// First element requested.
+        start: u64,
+        /// One past the last element requested.
+        end: u64,
+        /// Elements in the section.
+        count: u64,
     },
     /// The file is well formed but the mesh breaks an invariant.
     #[error("{path}: invalid mesh: {source}", path = .path.display())]
@@ -739,18 +790,7 @@ pub fn load(path: impl AsRef<Path>) -> Result<TetMesh, FormatError> {
 /// [`load`], also returning the scene block (empty when absent).
 pub fn load_with_scene(path: impl AsRef<Path>) -> Result<(TetMesh, SceneInfo), FormatError> {
     let path = path.as_ref();
-    let io = |source| FormatError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let mut file = File::open(path).map_err(io)?;
-    let actual = file.metadata().map_err(io)?.len();
-    let mut head = Vec::with_capacity(HEADER_LEN);
-    (&mut file)
-        .take(HEADER_LEN as u64)
-        .read_to_end(&mut head)
-        .map_err(io)?;
-    let header = parse_header(&head, actual, path)?;
+    let (file, header) = SectionReader::open(path)?.into_parts();
     decode(
         FileSource(BufReader::with_capacity(1 << 16, file)),
         header,
@@ -799,6 +839,39 @@ fn hash_le_words(h: &mut Hasher, bytes: &[u8]) {
     }
 }
 
+/// What the header records (see the module docs).
+struct HeaderFields {
+    flags: u32,
+    file_length: u64,
+    triangle_count: u32,
+    /// Points, tets, constrained faces.
+    counts: [u64; 3],
+    /// (offset, length) per section, in table order.
+    table: [(u64, u64); 7],
+    payload_crc: u32,
+}
+
+/// The 176 header bytes, header CRC included.
+fn header_bytes(h: &HeaderFields) -> [u8; HEADER_LEN] {
+    let mut head = [0u8; HEADER_LEN];
+    head[0..8].copy_from_slice(&MAGIC);
+    head[8..12].copy_from_slice(&VERSION.to_le_bytes());
+    head[12..16].copy_from_slice(&h.flags.to_le_bytes());
+    head[16..24].copy_from_slice(&h.file_length.to_le_bytes());
+    head[24..28].copy_from_slice(&h.triangle_count.to_le_bytes());
+    for (i, count) in h.counts.iter().enumerate() {
+        head[32 + 8 * i..40 + 8 * i].copy_from_slice(&count.to_le_bytes());
+    }
+    for (i, (off, len)) in h.table.iter().enumerate() {
+        head[56 + 16 * i..64 + 16 * i].copy_from_slice(&off.to_le_bytes());
+        head[64 + 16 * i..72 + 16 * i].copy_from_slice(&len.to_le_bytes());
+    }
+    head[PAYLOAD_CRC_AT..PAYLOAD_CRC_AT + 4].copy_from_slice(&h.payload_crc.to_le_bytes());
+    let hcrc = crc32fast::hash(&head[..HEADER_CRC_AT]);
+    head[HEADER_CRC_AT..HEADER_LEN].copy_from_slice(&hcrc.to_le_bytes());
+    head
+}
+
 /// Serialises `mesh` into `w` (header first, then the sections).
 ///
 /// The mesh is not validated: an invalid mesh is written as is and rejected
@@ -842,22 +915,18 @@ pub fn write_to_with_scene(
     let scene_bytes: &[u8] = bytemuck::cast_slice(&records);
     hash_le_words(&mut crc, scene_bytes);
     end += scene_bytes.len() as u64;
-    let mut head = [0u8; HEADER_LEN];
-    head[0..8].copy_from_slice(&MAGIC);
-    head[8..12].copy_from_slice(&VERSION.to_le_bytes());
-    head[12..16].copy_from_slice(&flags.to_le_bytes());
-    head[16..24].copy_from_slice(&end.to_le_bytes());
-    head[24..28].copy_from_slice(&mesh.triangle_count.to_le_bytes());
-    head[32..40].copy_from_slice(&(mesh.points.len() as u64).to_le_bytes());
-    head[40..48].copy_from_slice(&(mesh.tets.len() as u64).to_le_bytes());
-    head[48..56].copy_from_slice(&(mesh.constrained.len() as u64).to_le_bytes());
-    for (i, (off, len)) in table.iter().enumerate() {
-        head[56 + 16 * i..64 + 16 * i].copy_from_slice(&off.to_le_bytes());
-        head[64 + 16 * i..72 + 16 * i].copy_from_slice(&len.to_le_bytes());
-    }
-    head[PAYLOAD_CRC_AT..PAYLOAD_CRC_AT + 4].copy_from_slice(&crc.finalize().to_le_bytes());
-    let hcrc = crc32fast::hash(&head[..HEADER_CRC_AT]);
-    head[HEADER_CRC_AT..HEADER_LEN].copy_from_slice(&hcrc.to_le_bytes());
+    let head = header_bytes(&HeaderFields {
+        flags,
+        file_length: end,
+        triangle_count: mesh.triangle_count,
+        counts: [
+            mesh.points.len() as u64,
+            mesh.tets.len() as u64,
+            mesh.constrained.len() as u64,
+        ],
+        table,
+        payload_crc: crc.finalize(),
+    });
     w.write_all(&head)?;
     for bytes in sections.into_iter().flatten() {
         write_le_words(w, bytes)?;
@@ -888,47 +957,55 @@ pub fn save(path: impl AsRef<Path>, mesh: &TetMesh) -> Result<(), FormatError> {
 
 /// [`save`] with a scene block holding `scene` (none when it is empty), so
 /// the file remembers the camera and lights of the scene it was built from.
+///
+/// The sections go through a [`StreamWriter`], which checks on the way that
+/// attribute arrays have their section's length
+/// ([`FormatError::SizeMismatch`]); nothing else is validated.
 pub fn save_with_scene(
     path: impl AsRef<Path>,
     mesh: &TetMesh,
     scene: &SceneInfo,
 ) -> Result<(), FormatError> {
+    let a = &mesh.attributes;
+    let mut w = StreamWriter::create(
+        path,
+        mesh.triangle_count,
+        OptionalSections::of(&mesh.attributes),
+    )?;
+    w.append_points(&mesh.points)?;
+    w.append_tets(&mesh.tets)?;
+    w.append_neighbors(&mesh.neighbors)?;
+    w.append_constrained(&mesh.constrained)?;
+    if let Some(n) = &a.normals {
+        w.append_normals(n)?;
+    }
+    if let Some(u) = &a.uvs {
+        w.append_uvs(u)?;
+    }
+    if let Some(m) = &a.materials {
+        w.append_materials(m)?;
+    }
+    w.finish_with_scene(scene).map(|_| ())
+}
+
+/// A fresh temporary path in `path`'s directory, named after it (so that
+/// renaming it over `path` is atomic: same file system).
+fn temp_path(path: &Path) -> Result<PathBuf, FormatError> {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let path = path.as_ref();
-    let io = |source| FormatError::Io {
+    let name = path.file_name().ok_or_else(|| FormatError::Io {
         path: path.to_path_buf(),
-        source,
-    };
-    let name = path.file_name().ok_or_else(|| {
-        io(io::Error::new(
-            io::ErrorKind::InvalidInput,
-            "path has no file name",
-        ))
+        source: io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"),
     })?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let tmp = dir.join(format!(
+    Ok(dir.join(format!(
         ".{}.tmp-{}-{}",
         name.to_string_lossy(),
         std::process::id(),
         COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let result = (|| -> io::Result<()> {
-        let file = OpenOptions::new().write(true).create_new(true).open(&tmp)?;
-        let mut w = BufWriter::with_capacity(1 << 16, file);
-        write_to_with_scene(mesh, scene, &mut w)?;
-        let file = w.into_inner().map_err(io::IntoInnerError::into_error)?;
-        file.sync_all()?;
-        drop(file);
-        fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = fs::remove_file(&tmp);
-        return Err(io(e));
-    }
-    Ok(())
+    )))
 }
 
 #[cfg(test)]
