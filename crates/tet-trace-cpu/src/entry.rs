@@ -94,6 +94,9 @@ pub struct EntryHint(usize);
 #[derive(Clone, Debug)]
 pub struct BoundaryEntry {
     faces: Vec<EntryFace>,
+    /// The viewpoint every kept face faces ([`BoundaryEntry::seen_from`]):
+    /// rays from it skip the per-face orientation test.
+    seen_from: Option<Vec3>,
     /// Bounds of the mesh points (the boundary lies inside them).
     lo: DVec3,
     hi: DVec3,
@@ -135,7 +138,12 @@ impl BoundaryEntry {
             .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), p| {
                 (a.min(p.as_dvec3()), b.max(p.as_dvec3()))
             });
-        Ok(BoundaryEntry { faces, lo, hi })
+        Ok(BoundaryEntry {
+            faces,
+            seen_from: None,
+            lo,
+            hi,
+        })
     }
 
     /// The faces whose plane has `origin` on its outer side or on it: the
@@ -149,6 +157,7 @@ impl BoundaryEntry {
             .collect();
         BoundaryEntry {
             faces,
+            seen_from: Some(origin),
             lo: self.lo,
             hi: self.hi,
         }
@@ -213,12 +222,13 @@ impl BoundaryEntry {
             return None;
         }
         let proj = P::setup(ray);
+        let faced = self.seen_from == Some(ray.origin);
         let enters = |f: &EntryFace| {
             let p = f.ids.map(|i| proj.project(mesh.points[i as usize]));
             proj.left(p[0], f.ids[0], p[1], f.ids[1])
                 && proj.left(p[1], f.ids[1], p[2], f.ids[2])
                 && proj.left(p[2], f.ids[2], p[0], f.ids[0])
-                && faces_origin(mesh, f, ray.origin)
+                && (faced || faces_origin(mesh, f, ray.origin))
         };
         let n = self.faces.len();
         let first = hint.0.min(n.saturating_sub(1));

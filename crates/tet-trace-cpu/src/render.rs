@@ -348,31 +348,6 @@ pub fn render_scene_with<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
         areas: lights.areas,
     };
     let cam = PinholeCamera::new(camera, w, h, opts.pixel_centers);
-    let tiles_x = w.div_ceil(TILE);
-    let tiles_y = h.div_ceil(TILE);
-    let tiles: Vec<(u32, Vec<Pixel>)> = (0..tiles_x * tiles_y)
-        .into_par_iter()
-        .map(|tile| {
-            let (tx, ty) = (tile % tiles_x, tile / tiles_x);
-            let mut rays = Vec::with_capacity((TILE * TILE) as usize);
-            let mut ids = Vec::with_capacity((TILE * TILE) as usize);
-            for j in ty * TILE..((ty + 1) * TILE).min(h) {
-                for i in tx * TILE..((tx + 1) * TILE).min(w) {
-                    rays.push(cam.ray(i, j));
-                    ids.push(j * w + i);
-                }
-            }
-            let mut outcomes = vec![TraceOutcome::Miss { tets_visited: 0 }; rays.len()];
-            view.trace_batch(tracer, &rays, &mut outcomes);
-            let out = rays
-                .iter()
-                .zip(outcomes)
-                .zip(&ids)
-                .map(|((ray, o), &k)| shade(shadow, mesh, ray, o, k, &frame_lights, opts))
-                .collect();
-            (tile, out)
-        })
-        .collect();
     let n = (w * h) as usize;
     let mut frame = Frame {
         width: w,
@@ -382,25 +357,61 @@ pub fn render_scene_with<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
         triangle: vec![u32::MAX; n],
         stats: FrameStats::default(),
     };
-    for (tile, pixels) in tiles {
-        let (tx, ty) = (tile % tiles_x, tile / tiles_x);
-        let mut it = pixels.into_iter();
-        for j in ty * TILE..((ty + 1) * TILE).min(h) {
-            for i in tx * TILE..((tx + 1) * TILE).min(w) {
-                let Some(p) = it.next() else { break };
-                let k = (j * w + i) as usize;
-                frame.color[k] = p.color;
-                frame.tets[k] = p.tets;
-                frame.triangle[k] = p.triangle;
-                frame.stats.rays += 1;
-                frame.stats.hits += p.hit as u64;
-                frame.stats.failures += p.failed as u64;
-                frame.stats.tets_visited += p.tets as u64;
-                frame.stats.shadow_rays += p.shadow_rays as u64;
-                frame.stats.shadow_failures += p.shadow_failures as u64;
+    // One task per band of TILE rows: its tiles are traced in turn and
+    // shaded straight into the band's rows of the frame (contiguous), so no
+    // per-pixel record is collected and copied afterwards.
+    let band = (TILE * w) as usize;
+    let stats = frame
+        .color
+        .par_chunks_mut(band)
+        .zip(frame.tets.par_chunks_mut(band))
+        .zip(frame.triangle.par_chunks_mut(band))
+        .enumerate()
+        .map(|(ty, ((color, tets), triangle))| {
+            let mut stats = FrameStats::default();
+            let mut rays = Vec::with_capacity((TILE * TILE) as usize);
+            let mut ids = Vec::with_capacity((TILE * TILE) as usize);
+            let mut outcomes = Vec::with_capacity((TILE * TILE) as usize);
+            let y0 = ty as u32 * TILE;
+            let y1 = (y0 + TILE).min(h);
+            for x0 in (0..w).step_by(TILE as usize) {
+                rays.clear();
+                ids.clear();
+                for j in y0..y1 {
+                    for i in x0..(x0 + TILE).min(w) {
+                        rays.push(cam.ray(i, j));
+                        ids.push(j * w + i);
+                    }
+                }
+                outcomes.clear();
+                outcomes.resize(rays.len(), TraceOutcome::Miss { tets_visited: 0 });
+                view.trace_batch(tracer, &rays, &mut outcomes);
+                for ((ray, o), &k) in rays.iter().zip(&outcomes).zip(&ids) {
+                    let p = shade(shadow, mesh, ray, *o, k, &frame_lights, opts);
+                    let local = k as usize - (y0 * w) as usize;
+                    color[local] = p.color;
+                    tets[local] = p.tets;
+                    triangle[local] = p.triangle;
+                    stats.rays += 1;
+                    stats.hits += p.hit as u64;
+                    stats.failures += p.failed as u64;
+                    stats.tets_visited += p.tets as u64;
+                    stats.shadow_rays += p.shadow_rays as u64;
+                    stats.shadow_failures += p.shadow_failures as u64;
+                }
             }
-        }
-    }
+            stats
+        })
+        .reduce(FrameStats::default, |a, b| FrameStats {
+            ms: 0.0,
+            rays: a.rays + b.rays,
+            hits: a.hits + b.hits,
+            tets_visited: a.tets_visited + b.tets_visited,
+            failures: a.failures + b.failures,
+            shadow_rays: a.shadow_rays + b.shadow_rays,
+            shadow_failures: a.shadow_failures + b.shadow_failures,
+        });
+    frame.stats = stats;
     frame.stats.ms = t0.elapsed().as_secs_f64() * 1e3;
     Ok(frame)
 }
