@@ -25,7 +25,7 @@ use tet_trace_cpu::tet16::Tet16Tracer;
 use tet_trace_cpu::tet20::Tet20Tracer;
 use tet_trace_cpu::tet32::Tet32Tracer;
 use tet_trace_cpu::tet80::Tet80Tracer;
-use tet_trace_cpu::{Failure, Ray, Start, TraceOutcome, Tracer, locate};
+use tet_trace_cpu::{Failure, Ray, Start, TraceOutcome, Tracer, Viewpoint, locate};
 use tet_trace_gpu::{
     GpuContext, GpuError, GpuFrame, GpuLayout, GpuOptions, GpuTracer, REQUIRE_ADAPTER_ENV,
 };
@@ -400,9 +400,9 @@ fn camera_case(
     w: u32,
     h: u32,
 ) -> GpuFrame {
-    let start = locate(mesh, camera.position, 0).unwrap();
+    let view = Viewpoint::locate(mesh, camera.position).unwrap();
     let gpu = GpuTracer::new(ctx, mesh, layout).unwrap();
-    let frame = gpu.render(camera, w, h, false, start).unwrap();
+    let frame = gpu.render_view(camera, w, h, false, &view).unwrap();
     assert_eq!(frame.outcomes.len(), (w * h) as usize);
     let cam = PinholeCamera::new(camera, w, h, false);
     let cpu = cpu_tracer(mesh, layout, None);
@@ -412,7 +412,10 @@ fn camera_case(
         for i in 0..w {
             let ray = cam.ray(i, j);
             let g = &frame.outcomes[(j * w + i) as usize];
-            let c = cpu.trace(&ray, Start::Tet(start));
+            let c = match view.start(cpu.as_ref(), &ray) {
+                Ok(s) => cpu.trace(&ray, s),
+                Err(done) => done,
+            };
             let graze = grazes_an_edge(mesh, &ray, GRAZE);
             assert!(
                 !g.is_failure() || (layout == GpuLayout::Tet80 && same_walk(g, &c)),
@@ -463,6 +466,25 @@ fn camera_rays_generated_on_the_gpu_match_the_cpu_camera() {
         assert!(
             hits > 200,
             "the shell should fill much of the image: {hits}"
+        );
+    }
+    // From outside the mesh (a tight enclosing box): rays enter through the
+    // boundary, chosen on the host; the rays around the mesh visit no tet.
+    let outside = Camera {
+        position: Vec3::new(7.0, 6.0, 9.0),
+        ..camera
+    };
+    for layout in GpuLayout::ALL {
+        let frame = camera_case(&ctx, layout, &mesh, &outside, 40, 30);
+        let hits = frame.outcomes.iter().filter(|o| o.hit().is_some()).count();
+        let untouched = frame
+            .outcomes
+            .iter()
+            .filter(|o| o.tets_visited() == 0)
+            .count();
+        assert!(
+            hits > 100 && untouched > 50,
+            "{layout:?}: {hits} hits, {untouched} untouched"
         );
     }
 }
