@@ -2,6 +2,8 @@
 
 #![cfg(feature = "tetgen")]
 
+mod common;
+
 use std::time::Duration;
 
 use glam::Vec3;
@@ -904,4 +906,118 @@ fn seam_quality_splits_tets_at_the_seam() {
     let q = seam_quality(&whole, &report.seams);
     assert!(q.seam.is_none());
     assert_eq!(q.rest.unwrap().tets, whole.tets.len());
+}
+
+// ---------------------------------------------------------------------------
+// Streaming merge: every part through a part file, merged a part at a time.
+
+use tet_build::outofcore::seam::{SeamReport, build_slabs_to_file};
+use tet_build::outofcore::stream::{StreamOptions, StreamSummary};
+use tet_build::outofcore::tree::build_tree_to_file;
+
+/// Builds `tree` (or the slabs `slabs`) with the in-memory merge and with
+/// the streaming merge: the mesh file is the in-memory mesh (up to order;
+/// `load` runs `validate`), and no part file is left behind.
+fn streamed_equals_in_memory(
+    scene: &Scene,
+    split: Result<&CutTree, (usize, &[f32])>,
+    options: &SeamOptions,
+) -> (StreamSummary, SeamReport) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("streamed.tmesh");
+    let stream = StreamOptions::new(&out);
+    let ((mesh, _), (summary, report)) = match split {
+        Ok(tree) => (
+            build_tree(scene, tree, options).unwrap(),
+            build_tree_to_file(scene, tree, options, &stream).unwrap(),
+        ),
+        Err((axis, values)) => (
+            build_slabs(scene, axis, values, options).unwrap(),
+            build_slabs_to_file(scene, axis, values, options, &stream).unwrap(),
+        ),
+    };
+    let streamed = tet_core::format::load(&out).unwrap();
+    assert_eq!(
+        (summary.points, summary.tets, summary.constrained),
+        (
+            mesh.points.len() as u64,
+            mesh.tets.len() as u64,
+            mesh.constrained.len() as u64
+        )
+    );
+    assert!(
+        common::canonical(&streamed) == common::canonical(&mesh),
+        "{}: the streamed mesh differs from the in-memory one",
+        scene.name
+    );
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, ["streamed.tmesh"], "part files are removed");
+    (summary, report)
+}
+
+/// Depth 1, 2 and 3 on a torus knot (cut triangles, perpendicular seams
+/// whose traces cross, eight parts meeting at a point), parts in workers
+/// two at a time: the streamed mesh is the in-memory one. On the eight
+/// parts the merge's working set (one part's arrays and the seam maps) is
+/// well below all parts together.
+#[test]
+fn streamed_merge_equals_in_memory_merge_on_a_knot() {
+    let scene = knot_grid(1, 120, 12);
+    let options = SeamOptions {
+        isolation: worker(),
+        parallel_parts: 2,
+        ..SeamOptions::default()
+    };
+    let depth1 = CutTree::split(0, 0.1, leaf(), leaf());
+    let depth2 = CutTree::split(
+        0,
+        0.1,
+        CutTree::split(1, 0.05, leaf(), leaf()),
+        CutTree::split(1, -0.3, leaf(), leaf()),
+    );
+    let depth3 = CutTree::grid(&[0.1], &[0.05], &[-0.37]);
+    for tree in [&depth1, &depth2] {
+        let (s, _) = streamed_equals_in_memory(&scene, Ok(tree), &options);
+        assert!(s.seam_points > 0 && s.seam_faces > 0, "{s:?}");
+    }
+    let (s, report) = streamed_equals_in_memory(&scene, Ok(&depth3), &options);
+    assert_eq!(report.part_tets.len(), 8);
+    println!(
+        "8 parts: merge held at most {} bytes; all parts {} bytes; {} seam points, {} seam faces",
+        s.max_resident_bytes, s.all_parts_bytes, s.seam_points, s.seam_faces
+    );
+    assert!(
+        s.max_resident_bytes < s.all_parts_bytes / 2,
+        "the merge held {} bytes of {} in all parts",
+        s.max_resident_bytes,
+        s.all_parts_bytes
+    );
+}
+
+/// Scene faces lying on cut planes (a cube cut on its faces by slabs and
+/// by a tree, planes along its edges and through its vertices) become one
+/// constrained face with a side in each part, as in memory.
+#[test]
+fn streamed_merge_keeps_scene_faces_on_cut_planes() {
+    let scene = single("cube", tet_build::procedural::cube(1.0));
+    let options = SeamOptions::default();
+    let (s, report) = streamed_equals_in_memory(&scene, Err((0, &[-1.0, 0.0, 1.0])), &options);
+    assert_eq!(report.triangles_in_plane, 4);
+    assert!(s.seam_constrained >= 4, "{s:?}");
+    let tree = CutTree::split(
+        0,
+        0.0,
+        CutTree::split(1, 1.0, CutTree::split(2, 0.0, leaf(), leaf()), leaf()),
+        CutTree::split(
+            1,
+            0.0,
+            leaf(),
+            CutTree::split(0, 1.0, CutTree::split(2, 1.0, leaf(), leaf()), leaf()),
+        ),
+    );
+    let (s, _) = streamed_equals_in_memory(&scene, Ok(&tree), &options);
+    assert!(s.seam_constrained >= 3, "{s:?}");
 }

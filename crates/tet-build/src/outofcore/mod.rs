@@ -15,48 +15,69 @@
 //!   recursive rule (plane through the mean of the axis of largest
 //!   variance, moved to a nearby plane cutting fewer triangles — the
 //!   paper's future work) as a [`split::SplitTree`] with the triangles cut
-//!   at every node. [`split::plan_slabs`] is what the builder uses today:
-//!   parallel planes on the axis of largest variance at corner quantiles,
-//!   as many as needed for every slab's prediction to fit.
-//! * [`seam`]: exact seams and the merge. Triangles crossing a plane are
-//!   clipped with crossing points rounded once to f32 and lying exactly on
-//!   the plane; one `spade` constrained Delaunay triangulation of the
-//!   section (cut segments, in-plane scene edges and vertices as
+//!   at every node; [`split::plan_slabs`] cuts parallel slabs on the axis
+//!   of largest variance at corner quantiles, as many as needed for every
+//!   slab's prediction to fit (the fallback when no tree fits).
+//! * [`seam`]: exact seams between parallel planes. Triangles crossing a
+//!   plane are clipped with crossing points rounded once to f32 and lying
+//!   exactly on the plane; one `spade` constrained Delaunay triangulation
+//!   of the section (cut segments, in-plane scene edges and vertices as
 //!   constraints) is given to both neighbouring parts as facets; TetGen
-//!   `-pY` keeps every facet; the merge is exact point deduplication +
-//!   [`tet_core::TetMesh::assemble`] — no repair step, no hashing of
-//!   centroids. [`seam::build_slabs`] builds `k + 1` slabs (parts run
-//!   concurrently in worker processes with `parallel_parts`),
+//!   `-pY` keeps every facet. [`seam::build_slabs`] builds `k + 1` slabs
+//!   (parts run concurrently in worker processes with `parallel_parts`),
 //!   [`seam::build_with_memory_limit`] plans and builds under a limit.
+//! * [`tree`]: the paper's recursive tree with perpendicular planes. Where
+//!   seams meet, every wall is triangulated with the traces of the other
+//!   seams and the crossings registered on shared roots, so both sides of
+//!   every wall receive the very same triangles
+//!   ([`tree::build_tree`], [`tree::build_tree_with_memory_limit`], which
+//!   moves a plane meeting a degenerate configuration and retries).
+//! * Merging, two ways: in memory (exact point deduplication +
+//!   [`tet_core::TetMesh::assemble`]: no repair step, no hashing of
+//!   centroids; the caller holds the whole mesh), or streamed ([`stream`]:
+//!   each part written to a part file as soon as its worker returns, the
+//!   part files merged into the mesh file a part at a time, holding one
+//!   part plus maps proportional to the seams' area;
+//!   [`tree::build_tree_to_file`], [`seam::build_slabs_to_file`],
+//!   [`tree::build_tree_with_memory_limit_to_file`]). Both give the same
+//!   mesh up to the order of its elements; the streamed one is
+//!   Hilbert-sorted part by part, parts in leaf order.
+//! * [`seam_index`]: which points and faces lie on a seam (exact), for the
+//!   streamed merge and the seam [`report`].
+//! * [`report`]: tet quality at the seams vs elsewhere.
 //!
 //! | paper (seed 003)                       | code                                   |
 //! |----------------------------------------|----------------------------------------|
-//! | `TETRA(vertices, faces)`               | [`seam::build_with_memory_limit`]      |
+//! | `TETRA(vertices, faces)`               | [`tree::build_tree_with_memory_limit`] |
 //! | `CALCULATE_EXPECTED_MEMORY`            | [`memory_model::predict_peak_memory`]  |
 //! | `memory_limit`                         | `SplitOptions::limit_bytes`            |
 //! | `CLIP` plane (mean, max-variance axis) | [`split::choose_plane`]                |
-//! | `CLIP` of triangles                    | [`seam::clip_polygon`], [`seam::crossing_point`] |
-//! | left / right parts                     | slabs `k`, `k + 1` of [`seam::build_slabs`] |
-//! | `MERGE` (repairs, centroid hashing)    | exact dedup + `TetMesh::assemble` in [`seam::build_slabs`] |
+//! | `CLIP` of triangles                    | [`seam::clip_polygon`], [`seam::crossing_point`], tree-order clipping in [`tree`] |
+//! | left / right parts                     | the leaves of [`tree::CutTree`] (slabs `k`, `k + 1` of [`seam::build_slabs`]) |
+//! | `MERGE` (repairs, centroid hashing)    | exact vertex triples: in memory, or [`stream::merge_part_files`] |
 //!
-//! ## Limits of this first part
-//! * Only parallel planes are built ([`seam::build_slabs`]). The recursive
-//!   tree of [`split::plan_split`] has perpendicular planes, whose seams
-//!   meet each other: a seam's triangulation would then need the traces of
-//!   the other side's deeper planes (and their crossing points) as
-//!   constraints so both sides agree; not done yet.
-//! * Parts are held in memory and merged in memory (no streaming through
-//!   mesh files yet), so the *caller's* process holds the whole mesh; the
-//!   limit applies to each TetGen worker.
+//! ## Limits
+//! * The limit is honoured by every TetGen worker's *predicted* peak (and
+//!   measured: see the tests); the caller's own memory is the planner's
+//!   inputs (the cleaned scene, every part's facets) plus, while parts
+//!   run, one finished part (TetGen's output, then its assembled and
+//!   sorted [`tet_core::TetMesh`]) per worker thread; the streamed merge
+//!   then holds one part plus the seam maps. The in-memory merge (and
+//!   the whole-mesh Hilbert sort after it) holds the whole mesh.
+//! * The streamed mesh is Hilbert-sorted within each part only: the
+//!   whole-mesh order needs the whole mesh in memory.
 //! * A Steiner point whose f32 rounding flattens a tet is an error
 //!   ([`seam::SeamError::RoundingFlattens`]); the in-core pipeline's
 //!   snapping repair is not reused yet.
 //! * A plane closer than [`seam::NEAR_PLANE`] × the box extent to a vertex
 //!   (but not through it) is refused (TetGen would merge the crossing
-//!   points with the vertex); [`split::plan_slabs`] avoids such planes.
+//!   points with the vertex); [`split::plan_slabs`] avoids such planes and
+//!   [`tree::build_tree_with_memory_limit`] moves them.
 
 pub mod memory_model;
 pub mod report;
 pub mod seam;
+pub mod seam_index;
 pub mod split;
+pub mod stream;
 pub mod tree;

@@ -4,16 +4,16 @@
 //!
 //! A tet *touches a seam* when one of its faces lies in a seam: its three
 //! vertices have exactly the seam plane's coordinate and lie inside the
-//! seam's rectangle ([`super::seam::SeamReport::seams`]). Exact: seam
-//! points carry the plane coordinate bit for bit. [`seam_quality`]
+//! seam's rectangle ([`super::seam::SeamReport::seams`],
+//! [`super::seam_index::SeamIndex`]). Exact: seam points carry the plane
+//! coordinate bit for bit. [`seam_quality`]
 //! measures those tets and the rest separately with
 //! [`crate::quality`]'s aspect ratio and radius-edge ratio.
-
-use std::collections::HashMap;
 
 use glam::Vec3;
 use tet_core::{FACE_VERTICES, TetMesh};
 
+use super::seam_index::SeamIndex;
 use super::split::SplitPlane;
 use crate::quality::{QualityReport, Stats, aspect_ratio, radius_edge_ratio};
 
@@ -26,38 +26,16 @@ pub struct SeamQuality {
     pub rest: Option<QualityReport>,
 }
 
-/// Does the tet face `f` (three points) lie in one of the seams?
-fn on_seam(f: [Vec3; 3], seams: &HashMap<(usize, u32), Vec<(Vec3, Vec3)>>) -> bool {
-    (0..3).any(|k| {
-        let v = f[0][k];
-        if f[1][k] != v || f[2][k] != v {
-            return false;
-        }
-        seams.get(&(k, (v + 0.0).to_bits())).is_some_and(|rects| {
-            rects.iter().any(|(lo, hi)| {
-                f.iter()
-                    .all(|p| (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a]))
-            })
-        })
-    })
-}
-
 /// Which tets of `mesh` have a face in one of `seams` (plane, rectangle
-/// lower and upper corner).
+/// lower and upper corner; [`SeamIndex::contains_face`]).
 pub fn seam_tets(mesh: &TetMesh, seams: &[(SplitPlane, Vec3, Vec3)]) -> Vec<bool> {
-    let mut index: HashMap<(usize, u32), Vec<(Vec3, Vec3)>> = HashMap::new();
-    for (plane, lo, hi) in seams {
-        index
-            .entry((plane.axis, (plane.value + 0.0).to_bits()))
-            .or_default()
-            .push((*lo, *hi));
-    }
+    let index = SeamIndex::new(seams);
     (0..mesh.tets.len())
         .map(|t| {
             let p = mesh.tet_points(t as u32);
             FACE_VERTICES
                 .iter()
-                .any(|f| on_seam(f.map(|i| p[i]), &index))
+                .any(|f| index.contains_face(f.map(|i| p[i])))
         })
         .collect()
 }

@@ -28,6 +28,8 @@
 //!    triangle comes from both slabs and is listed once). Seam-only faces become ordinary interior
 //!    faces; pieces of a cut scene triangle are constrained faces carrying
 //!    the source triangle id (a scene triangle may then be several faces).
+//!    [`build_slabs_to_file`] streams the parts through part files instead
+//!    ([`super::stream`]), with the same result.
 //!
 //! TetGen's Steiner points (interior only, with `-Y`) are rounded to f32;
 //! a tet flattened by that rounding is reported as
@@ -43,14 +45,15 @@ use tet_core::{MeshError, TetMesh, face_key};
 use thiserror::Error;
 
 use super::split::SplitPlane;
+use super::stream::{StreamOptions, StreamSummary, ToFile};
 use crate::bbox::{BoxError, BoxSpec, EnclosingBox};
 use crate::clean::{CleanError, clean_scene};
 use crate::procedural::BOX_TRIANGLES;
 use crate::scene::Scene;
 use crate::tetgen::{Isolation, TetgenError, TetgenInput, TetgenOptions, tetrahedralize};
 
-/// A failure of [`build_split_once`].
-#[derive(Debug, Clone, PartialEq, Error)]
+/// A failure of [`build_split_once`] and the other out-of-core builders.
+#[derive(Debug, Error)]
 pub enum SeamError {
     /// Cleaning rejected the scene.
     #[error("cleaning: {0}")]
@@ -195,6 +198,9 @@ pub enum SeamError {
     /// Assembly or validation of the merged mesh failed.
     #[error("merged mesh: {0}")]
     Mesh(#[from] MeshError),
+    /// Writing a part file or streaming the parts into the mesh file failed.
+    #[error("streaming merge: {0}")]
+    Stream(#[from] super::stream::StreamError),
 }
 
 /// What [`build_slabs`] (and [`build_split_once`]) did.
@@ -474,19 +480,26 @@ pub(super) enum FacetKind {
     Seam,
 }
 
-/// One part after TetGen: f32 points, positive tets, constrained faces.
-pub(super) struct PartMesh {
-    points: Vec<Vec3>,
-    tets: Vec<[u32; 4]>,
-    /// (vertices, cleaned source) in the part's point indices.
-    constrained: Vec<([u32; 3], u32)>,
+/// What one part's TetGen run took and gave (the per-part report fields).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PartStats {
     input_points: usize,
     input_triangles: usize,
     /// Points used by no scene facet (seam and box corners, trace points).
     wall_points: usize,
     /// Facets that are not scene pieces (seam-only and box faces).
     wall_triangles: usize,
+    tets: usize,
     peak_kib: Option<u64>,
+}
+
+/// One part after TetGen: f32 points, positive tets, constrained faces.
+pub(super) struct PartMesh {
+    pub(super) points: Vec<Vec3>,
+    pub(super) tets: Vec<[u32; 4]>,
+    /// (vertices, cleaned source) in the part's point indices.
+    pub(super) constrained: Vec<([u32; 3], u32)>,
+    pub(super) stats: PartStats,
 }
 
 fn run_part(
@@ -592,14 +605,17 @@ fn run_part(
         })
         .collect();
     Ok(PartMesh {
+        stats: PartStats {
+            input_points: input.points.len(),
+            input_triangles: input.triangles.len(),
+            wall_points,
+            wall_triangles,
+            tets: tets.len(),
+            peak_kib: out.worker_peak_kib,
+        },
         points: p32,
         tets,
         constrained,
-        input_points: input.points.len(),
-        input_triangles: input.triangles.len(),
-        wall_points,
-        wall_triangles,
-        peak_kib: out.worker_peak_kib,
     })
 }
 
@@ -674,6 +690,30 @@ pub fn build_slabs(
     values: &[f32],
     options: &SeamOptions,
 ) -> Result<(TetMesh, SeamReport), SeamError> {
+    build_slabs_with(scene, axis, values, options, &InMemory)
+}
+
+/// [`build_slabs`] with the parts written to part files as they finish
+/// and streamed into the mesh file `stream.output`
+/// ([`super::stream`]): the caller never holds the whole mesh.
+pub fn build_slabs_to_file(
+    scene: &Scene,
+    axis: usize,
+    values: &[f32],
+    options: &SeamOptions,
+    stream: &StreamOptions,
+) -> Result<(StreamSummary, SeamReport), SeamError> {
+    build_slabs_with(scene, axis, values, options, &ToFile::new(stream)?)
+}
+
+/// [`build_slabs`] with the parts finished and merged by `merge`.
+fn build_slabs_with<M: Merge>(
+    scene: &Scene,
+    axis: usize,
+    values: &[f32],
+    options: &SeamOptions,
+    merge: &M,
+) -> Result<(M::Output, SeamReport), SeamError> {
     let (cleaned, cm) = clean_scene(scene)?;
     if cleaned.triangles.is_empty() {
         return Err(SeamError::EmptyScene);
@@ -815,14 +855,13 @@ pub fn build_slabs(
             .collect()
     };
     let faces: Vec<Vec<[Vec3; 3]>> = (0..=n).map(slab_faces).collect();
-    let meshes = run_parts(&parts, &faces, options)?;
-    let mesh = merge_parts(
-        &meshes,
-        &cm.triangle_source,
-        scene.triangles.len() as u32,
-        &mut report,
-    )?;
-    Ok((mesh, report))
+    let inputs = PartInputs {
+        parts,
+        faces,
+        triangle_source: cm.triangle_source,
+        triangle_count: scene.triangles.len() as u32,
+    };
+    finish_parts(inputs, report, options, merge)
 }
 
 /// Adds the segment between the already inserted seam points `a` and `b`
@@ -844,18 +883,124 @@ pub(super) fn add_seam_constraint(
     Ok(())
 }
 
-/// Merges tetrahedralized parts: points deduplicated by their exact f32
-/// bits, tets concatenated, constrained faces listed once each (a face on
-/// a seam carrying an in-plane scene triangle comes from both sides) with
-/// the *input* scene triangle id (`triangle_source` maps cleaned → input),
-/// then [`TetMesh::assemble`] and [`TetMesh::validate`]. Fills the per-part
-/// fields of `report`.
-pub(super) fn merge_parts(
-    meshes: &[PartMesh],
-    triangle_source: &[u32],
-    triangle_count: u32,
-    report: &mut SeamReport,
-) -> Result<TetMesh, SeamError> {
+/// The parts of a split, ready for TetGen.
+pub(super) struct PartInputs {
+    /// Each part's PLC facets (scene pieces and wall triangles).
+    pub(super) parts: Vec<Vec<([Vec3; 3], FacetKind)>>,
+    /// Each part's box faces (unmarked facets; empty for a tree, whose
+    /// walls are among the facets).
+    pub(super) faces: Vec<Vec<[Vec3; 3]>>,
+    /// Input scene triangle of each cleaned one.
+    pub(super) triangle_source: Vec<u32>,
+    /// Input scene triangles.
+    pub(super) triangle_count: u32,
+}
+
+/// What a [`Merge`] needs besides the parts.
+pub(super) struct MergeContext<'a> {
+    /// Input scene triangle of each cleaned one.
+    pub(super) triangle_source: &'a [u32],
+    /// Input scene triangles.
+    pub(super) triangle_count: u32,
+    /// The seams (plane and rectangle), as in [`SeamReport::seams`].
+    pub(super) seams: &'a [(SplitPlane, Vec3, Vec3)],
+}
+
+impl MergeContext<'_> {
+    /// A part's constrained faces with the *input* scene triangle ids.
+    pub(super) fn scene_ids(&self, constrained: &[([u32; 3], u32)]) -> Vec<([u32; 3], u32)> {
+        constrained
+            .iter()
+            .map(|&(t, s)| (t, self.triangle_source[s as usize]))
+            .collect()
+    }
+}
+
+/// What becomes of the parts once TetGen has run: [`InMemory`] keeps them
+/// and merges them into one [`TetMesh`]; [`super::stream::ToFile`] writes
+/// each to a part file and streams them into the mesh file.
+pub(super) trait Merge: Sync {
+    /// What is kept of a finished part until the merge.
+    type Part: Send;
+    /// The merged result.
+    type Output;
+    /// Called on the worker thread as soon as part `k`'s TetGen run returns.
+    fn part(&self, k: usize, mesh: PartMesh, ctx: &MergeContext) -> Result<Self::Part, SeamError>;
+    /// The report fields of a finished part.
+    fn stats(part: &Self::Part) -> PartStats;
+    /// Merges the parts (in part order).
+    fn merge(&self, parts: Vec<Self::Part>, ctx: &MergeContext) -> Result<Self::Output, SeamError>;
+}
+
+/// Runs TetGen on every part ([`run_parts`]), hands each finished part to
+/// `merge`, fills the per-part fields of `report` and merges.
+pub(super) fn finish_parts<M: Merge>(
+    inputs: PartInputs,
+    mut report: SeamReport,
+    options: &SeamOptions,
+    merge: &M,
+) -> Result<(M::Output, SeamReport), SeamError> {
+    let ctx = MergeContext {
+        triangle_source: &inputs.triangle_source,
+        triangle_count: inputs.triangle_count,
+        seams: &report.seams,
+    };
+    let parts = run_parts(&inputs.parts, &inputs.faces, options, &|k, mesh| {
+        merge.part(k, mesh, &ctx)
+    })?;
+    let stats: Vec<PartStats> = parts.iter().map(M::stats).collect();
+    let output = merge.merge(parts, &ctx)?;
+    for s in &stats {
+        record_part(&mut report, s);
+    }
+    Ok((output, report))
+}
+
+/// The in-memory merge: parts kept as they come from TetGen, merged by
+/// [`merge_parts`].
+pub(super) struct InMemory;
+
+impl Merge for InMemory {
+    type Part = PartMesh;
+    type Output = TetMesh;
+
+    fn part(&self, _: usize, mesh: PartMesh, _: &MergeContext) -> Result<PartMesh, SeamError> {
+        Ok(mesh)
+    }
+
+    fn stats(part: &PartMesh) -> PartStats {
+        part.stats
+    }
+
+    fn merge(&self, parts: Vec<PartMesh>, ctx: &MergeContext) -> Result<TetMesh, SeamError> {
+        merge_parts(&parts, ctx)
+    }
+}
+
+/// Records a part's stats in the per-part fields of `report`.
+fn record_part(report: &mut SeamReport, s: &PartStats) {
+    report.part_points.push(s.input_points);
+    report.part_triangles.push(s.input_triangles);
+    report.part_wall_points.push(s.wall_points);
+    report.part_wall_triangles.push(s.wall_triangles);
+    report.part_tets.push(s.tets);
+    report.part_peak_kib.push(s.peak_kib);
+    report
+        .part_predicted_bytes
+        .push(super::memory_model::predict_part_peak_memory(
+            s.input_points - s.wall_points,
+            s.input_triangles - s.wall_triangles,
+            s.wall_points,
+            s.wall_triangles,
+        ));
+}
+
+/// Merges tetrahedralized parts in memory: points deduplicated by their
+/// exact f32 bits, tets concatenated, constrained faces listed once each (a
+/// face on a seam carrying an in-plane scene triangle comes from both
+/// sides) with the *input* scene triangle id, then [`TetMesh::assemble`]
+/// and [`TetMesh::validate`].
+fn merge_parts(meshes: &[PartMesh], ctx: &MergeContext) -> Result<TetMesh, SeamError> {
     let mut index: HashMap<[u32; 3], u32> = HashMap::new();
     let mut points = Vec::new();
     let mut tets = Vec::new();
@@ -873,28 +1018,14 @@ pub(super) fn merge_parts(
             })
             .collect();
         tets.extend(m.tets.iter().map(|t| t.map(|v| map[v as usize])));
-        for &(t, s) in &m.constrained {
+        for (t, s) in ctx.scene_ids(&m.constrained) {
             let g = t.map(|v| map[v as usize]);
             if seen.insert(face_key(g)) {
-                tris.push((g, triangle_source[s as usize]));
+                tris.push((g, s));
             }
         }
-        report.part_points.push(m.input_points);
-        report.part_triangles.push(m.input_triangles);
-        report.part_wall_points.push(m.wall_points);
-        report.part_wall_triangles.push(m.wall_triangles);
-        report.part_tets.push(m.tets.len());
-        report.part_peak_kib.push(m.peak_kib);
-        report
-            .part_predicted_bytes
-            .push(super::memory_model::predict_part_peak_memory(
-                m.input_points - m.wall_points,
-                m.input_triangles - m.wall_triangles,
-                m.wall_points,
-                m.wall_triangles,
-            ));
     }
-    let mesh = TetMesh::assemble(points, tets, &tris, triangle_count)?;
+    let mesh = TetMesh::assemble(points, tets, &tris, ctx.triangle_count)?;
     mesh.validate()?;
     Ok(mesh)
 }
@@ -925,18 +1056,21 @@ pub fn build_with_memory_limit(
 /// that many threads take the next part from a queue as soon as their
 /// previous one finishes (largest input first, so a big part does not
 /// start last), which keeps both threads busy when parts differ in size.
-/// The first error (in part order) is returned.
-pub(super) fn run_parts(
+/// Each part is handed to `finish` on its thread as soon as its TetGen
+/// run returns. Results are in part order; the first error (in part order)
+/// is returned.
+pub(super) fn run_parts<T: Send>(
     parts: &[Vec<([Vec3; 3], FacetKind)>],
     faces: &[Vec<[Vec3; 3]>],
     options: &SeamOptions,
-) -> Result<Vec<PartMesh>, SeamError> {
+    finish: &(dyn Fn(usize, PartMesh) -> Result<T, SeamError> + Sync),
+) -> Result<Vec<T>, SeamError> {
     use std::sync::Mutex;
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     let width = options.parallel_parts.max(1).min(parts.len().max(1));
     let mut order: Vec<usize> = (0..parts.len()).collect();
     order.sort_by_key(|&k| std::cmp::Reverse(parts[k].len() + faces[k].len()));
-    let results: Vec<Mutex<Option<Result<PartMesh, SeamError>>>> =
+    let results: Vec<Mutex<Option<Result<T, SeamError>>>> =
         (0..parts.len()).map(|_| Mutex::new(None)).collect();
     let next = AtomicUsize::new(0);
     let failed = AtomicBool::new(false);
@@ -947,7 +1081,7 @@ pub(super) fn run_parts(
                 break;
             }
             let k = order[i];
-            let r = run_part(k, &parts[k], &faces[k], options);
+            let r = run_part(k, &parts[k], &faces[k], options).and_then(|m| finish(k, m));
             if r.is_err() {
                 failed.store(true, Ordering::Relaxed);
             }

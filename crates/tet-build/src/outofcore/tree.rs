@@ -35,7 +35,8 @@
 //!    it lies on that lie inside the face. Adjacent leaves therefore receive
 //!    the very same triangles on shared faces, and subdivide shared edges
 //!    identically; TetGen `-pY` keeps every facet (checked), and the merge
-//!    is [`super::seam::merge_parts`] (exact dedup + `assemble`).
+//!    is exact: in memory (dedup + `assemble`, [`build_tree`]) or streamed
+//!    through part files ([`build_tree_to_file`], [`super::stream`]).
 //!
 //! | paper (seed 003)                       | code                              |
 //! |----------------------------------------|-----------------------------------|
@@ -51,10 +52,11 @@ use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 use tet_core::TetMesh;
 
 use super::seam::{
-    FacetKind, NEAR_PLANE, PartMesh, SeamError, SeamOptions, SeamReport, add_seam_constraint,
-    crossing_point, key, merge_parts, run_parts,
+    FacetKind, InMemory, Merge, NEAR_PLANE, PartInputs, SeamError, SeamOptions, SeamReport,
+    add_seam_constraint, crossing_point, finish_parts, key,
 };
 use super::split::{SplitPlane, SplitTree};
+use super::stream::{StreamOptions, StreamSummary, ToFile};
 use crate::bbox::EnclosingBox;
 use crate::clean::clean_scene;
 use crate::scene::Scene;
@@ -887,6 +889,30 @@ pub fn build_tree(
     tree: &CutTree,
     options: &SeamOptions,
 ) -> Result<(TetMesh, SeamReport), SeamError> {
+    build_tree_with(scene, tree, options, &InMemory)
+}
+
+/// [`build_tree`] with the parts written to part files as they finish and
+/// streamed into the mesh file `stream.output` ([`super::stream`]): the
+/// caller never holds the whole mesh. The parts follow each other in the
+/// file in leaf order (depth first, below before above), each
+/// Hilbert-sorted on its own with `stream.sort_parts`.
+pub fn build_tree_to_file(
+    scene: &Scene,
+    tree: &CutTree,
+    options: &SeamOptions,
+    stream: &StreamOptions,
+) -> Result<(StreamSummary, SeamReport), SeamError> {
+    build_tree_with(scene, tree, options, &ToFile::new(stream)?)
+}
+
+/// [`build_tree`] with the parts finished and merged by `merge`.
+fn build_tree_with<M: Merge>(
+    scene: &Scene,
+    tree: &CutTree,
+    options: &SeamOptions,
+    merge: &M,
+) -> Result<(M::Output, SeamReport), SeamError> {
     let (cleaned, cm) = clean_scene(scene)?;
     if cleaned.triangles.is_empty() {
         return Err(SeamError::EmptyScene);
@@ -968,15 +994,13 @@ pub fn build_tree(
         }
         parts.push(facets);
     }
-    let no_box: Vec<Vec<[Vec3; 3]>> = vec![Vec::new(); parts.len()];
-    let meshes: Vec<PartMesh> = run_parts(&parts, &no_box, options)?;
-    let mesh = merge_parts(
-        &meshes,
-        &cm.triangle_source,
-        scene.triangles.len() as u32,
-        &mut report,
-    )?;
-    Ok((mesh, report))
+    let inputs = PartInputs {
+        faces: vec![Vec::new(); parts.len()],
+        parts,
+        triangle_source: cm.triangle_source,
+        triangle_count: scene.triangles.len() as u32,
+    };
+    finish_parts(inputs, report, options, merge)
 }
 
 impl CutTree {
@@ -1038,6 +1062,27 @@ pub fn build_tree_with_memory_limit(
     split: &super::split::SplitOptions,
     options: &SeamOptions,
 ) -> Result<(TetMesh, SeamReport, TreePlan), SeamError> {
+    build_tree_with_memory_limit_with(scene, split, options, &InMemory)
+}
+
+/// [`build_tree_with_memory_limit`] streaming the parts into the mesh file
+/// `stream.output` ([`build_tree_to_file`]).
+pub fn build_tree_with_memory_limit_to_file(
+    scene: &Scene,
+    split: &super::split::SplitOptions,
+    options: &SeamOptions,
+    stream: &StreamOptions,
+) -> Result<(StreamSummary, SeamReport, TreePlan), SeamError> {
+    build_tree_with_memory_limit_with(scene, split, options, &ToFile::new(stream)?)
+}
+
+/// [`build_tree_with_memory_limit`] with the parts merged by `merge`.
+fn build_tree_with_memory_limit_with<M: Merge>(
+    scene: &Scene,
+    split: &super::split::SplitOptions,
+    options: &SeamOptions,
+    merge: &M,
+) -> Result<(M::Output, SeamReport, TreePlan), SeamError> {
     let (cleaned, _) = clean_scene(scene)?;
     if cleaned.triangles.is_empty() {
         return Err(SeamError::EmptyScene);
@@ -1053,7 +1098,7 @@ pub fn build_tree_with_memory_limit(
     let mut tree = CutTree::from_split_tree(&plan);
     let mut moves = 0;
     loop {
-        match build_tree(scene, &tree, options) {
+        match build_tree_with(scene, &tree, options, merge) {
             Ok((mesh, report)) => {
                 return Ok((
                     mesh,
