@@ -11,7 +11,7 @@ use proptest::prelude::*;
 use tet_core::TetMesh;
 use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::kernel::{Interleaved, WalkTracer};
-use tet_trace_cpu::lockstep::trace_lockstep_portable;
+use tet_trace_cpu::lockstep::{trace_lockstep_avx2, trace_lockstep_portable};
 use tet_trace_cpu::reference::{Aim, random_direction, random_point_inside, ray_from_feature};
 use tet_trace_cpu::walk::Topology;
 use tet_trace_cpu::{DuffF32, Ray, Start, Starts, TraceOutcome, Tracer, locate};
@@ -106,6 +106,8 @@ fn check_batch<L: Topology>(t: &WalkTracer<'_, L, DuffF32>, rays: &[Ray], start:
     let mut lock = fresh();
     t.trace_batch(rays, start, &mut lock);
     let (mesh, topo, cap) = (t.mesh(), t.layout(), t.step_cap());
+    let mut a2 = fresh();
+    trace_lockstep_avx2(mesh, topo, rays, Starts::Same(start), cap, &mut a2);
     let mut p1 = fresh();
     trace_lockstep_portable::<L, 1>(mesh, topo, rays, Starts::Same(start), cap, &mut p1);
     let mut p3 = fresh();
@@ -119,6 +121,7 @@ fn check_batch<L: Topology>(t: &WalkTracer<'_, L, DuffF32>, rays: &[Ray], start:
         for (name, got) in [
             ("interleaved", &inter),
             ("lockstep", &lock),
+            ("avx2", &a2),
             ("portable/1", &p1),
             ("portable/3", &p3),
             ("portable/4", &p4),
