@@ -3,9 +3,15 @@
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
 
+use std::path::Path;
+
+use tet_core::TetMesh;
+use tet_core::scene::SceneInfo;
+
 use crate::cli::BuildArgs;
 use crate::load::{BuildSummary, MESH_EXTENSION, load};
-use crate::outofcore::{MemoryReport, predict, print_memory};
+use crate::outofcore::{Limited, MemoryReport, MergeMode, predict, print_memory};
+use crate::render::RenderDoc;
 
 /// The `build` document.
 #[derive(Debug, Serialize)]
@@ -26,6 +32,42 @@ pub struct BuildDoc {
     pub build: Option<BuildSummary>,
     /// With `--memory-limit`: the prediction, parts and peaks (else `null`).
     pub memory: Option<MemoryReport>,
+    /// With `--tet20`: tet20 on the written mesh, read back from the file
+    /// (else `null`).
+    pub tet20: Option<RenderDoc>,
+}
+
+/// The scene's own camera and lights, stored with the mesh so that
+/// `render FILE` sees what `render SCENE` sees.
+fn stored_scene(scene: Option<&tet_build::scene::Scene>) -> SceneInfo {
+    SceneInfo {
+        camera: scene.and_then(|s| s.camera),
+        lights: scene.map(|s| s.lights.clone()).unwrap_or_default(),
+    }
+}
+
+/// Saves a mesh built in memory and describes it.
+fn save(
+    mesh: &TetMesh,
+    stored: &SceneInfo,
+    output: &Path,
+    name: String,
+    build: Option<BuildSummary>,
+    memory: Option<MemoryReport>,
+) -> Result<BuildDoc> {
+    tet_core::format::save_with_scene(output, mesh, stored)
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    Ok(BuildDoc {
+        name,
+        output: output.display().to_string(),
+        points: mesh.points.len(),
+        tets: mesh.tets.len(),
+        constrained_faces: mesh.constrained.len(),
+        file_bytes: std::fs::metadata(output).map_or(0, |m| m.len()),
+        build,
+        memory,
+        tet20: None,
+    })
 }
 
 /// Prints a construction report.
@@ -69,8 +111,19 @@ pub fn run(args: &BuildArgs, json: bool) -> Result<()> {
             output.display()
         );
     }
-    let (loaded, memory) = match args.memory_limit {
-        None => (load(&args.scene, &args.build, json)?, None),
+    let doc = match args.memory_limit {
+        None => {
+            let loaded = load(&args.scene, &args.build, json)?;
+            let stored = stored_scene(loaded.scene.as_ref());
+            save(
+                &loaded.mesh,
+                &stored,
+                output,
+                loaded.name.clone(),
+                loaded.build,
+                None,
+            )?
+        }
         Some(limit) => {
             if args.scene.ends_with(&format!(".{MESH_EXTENSION}")) {
                 bail!(
@@ -80,43 +133,54 @@ pub fn run(args: &BuildArgs, json: bool) -> Result<()> {
             }
             let scene = tet_build::scene::Scene::load(&args.scene)
                 .with_context(|| format!("cannot load scene `{}`", args.scene))?;
-            let (mesh, build, memory) = crate::outofcore::build_limited(
-                &scene,
-                &args.build,
-                limit,
-                args.threads
+            let stored = stored_scene(Some(&scene));
+            let limited = Limited {
+                scene: &scene,
+                flags: &args.build,
+                limit_bytes: limit,
+                max_parallel: args
+                    .threads
                     .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
-                json,
-                &[],
-            )?;
-            (
-                crate::load::with_mesh(scene, mesh, Some(build)),
-                Some(memory),
-            )
+                quiet: json,
+                extra: &[],
+                planner: args.planner,
+            };
+            match args.merge {
+                MergeMode::Memory => {
+                    let (mesh, build, memory) = limited.in_memory()?;
+                    save(
+                        &mesh,
+                        &stored,
+                        output,
+                        scene.name.clone(),
+                        Some(build),
+                        Some(memory),
+                    )?
+                }
+                MergeMode::Stream => {
+                    let (written, build, memory) = limited.to_file(output, &stored)?;
+                    BuildDoc {
+                        name: scene.name.clone(),
+                        output: output.display().to_string(),
+                        points: written.points,
+                        tets: written.tets,
+                        constrained_faces: written.constrained,
+                        file_bytes: written.file_bytes,
+                        build: Some(build),
+                        memory: Some(memory),
+                        tet20: None,
+                    }
+                }
+            }
         }
     };
-    // The scene's own camera and lights travel with the mesh, so that
-    // `render FILE` sees what `render SCENE` sees.
-    let stored = tet_core::scene::SceneInfo {
-        camera: loaded.scene.as_ref().and_then(|s| s.camera),
-        lights: loaded
-            .scene
-            .as_ref()
-            .map(|s| s.lights.clone())
-            .unwrap_or_default(),
-    };
-    tet_core::format::save_with_scene(output, &loaded.mesh, &stored)
-        .with_context(|| format!("cannot write {}", output.display()))?;
-    let file_bytes = std::fs::metadata(output).map(|m| m.len()).unwrap_or(0);
     let doc = BuildDoc {
-        name: loaded.name.clone(),
-        output: output.display().to_string(),
-        points: loaded.mesh.points.len(),
-        tets: loaded.mesh.tets.len(),
-        constrained_faces: loaded.mesh.constrained.len(),
-        file_bytes,
-        build: loaded.build.clone(),
-        memory,
+        tet20: if args.tet20 {
+            Some(crate::outofcore::tet20_speed(output, &args.build, json)?)
+        } else {
+            None
+        },
+        ..doc
     };
     if json {
         println!("{}", serde_json::to_string_pretty(&doc)?);
@@ -130,6 +194,12 @@ pub fn run(args: &BuildArgs, json: bool) -> Result<()> {
         }
         if let Some(m) = &doc.memory {
             print_memory(m);
+        }
+        if let Some(t) = &doc.tet20 {
+            println!(
+                "  tet20 on the written mesh: {:.2} Mrays/s ({}x{}, best of {} frames, {} threads, {} failures)",
+                t.mrays_per_s, t.width, t.height, t.frames, t.threads, t.failures
+            );
         }
     }
     Ok(())

@@ -76,13 +76,28 @@ pub struct BuildArgs {
     pub predict_memory: bool,
     /// Keep every TetGen run's predicted peak under this size (bytes, or
     /// with a unit K, M, G: powers of 1024, e.g. 512M): over it, the scene
-    /// is built out of core in slabs with exact seams and merged.
+    /// is split into parts with exact seams, built by parallel workers and
+    /// merged.
     #[arg(long, value_name = "BYTES", value_parser = crate::outofcore::parse_memory_limit)]
     pub memory_limit: Option<u64>,
     /// With `--memory-limit`: at most this many TetGen workers at once
     /// (default: all cores); their predictions together stay under the limit.
     #[arg(long, requires = "memory_limit")]
     pub threads: Option<usize>,
+    /// With `--memory-limit`: how to split (default: the paper's recursive
+    /// tree, parallel slabs when no tree fits).
+    #[arg(long, value_enum, default_value_t, requires = "memory_limit")]
+    pub planner: crate::outofcore::Planner,
+    /// With `--memory-limit`: how to merge the parts. `stream` (default)
+    /// writes each part to a part file as it finishes and merges the files
+    /// into the output a part at a time, each part Hilbert-sorted on its
+    /// own; `memory` merges the whole mesh in memory and sorts it as a whole.
+    #[arg(long, value_enum, default_value_t, requires = "memory_limit")]
+    pub merge: crate::outofcore::MergeMode,
+    /// After writing, trace the written mesh with tet20 (640×480, best of 3
+    /// frames, all cores) and report its speed (`tet20` in `--json`).
+    #[arg(long)]
+    pub tet20: bool,
     /// Build options.
     #[command(flatten)]
     pub build: BuildFlags,

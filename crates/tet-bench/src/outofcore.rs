@@ -11,9 +11,24 @@
 //! ([`tet_build::outofcore::tree::build_tree_with_memory_limit`]), each
 //! part is tetrahedralized by its own TetGen worker with exact seams and
 //! the parts are merged; when no tree fits, parallel slabs are tried
-//! ([`tet_build::outofcore::split::plan_slabs`]). Measured on Torus Knots
-//! in a Box, the tree cuts 12 triangles where slabs cut 14,012–28,340 and
-//! builds in 0.62–0.67× the in-core time at ½–¼ of its peak.
+//! ([`tet_build::outofcore::split::plan_slabs`]); `--planner tree|slabs`
+//! forces one. Measured on Torus Knots in a Box, the tree cuts 12
+//! triangles where slabs cut 14,012–28,340 and builds in 0.62–0.67× the
+//! in-core time at ½–¼ of its peak.
+//!
+//! **Merging.** `build` streams by default ([`MergeMode::Stream`],
+//! [`Limited::to_file`]): each part goes to a part file as soon as its
+//! worker returns and the part files are merged into the output a part at
+//! a time, so the process never holds the whole mesh — what the issue asks
+//! of a build under a limit. The price is locality: each part is
+//! Hilbert-sorted on its own and the parts follow each other in the tree's
+//! leaf order, instead of one curve through the whole mesh.
+//! `--merge memory` ([`Limited::in_memory`]) merges in memory and sorts the
+//! whole mesh; the `tables` harness uses it (it traces the mesh right
+//! away, so holds it anyway). `build --tet20` reads the written file back
+//! and traces it, so the trade (memory, build time, render speed) of both
+//! merges and of the in-core build is measured the same way
+//! ([`tet20_speed`]).
 
 use anyhow::Result;
 use serde::Serialize;
@@ -130,6 +145,25 @@ pub struct MemoryReport {
     pub max_part_peak_kib: Option<u64>,
     /// Wall time of the build (parts, merge, validation), s.
     pub total_s: f64,
+    /// How the parts were merged: `in-core` (one part), `memory` (the
+    /// whole mesh in memory, then Hilbert-sorted as a whole) or `stream`
+    /// (part files merged into the mesh file a part at a time, each part
+    /// Hilbert-sorted on its own).
+    pub merge: String,
+    /// Seconds of the streaming merge after the last part (else `null`).
+    pub merge_s: Option<f64>,
+    /// Largest number of bytes the streaming merge held at once: one
+    /// part's arrays and the seam maps (else `null`).
+    pub merge_max_resident_bytes: Option<u64>,
+    /// Bytes of every part's arrays together: what a merge holding all
+    /// parts at once would need (streaming only, else `null`).
+    pub merge_all_parts_bytes: Option<u64>,
+    /// Bytes of all part files (streaming only, else `null`).
+    pub part_file_bytes: Option<u64>,
+    /// Peak resident memory (`VmHWM`, KiB) of this process when the build
+    /// was done: planner, finished parts, merge (the TetGen workers are
+    /// processes of their own: `part_peak_kib`); `null` without `/proc`.
+    pub process_peak_kib: Option<u64>,
 }
 
 /// Cleaned scene size as TetGen would receive it (with the box unless `no_box`).
@@ -172,14 +206,72 @@ pub fn predict(scene: &Scene, _: bool) -> Result<Prediction> {
     )
 }
 
-/// Builds `scene` so that every TetGen run's predicted peak fits
-/// `limit_bytes`: in core when the whole scene's prediction fits, else in
-/// slabs, up to `max_parallel` at a time with their predictions together
-/// under the limit (the most parallel plan that has at least as many
-/// slabs as workers and at most twice as many as the one-at-a-time plan). The result is Hilbert-sorted unless
-/// `flags.no_sort`. `extra` points (other cameras and lights) are kept
-/// inside the enclosing box.
+/// How `build --memory-limit` splits a scene whose prediction exceeds the
+/// limit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Planner {
+    /// The paper's recursive tree, parallel slabs when no tree fits.
+    #[default]
+    Auto,
+    /// Only the paper's recursive tree (perpendicular planes).
+    Tree,
+    /// Only parallel slabs on the axis of largest variance.
+    Slabs,
+}
+
+/// How the parts of an out-of-core build are merged.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum MergeMode {
+    /// Part files merged into the mesh file a part at a time (each part
+    /// Hilbert-sorted on its own): the merge holds one part and the seams.
+    #[default]
+    Stream,
+    /// The whole mesh merged in memory and Hilbert-sorted as a whole.
+    Memory,
+}
+
+/// A build under a memory limit.
+#[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
+pub struct Limited<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Build options.
+    pub flags: &'a BuildFlags,
+    /// The limit, bytes.
+    pub limit_bytes: u64,
+    /// Most TetGen workers at once.
+    pub max_parallel: usize,
+    /// No progress spinner.
+    pub quiet: bool,
+    /// Points (other cameras and lights) the enclosing box must hold with
+    /// `--wide-box`.
+    pub extra: &'a [glam::Vec3],
+    /// How to split.
+    pub planner: Planner,
+}
+
+/// Counts of a mesh written to a file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Written {
+    /// Points.
+    pub points: usize,
+    /// Tets.
+    pub tets: usize,
+    /// Constrained faces.
+    pub constrained: usize,
+    /// Bytes of the file.
+    pub file_bytes: u64,
+}
+
 #[cfg(feature = "tetgen")]
+mod limited;
+mod trace_speed;
+
+pub use trace_speed::tet20_speed;
+
+/// Builds `scene` so that every TetGen run's predicted peak fits
+/// `limit_bytes`, the parts merged in memory ([`Limited::in_memory`] with
+/// the default planner: the paper's tree, slabs when no tree fits).
 pub fn build_limited(
     scene: &Scene,
     flags: &BuildFlags,
@@ -188,232 +280,41 @@ pub fn build_limited(
     quiet: bool,
     extra: &[glam::Vec3],
 ) -> Result<(TetMesh, BuildSummary, MemoryReport)> {
-    use std::time::Instant;
-
-    use anyhow::{Context, bail};
-    use tet_build::bbox::EnclosingBox;
-    use tet_build::outofcore::seam::{SeamOptions, build_slabs};
-    use tet_build::outofcore::split::{SplitOptions, plan_slabs, plan_split};
-    use tet_build::outofcore::tree::build_tree_with_memory_limit;
-    use tet_build::tetgen::TetgenOptions;
-
-    let start = Instant::now();
-    let predicted = predict(scene, flags.no_box)?.predicted_peak_bytes;
-    if predicted <= limit_bytes {
-        let (mesh, build) = crate::load::build_scene_in(scene, flags, quiet, extra)?;
-        let report = MemoryReport {
-            limit_bytes,
-            predicted_in_core_bytes: predicted,
-            out_of_core: false,
-            parts: 1,
-            parallel_parts: 1,
-            axis: None,
-            planes: Vec::new(),
-            plane_axes: Vec::new(),
-            planner: "in-core".to_string(),
-            depth: 0,
-            triangles_cut: 0,
-            part_points: Vec::new(),
-            part_triangles: Vec::new(),
-            part_tets: vec![mesh.tets.len()],
-            part_predicted_bytes: vec![predicted],
-            part_peak_kib: vec![build.worker_peak_kib],
-            max_part_peak_kib: build.worker_peak_kib,
-            total_s: start.elapsed().as_secs_f64(),
-        };
-        return Ok((mesh, build, report));
-    }
-    if flags.no_box {
-        bail!(
-            "`{}` needs an out-of-core build (predicted {:.1} MiB > limit {:.1} MiB), which cuts the enclosing box into slabs: drop --no-box",
-            scene.name,
-            mib(predicted),
-            mib(limit_bytes)
-        );
-    }
-    let spinner = crate::load::spinner(quiet);
-    spinner.set_message(format!("{}: planning the split", scene.name));
-    let clean_start = Instant::now();
-    let (cleaned, cm) = tet_build::clean::clean_scene(scene)
-        .map_err(|e| anyhow::anyhow!("cannot clean `{}`: {e}", scene.name))?;
-    let clean_s = clean_start.elapsed().as_secs_f64();
-    let box_spec = crate::load::enclosing_box(scene, extra, flags.wide_box);
-    let b = EnclosingBox::new(cleaned.bounds(), box_spec)
-        .with_context(|| format!("cannot build the enclosing box of `{}`", scene.name))?;
-    // One worker at a time: slabs predicted under the limit. With `p`
-    // workers at once, slabs must be predicted under `limit / p`: more
-    // slabs, more cut triangles and seam tets, worse tets near the seams.
-    // The most parallel plan is taken that has at least `p` slabs and at
-    // most twice as many as the one-at-a-time plan.
-    let split = SplitOptions {
+    Limited {
+        scene,
+        flags,
         limit_bytes,
-        ..SplitOptions::default()
-    };
-    let make_options = |parallel: usize| -> Result<SeamOptions> {
-        Ok(SeamOptions {
-            enclosing_box: box_spec,
-            tetgen: TetgenOptions {
-                quality: flags.quality,
-                max_steiner: flags.max_steiner,
-                ..TetgenOptions::default()
-            },
-            isolation: crate::load::worker_isolation(flags.time_limit)?,
-            parallel_parts: parallel,
-        })
-    };
-    // The paper's recursive tree (planes through the mean of the axis of
-    // largest variance, moved to cut fewer triangles) is tried first: on
-    // Torus Knots in a Box it cut 10-12 triangles where slabs cut 8-28 340
-    // and was as fast or faster (tests/outofcore.rs `trade_torus_knots`).
-    // With `p` parts at once every leaf must be predicted under `limit / p`.
-    let tree_for = |p: usize| {
-        let opts = SplitOptions {
-            limit_bytes: limit_bytes / p as u64,
-            ..split
-        };
-        let plan = plan_split(&cleaned.vertices, &cleaned.triangles, (b.min, b.max), &opts);
-        (plan.max_predicted_bytes() <= opts.limit_bytes && plan.parts() >= p).then_some((opts, p))
-    };
-    let tree_choice = (1..=max_parallel.max(1)).rev().find_map(tree_for);
-    let tetgen_start = Instant::now();
-    let (mut mesh, report, parallel, cuts, planner, depth): (_, _, _, Vec<(usize, f32)>, _, _) =
-        if let Some((opts, p)) = tree_choice {
-            spinner.set_message(format!(
-                "{}: building a split tree ({} at a time)",
-                scene.name, p
-            ));
-            let options = make_options(p)?;
-            let (mesh, report, plan) = build_tree_with_memory_limit(scene, &opts, &options)
-                .with_context(|| format!("out-of-core build of `{}` failed", scene.name))?;
-            // Planes in preorder (n parts, n - 1 planes), each with its axis.
-            let mut cuts = Vec::new();
-            let mut stack = vec![&plan.cuts];
-            while let Some(node) = stack.pop() {
-                if let tet_build::outofcore::tree::CutTree::Split {
-                    plane,
-                    below,
-                    above,
-                } = node
-                {
-                    cuts.push((plane.axis, plane.value));
-                    stack.push(above);
-                    stack.push(below);
-                }
-            }
-            (mesh, report, p, cuts, "tree", plan.plan.depth())
-        } else {
-            let plan_for = |p: usize| {
-                let opts = SplitOptions {
-                    limit_bytes: limit_bytes / p as u64,
-                    ..split
-                };
-                plan_slabs(&cleaned.vertices, &cleaned.triangles, (b.min, b.max), &opts)
-            };
-            let Some(base) = plan_for(1) else {
-                bail!(
-                    "no split of `{}` keeps every part's predicted TetGen peak under {:.1} MiB (an empty part alone is predicted {:.1} MiB, and every part carries its seams and box): raise --memory-limit",
-                    scene.name,
-                    mib(limit_bytes),
-                    mib(split.model.predict(0, 0))
-                );
-            };
-            let base_parts = base.values.len() + 1;
-            let (plan, parallel) = (2..=max_parallel.max(1))
-                .rev()
-                .find_map(|p| {
-                    plan_for(p)
-                        .filter(|plan| {
-                            let parts = plan.values.len() + 1;
-                            parts >= p && parts <= 2 * base_parts
-                        })
-                        .map(|plan| (plan, p))
-                })
-                .unwrap_or((base, 1));
-            let options = make_options(parallel)?;
-            spinner.set_message(format!(
-                "{}: building {} parts ({} at a time)",
-                scene.name,
-                plan.values.len() + 1,
-                parallel
-            ));
-            let (mesh, report) = build_slabs(scene, plan.axis, &plan.values, &options)
-                .with_context(|| format!("out-of-core build of `{}` failed", scene.name))?;
-            let depth = (plan.values.len() + 1).next_power_of_two().trailing_zeros() as usize;
-            (
-                mesh,
-                report,
-                parallel,
-                plan.values.iter().map(|&v| (plan.axis, v)).collect(),
-                "slabs",
-                depth,
-            )
-        };
-    let tetgen_s = tetgen_start.elapsed().as_secs_f64();
-    let reorder_start = Instant::now();
-    if !flags.no_sort {
-        spinner.set_message(format!("{}: Hilbert reordering", scene.name));
-        tet_core::reorder::hilbert_reorder(&mut mesh)?;
+        max_parallel,
+        quiet,
+        extra,
+        planner: Planner::Auto,
     }
-    let reorder_s = reorder_start.elapsed().as_secs_f64();
-    spinner.finish_and_clear();
-    let total_s = start.elapsed().as_secs_f64();
-    let peaks = report.part_peak_kib.clone();
-    let max_peak = peaks.iter().flatten().copied().max();
-    let summary = BuildSummary {
-        switches: format!("{} (per part)", make_options(parallel)?.tetgen.switches()),
-        scene_triangles: cleaned.triangles.len(),
-        steiner_points: mesh.points.len().saturating_sub(cleaned.vertices.len() + 8),
-        clean_s,
-        tetgen_s,
-        assemble_s: 0.0,
-        reorder_s,
-        total_s,
-        worker_peak_kib: max_peak,
-        cleaning: crate::load::CleaningSummary {
-            merged_vertices: cm.report.merged_vertices.len(),
-            repeated_vertex_triangles: cm.report.repeated_vertex_triangles.len(),
-            zero_area_triangles: cm.report.zero_area_triangles.len(),
-            duplicate_triangles: cm.report.duplicate_triangles.len(),
-            unused_vertices: cm.report.unused_vertices.len(),
-        },
-    };
-    let memory = MemoryReport {
-        limit_bytes,
-        predicted_in_core_bytes: predicted,
-        out_of_core: true,
-        parts: report.part_tets.len(),
-        parallel_parts: parallel,
-        axis: cuts.first().map(|c| c.0),
-        planes: cuts.iter().map(|c| c.1).collect(),
-        plane_axes: cuts.iter().map(|c| c.0).collect(),
-        planner: planner.to_string(),
-        depth,
-        triangles_cut: report.triangles_cut,
-        part_points: report.part_points,
-        part_triangles: report.part_triangles,
-        part_tets: report.part_tets,
-        part_predicted_bytes: report.part_predicted_bytes,
-        part_peak_kib: peaks,
-        max_part_peak_kib: max_peak,
-        total_s,
-    };
-    Ok((mesh, summary, memory))
+    .in_memory()
 }
 
 /// Without TetGen, scenes cannot be built.
 #[cfg(not(feature = "tetgen"))]
-pub fn build_limited(
-    scene: &Scene,
-    _: &BuildFlags,
-    _: u64,
-    _: usize,
-    _: bool,
-    _: &[glam::Vec3],
-) -> Result<(TetMesh, BuildSummary, MemoryReport)> {
-    anyhow::bail!(
-        "`{}` is a scene, but this tet-bench was built without the `tetgen` feature",
-        scene.name
-    )
+impl Limited<'_> {
+    fn no_tetgen<T>(&self) -> Result<T> {
+        anyhow::bail!(
+            "`{}` is a scene, but this tet-bench was built without the `tetgen` feature",
+            self.scene.name
+        )
+    }
+
+    /// Fails: no TetGen.
+    pub fn in_memory(&self) -> Result<(TetMesh, BuildSummary, MemoryReport)> {
+        self.no_tetgen()
+    }
+
+    /// Fails: no TetGen.
+    pub fn to_file(
+        &self,
+        _: &std::path::Path,
+        _: &tet_core::scene::SceneInfo,
+    ) -> Result<(Written, BuildSummary, MemoryReport)> {
+        self.no_tetgen()
+    }
 }
 
 /// Prints a memory report.
@@ -452,6 +353,22 @@ pub fn print_memory(m: &MemoryReport) {
                 .flatten()
                 .map_or("n/a".into(), |k| format!("{:.1} MiB", k as f64 / 1024.0))
         );
+    }
+    let process = m
+        .process_peak_kib
+        .map_or("n/a".into(), |k| format!("{:.1} MiB", k as f64 / 1024.0));
+    match (
+        m.merge_s,
+        m.merge_max_resident_bytes,
+        m.merge_all_parts_bytes,
+    ) {
+        (Some(s), Some(held), Some(all)) => println!(
+            "  merge: streamed through {:.1} MiB of part files in {s:.2} s, holding at most {:.1} MiB (all parts: {:.1} MiB); this process's peak {process}",
+            mb(m.part_file_bytes.unwrap_or(0)),
+            mb(held),
+            mb(all)
+        ),
+        _ => println!("  merge: {}; this process's peak {process}", m.merge),
     }
 }
 

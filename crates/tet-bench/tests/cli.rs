@@ -264,6 +264,64 @@ fn memory_limit_builds_in_parts_that_trace_like_the_in_core_mesh() {
     assert!((ha - hc).abs() <= 2, "in core {ha} hits, out of core {hc}");
 }
 
+/// Under a limit the parts are streamed through part files by default;
+/// `--merge memory` gives the same mesh (counts) merged in memory;
+/// `--planner` forces the tree or slabs; `--tet20` traces the file written.
+#[test]
+fn memory_limit_streams_by_default_and_the_planner_can_be_chosen() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let predicted = json(&["build", "torus-knot", "--predict-memory"])["predicted_peak_bytes"]
+        .as_u64()
+        .unwrap();
+    let limit = (predicted * 3 / 4).to_string();
+    let build = |out: &str, extra: &[&str]| {
+        let mut args = vec!["build", "torus-knot", "-o", out, "--memory-limit", &limit];
+        args.extend_from_slice(extra);
+        json(&args)
+    };
+    let (streamed, in_memory) = (path("s.tmesh"), path("m.tmesh"));
+    let s = build(&streamed, &["--tet20"]);
+    let m = build(&in_memory, &["--merge", "memory"]);
+    let (sm, mm) = (&s["memory"], &m["memory"]);
+    assert_eq!(sm["merge"], "stream");
+    assert_eq!(mm["merge"], "memory");
+    assert_eq!(sm["planner"], "tree");
+    assert!(sm["parts"].as_u64().unwrap() >= 2, "{sm}");
+    for k in ["points", "tets", "constrained_faces"] {
+        assert_eq!(s[k], m[k], "{k}: streamed and in-memory merges agree");
+    }
+    assert_eq!(
+        s["file_bytes"].as_u64().unwrap(),
+        std::fs::metadata(&streamed).unwrap().len()
+    );
+    let held = sm["merge_max_resident_bytes"].as_u64().unwrap();
+    let all = sm["merge_all_parts_bytes"].as_u64().unwrap();
+    assert!(held > 0 && held < all, "{sm}");
+    assert!(sm["part_file_bytes"].as_u64().unwrap() > 0);
+    assert!(mm["merge_max_resident_bytes"].is_null());
+    assert!(sm["process_peak_kib"].as_u64().is_some_and(|k| k > 0));
+    // The streamed file traces: the camera stored with it, no failures.
+    let t = &s["tet20"];
+    assert!(t["mrays_per_s"].as_f64().unwrap() > 0.0, "{t}");
+    assert_eq!(t["failures"], 0);
+    assert!(m["tet20"].is_null());
+
+    let slabs = build(&path("slabs.tmesh"), &["--planner", "slabs"]);
+    assert_eq!(slabs["memory"]["planner"], "slabs");
+    assert_eq!(slabs["memory"]["merge"], "stream");
+    // Merge and planner only mean something under a limit.
+    let err = stderr_of(&[
+        "build",
+        "torus-knot",
+        "-o",
+        &path("x.tmesh"),
+        "--merge",
+        "memory",
+    ]);
+    assert!(err.contains("--memory-limit"), "{err}");
+}
+
 #[test]
 fn bad_memory_limits_are_explained() {
     let err = stderr_of(&[

@@ -575,11 +575,45 @@ fn memory_limit_is_honoured_by_measured_worker_peaks() {
     check_against_in_core(&scene, &mesh);
 }
 
+/// tet20's speed on `mesh` (640×480 from the scene's camera, or one
+/// framing the mesh from above; best of 3 frames after a warm-up), Mrays/s.
+fn tet20_mrays(mesh: &TetMesh, scene: &Scene) -> f64 {
+    use tet_trace_cpu::render::{RenderOptions, render};
+    let tracer = <tet_trace_cpu::tet20::Tet20Tracer<'_>>::new(mesh).unwrap();
+    let camera = scene.camera.unwrap_or_else(|| {
+        let (lo, hi) = scene.bounds().unwrap();
+        let c = (lo + hi) * 0.5;
+        tet_core::scene::Camera {
+            position: Vec3::new(c.x, c.y, hi.z + (hi - lo).max_element()),
+            target: c,
+            up: Vec3::Y,
+            vfov_deg: 60.0,
+        }
+    });
+    let opts = RenderOptions {
+        width: 640,
+        height: 480,
+        ..RenderOptions::default()
+    };
+    (0..4)
+        .map(|_| {
+            render(&tracer, &camera, &scene.lights, &opts)
+                .unwrap()
+                .stats
+                .mrays_per_s()
+        })
+        .skip(1)
+        .fold(0.0, f64::max)
+}
+
 /// Trade measurement (issue 8 item 5): in-core TetGen vs the out-of-core
 /// builders at 1/2, 1/3 and 1/4 of the in-core measured peak, 2 parts at a
 /// time, on Torus Knots in a Box and on a 125-knot grid: parallel slabs
 /// (`build_with_memory_limit`) and the paper's recursive tree with
-/// perpendicular planes (`build_tree_with_memory_limit`). Run in release:
+/// perpendicular planes (`build_tree_with_memory_limit`), merged in memory
+/// and streamed (`build_tree_with_memory_limit_to_file`), with tet20's
+/// speed on each mesh beside the in-core mesh's (every mesh Hilbert-sorted
+/// as a whole, the streamed one part by part). Run in release:
 /// `cargo test -p tet-build --release --test outofcore -- --ignored --nocapture trade_torus_knots`
 /// (`OOC_TRADE_SCENES=box` or `=grid` runs one scene only).
 #[test]
@@ -626,6 +660,10 @@ fn trade_torus_knots() {
             }
         };
         let in_core_s = t.elapsed().as_secs_f64();
+        let mut reference = reference;
+        tet_core::reorder::hilbert_reorder(&mut reference).unwrap();
+        let in_core_tet20 = tet20_mrays(&reference, scene);
+        println!("    in-core tet20 {in_core_tet20:.2} Mrays/s");
         let tets = reference.tets.len();
         let q = tet_build::quality::mesh_quality(&reference).unwrap();
         println!(
@@ -702,14 +740,38 @@ fn trade_torus_knots() {
                 Err(e) => panic!("{e}"),
             }
             let t = Instant::now();
-            let (mesh, report, plan) =
+            let (mut mesh, report, plan) =
                 build_tree_with_memory_limit(scene, &split, &options).unwrap();
+            let s = t.elapsed().as_secs_f64();
             row(
                 &format!("tree depth {}", plan.plan.depth()),
                 limit,
-                t.elapsed().as_secs_f64(),
+                s,
                 &mesh,
                 &report,
+            );
+            tet_core::reorder::hilbert_reorder(&mut mesh).unwrap();
+            println!(
+                "    tet20 {:.2} Mrays/s (in core {in_core_tet20:.2}), merged in memory",
+                tet20_mrays(&mesh, scene)
+            );
+            drop(mesh);
+            let dir = tempfile::tempdir().unwrap();
+            let stream = StreamOptions::new(dir.path().join("streamed.tmesh"));
+            let t = Instant::now();
+            let (summary, _, _) =
+                build_tree_with_memory_limit_to_file(scene, &split, &options, &stream).unwrap();
+            let s = t.elapsed().as_secs_f64();
+            let streamed = tet_core::format::load(&stream.output).unwrap();
+            println!(
+                "| {} | tree streamed | {:.1} MB | {s:.2} s = {:.2}x | merge {:.2} s holding {:.1} MB of {:.1} MB | tet20 {:.2} Mrays/s (in core {in_core_tet20:.2}) |",
+                scene.name,
+                limit as f64 / 1e6,
+                s / in_core_s,
+                summary.merge_s,
+                summary.max_resident_bytes as f64 / 1e6,
+                summary.all_parts_bytes as f64 / 1e6,
+                tet20_mrays(&streamed, scene),
             );
         }
     }
@@ -913,7 +975,7 @@ fn seam_quality_splits_tets_at_the_seam() {
 
 use tet_build::outofcore::seam::{SeamReport, build_slabs_to_file};
 use tet_build::outofcore::stream::{StreamOptions, StreamSummary};
-use tet_build::outofcore::tree::build_tree_to_file;
+use tet_build::outofcore::tree::{build_tree_to_file, build_tree_with_memory_limit_to_file};
 
 /// Builds `tree` (or the slabs `slabs`) with the in-memory merge and with
 /// the streaming merge: the mesh file is the in-memory mesh (up to order;
