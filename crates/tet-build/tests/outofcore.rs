@@ -815,15 +815,11 @@ fn torus_knot_perpendicular_splits_match_in_core() {
     }
 }
 
-/// A cube cut by perpendicular planes whose intersection lines run along
-/// cube edges (x = 1, z = 1), through cube vertices, through face
-/// diagonals' midpoints (x = 0, y = 0 pierces the top face at its
-/// diagonal's midpoint), with planes lying on cube faces (y = 1, x = 1,
-/// z = 1), and a plane parallel to the root below it in the tree.
-#[test]
-fn cube_cut_along_its_edges_and_through_its_vertices() {
-    let scene = single("cube", tet_build::procedural::cube(1.0));
-    let tree = CutTree::split(
+/// Seven parts of the cube [-1, 1]³: planes along its edges (x = 1 and
+/// z = 1 meet on one), through its vertices, on its faces (y = 1, x = 1,
+/// z = 1) and one parallel to the root below it.
+fn cube_tree() -> CutTree {
+    CutTree::split(
         0,
         0.0,
         CutTree::split(1, 1.0, CutTree::split(2, 0.0, leaf(), leaf()), leaf()),
@@ -833,7 +829,18 @@ fn cube_cut_along_its_edges_and_through_its_vertices() {
             leaf(),
             CutTree::split(0, 1.0, CutTree::split(2, 1.0, leaf(), leaf()), leaf()),
         ),
-    );
+    )
+}
+
+/// A cube cut by perpendicular planes whose intersection lines run along
+/// cube edges (x = 1, z = 1), through cube vertices, through face
+/// diagonals' midpoints (x = 0, y = 0 pierces the top face at its
+/// diagonal's midpoint), with planes lying on cube faces (y = 1, x = 1,
+/// z = 1), and a plane parallel to the root below it in the tree.
+#[test]
+fn cube_cut_along_its_edges_and_through_its_vertices() {
+    let scene = single("cube", tet_build::procedural::cube(1.0));
+    let tree = cube_tree();
     let (mesh, report) = build_tree(&scene, &tree, &SeamOptions::default()).unwrap();
     assert_eq!(report.part_tets.len(), 7);
     assert!(report.triangles_in_plane >= 3, "{report:?}");
@@ -1069,17 +1076,7 @@ fn streamed_merge_keeps_scene_faces_on_cut_planes() {
     let (s, report) = streamed_equals_in_memory(&scene, Err((0, &[-1.0, 0.0, 1.0])), &options);
     assert_eq!(report.triangles_in_plane, 4);
     assert!(s.seam_constrained >= 4, "{s:?}");
-    let tree = CutTree::split(
-        0,
-        0.0,
-        CutTree::split(1, 1.0, CutTree::split(2, 0.0, leaf(), leaf()), leaf()),
-        CutTree::split(
-            1,
-            0.0,
-            leaf(),
-            CutTree::split(0, 1.0, CutTree::split(2, 1.0, leaf(), leaf()), leaf()),
-        ),
-    );
+    let tree = cube_tree();
     let (s, _) = streamed_equals_in_memory(&scene, Ok(&tree), &options);
     assert!(s.seam_constrained >= 3, "{s:?}");
 }

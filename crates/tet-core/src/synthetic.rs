@@ -3,7 +3,7 @@
 //! tets each, with chosen faces marked constrained. Used by the property tests
 //! of every crate, by the fuzzers and by micro-benchmarks.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::mesh::{FACE_VERTICES, TetMesh};
 use crate::predicates::orient3d_f32;
@@ -195,6 +195,37 @@ pub fn kuhn_grid(spec: &GridSpec) -> TetMesh {
     }
     let count = triangles.len() as u32;
     TetMesh::assemble(points, tets, &triangles, count).expect("Kuhn grid is conforming")
+}
+
+/// `mesh` with random attributes: bit 0 of `which` adds per-point normals,
+/// bit 1 texture coordinates, bit 2 per-triangle materials (the mesh
+/// format's flag bits). Values include `-0.0` and subnormal-adjacent
+/// `1e-30`, so bit-exact round trips are tested, not just `==`.
+pub fn with_attributes(mut mesh: TetMesh, which: u8, seed: u64) -> TetMesh {
+    let mut rng = SplitMix64(seed);
+    let n = mesh.points.len();
+    if which & 1 != 0 {
+        mesh.attributes.normals = Some(
+            (0..n)
+                .map(|_| Vec3::new(rng.range_f32(-1.0, 1.0), rng.range_f32(-1.0, 1.0), -0.0))
+                .collect(),
+        );
+    }
+    if which & 2 != 0 {
+        mesh.attributes.uvs = Some(
+            (0..n)
+                .map(|_| Vec2::new(rng.range_f32(0.0, 1.0), 1e-30))
+                .collect(),
+        );
+    }
+    if which & 4 != 0 {
+        mesh.attributes.materials = Some(
+            (0..mesh.triangle_count)
+                .map(|_| rng.next_u64() as u32)
+                .collect(),
+        );
+    }
+    mesh
 }
 
 /// `grid` (a mesh without constrained faces, e.g. an unjittered

@@ -3,41 +3,14 @@
 
 use std::path::Path;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use proptest::prelude::*;
 use tet_core::format::{
     FormatError, HEADER_FIELDS, HEADER_LEN, IN_MEMORY, MAGIC, VERSION, from_bytes, load, save,
     to_bytes,
 };
-use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
+use tet_core::synthetic::{GridSpec, kuhn_grid, with_attributes};
 use tet_core::{MeshError, TetMesh};
-
-fn with_attributes(mut m: TetMesh, which: u8, seed: u64) -> TetMesh {
-    let mut rng = SplitMix64(seed);
-    let n = m.points.len();
-    if which & 1 != 0 {
-        m.attributes.normals = Some(
-            (0..n)
-                .map(|_| Vec3::new(rng.range_f32(-1.0, 1.0), rng.range_f32(-1.0, 1.0), -0.0))
-                .collect(),
-        );
-    }
-    if which & 2 != 0 {
-        m.attributes.uvs = Some(
-            (0..n)
-                .map(|_| Vec2::new(rng.range_f32(0.0, 1.0), 1e-30))
-                .collect(),
-        );
-    }
-    if which & 4 != 0 {
-        m.attributes.materials = Some(
-            (0..m.triangle_count)
-                .map(|_| rng.next_u64() as u32)
-                .collect(),
-        );
-    }
-    m
-}
 
 fn small_mesh() -> TetMesh {
     let m = kuhn_grid(&GridSpec {

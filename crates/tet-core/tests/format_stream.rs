@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use proptest::prelude::*;
 use tet_core::TetMesh;
 use tet_core::format::{
@@ -13,37 +13,18 @@ use tet_core::format::{
     to_bytes, to_bytes_with_scene,
 };
 use tet_core::scene::{Camera, PointLight, SceneInfo};
-use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
+use tet_core::synthetic::{GridSpec, kuhn_grid, with_attributes};
 
 /// A grid mesh with the attributes `which` (bit 0 normals, 1 uvs, 2 materials).
 fn mesh_with(cells: [u32; 3], which: u8, seed: u64) -> TetMesh {
-    let mut m = kuhn_grid(&GridSpec {
+    let m = kuhn_grid(&GridSpec {
         cells,
         jitter: 0.1,
         constrained_fraction: 0.4,
         seed,
         ..Default::default()
     });
-    let mut rng = SplitMix64(seed);
-    let n = m.points.len();
-    if which & 1 != 0 {
-        m.attributes.normals = Some(
-            (0..n)
-                .map(|_| Vec3::new(rng.range_f32(-1.0, 1.0), -0.0, 1.0))
-                .collect(),
-        );
-    }
-    if which & 2 != 0 {
-        m.attributes.uvs = Some(
-            (0..n)
-                .map(|_| Vec2::new(rng.range_f32(0.0, 1.0), 0.5))
-                .collect(),
-        );
-    }
-    if which & 4 != 0 {
-        m.attributes.materials = Some((0..m.triangle_count).map(|i| i * 7).collect());
-    }
-    m
+    with_attributes(m, which, seed)
 }
 
 fn scene() -> SceneInfo {

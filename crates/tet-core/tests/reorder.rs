@@ -7,14 +7,14 @@
 
 use std::collections::HashMap;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use proptest::prelude::*;
 use tet_core::hilbert::Quantizer;
 use tet_core::reorder::{
     apply_constrained_permutation, apply_point_permutation, apply_tet_permutation, hilbert_reorder,
     region_major_reorder, tet_keys,
 };
-use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
+use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid, with_attributes};
 use tet_core::{FaceSide, LinkKind, TetMesh};
 
 type P = [u32; 3];
@@ -100,33 +100,6 @@ fn assert_same_geometry(before: &TetMesh, after: &TetMesh) {
     );
     assert_eq!(before.triangle_count, after.triangle_count);
     assert_eq!(before.attributes.materials, after.attributes.materials);
-}
-
-fn with_attributes(mut m: TetMesh, which: u8, seed: u64) -> TetMesh {
-    let mut rng = SplitMix64(seed);
-    let n = m.points.len();
-    if which & 1 != 0 {
-        m.attributes.normals = Some(
-            (0..n)
-                .map(|_| Vec3::new(rng.range_f32(-1.0, 1.0), rng.range_f32(-1.0, 1.0), 1.0))
-                .collect(),
-        );
-    }
-    if which & 2 != 0 {
-        m.attributes.uvs = Some(
-            (0..n)
-                .map(|_| Vec2::new(rng.range_f32(0.0, 1.0), 0.5))
-                .collect(),
-        );
-    }
-    if which & 4 != 0 {
-        m.attributes.materials = Some(
-            (0..m.triangle_count)
-                .map(|_| (rng.next_u64() % 5) as u32)
-                .collect(),
-        );
-    }
-    m
 }
 
 prop_compose! {

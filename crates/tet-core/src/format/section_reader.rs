@@ -126,17 +126,22 @@ impl SectionReader {
             });
         }
         let mut v = vec![T::zeroed(); (range.end - range.start) as usize];
-        let at = offset + range.start * ELEMENT_BYTES[i];
-        let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut v);
+        self.read_at(offset + range.start * ELEMENT_BYTES[i], &mut v)?;
+        Ok(v)
+    }
+
+    /// Fills `v` from the 4-byte little-endian words at byte `offset`.
+    fn read_at<T: Pod>(&mut self, offset: u64, v: &mut [T]) -> Result<(), FormatError> {
+        let bytes: &mut [u8] = bytemuck::cast_slice_mut(v);
         let r = self
             .file
-            .seek(SeekFrom::Start(at))
+            .seek(SeekFrom::Start(offset))
             .and_then(|_| self.file.read_exact(bytes));
         if let Err(e) = r {
             return Err(self.io(e));
         }
         from_le_words(bytes);
-        Ok(v)
+        Ok(())
     }
 
     /// Points `range`.
@@ -186,15 +191,7 @@ impl SectionReader {
         }
         let (offset, length) = self.header.scene;
         let mut records = vec![[0u32; 12]; (length / super::SCENE_RECORD_BYTES) as usize];
-        let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut records);
-        let r = self
-            .file
-            .seek(SeekFrom::Start(offset))
-            .and_then(|_| self.file.read_exact(bytes));
-        if let Err(e) = r {
-            return Err(self.io(e));
-        }
-        from_le_words(bytes);
+        self.read_at(offset, &mut records)?;
         decode_scene(&records, &self.path)
     }
 
