@@ -162,6 +162,18 @@ impl Tracer for EmbreeTracer<'_> {
         self.mesh
     }
 
+    /// Every ray is traced from its origin, whatever the tet mesh's
+    /// boundary: a camera outside the mesh needs no entry face (the start
+    /// is ignored, like every `Start::Tet`).
+    fn start_outside(
+        &self,
+        _entry: &tet_trace_cpu::entry::BoundaryEntry,
+        _ray: &Ray,
+        _hint: &mut tet_trace_cpu::entry::EntryHint,
+    ) -> Result<Start, TraceOutcome> {
+        Ok(Start::Tet(0))
+    }
+
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
         let skip = start.on_face().unwrap_or(u32::MAX);
         if !ray.is_valid() {
@@ -173,6 +185,24 @@ impl Tracer for EmbreeTracer<'_> {
         self.trace_one(ray, skip)
     }
 
+    /// Packets also for rays from a viewpoint outside the tet mesh (their
+    /// starts are ignored).
+    fn trace_batch_from(
+        &self,
+        rays: &[Ray],
+        starts: tet_trace_cpu::Starts<'_>,
+        out: &mut [TraceOutcome],
+    ) {
+        match starts {
+            tet_trace_cpu::Starts::Outside(_) => self.trace_batch(rays, Start::Tet(0), out),
+            tet_trace_cpu::Starts::Same(s) => self.trace_batch(rays, s, out),
+            tet_trace_cpu::Starts::Each(s) => {
+                for ((r, s), o) in rays.iter().zip(s).zip(out.iter_mut()) {
+                    *o = self.trace(r, *s);
+                }
+            }
+        }
+    }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
         if !self.packets || matches!(start, Start::Face { .. }) {
             for (r, o) in rays.iter().zip(out.iter_mut()) {

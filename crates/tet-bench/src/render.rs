@@ -5,7 +5,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use tet_trace_cpu::kernel::Tracer;
-use tet_trace_cpu::render::{Frame, FrameStats, RenderOptions, render};
+use tet_trace_cpu::render::{Frame, FrameStats, RenderOptions, render, render_into};
 
 use crate::cli::{Method, RenderArgs};
 use crate::load::{Loaded, load, require_tets};
@@ -110,8 +110,9 @@ pub fn time_method(
     let run = || render(t.as_ref(), &loaded.camera, &loaded.lights, opts);
     let mut frame = pool.install(run).context("render failed")?;
     let mut stats: Vec<FrameStats> = Vec::new();
+    // Timed frames reuse the warm-up frame's buffers.
     for _ in 0..frames.max(1) {
-        frame = pool.install(run)?;
+        pool.install(|| render_into(t.as_ref(), &loaded.camera, &loaded.lights, opts, &mut frame))?;
         stats.push(frame.stats);
     }
     let mut nodes_per_ray = None;

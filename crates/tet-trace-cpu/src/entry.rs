@@ -49,7 +49,7 @@ use thiserror::Error;
 use crate::kernel::Tracer;
 use crate::locate::{LocateError, locate};
 use crate::ray::{Ray, TraceOutcome};
-use crate::walk::{DuffF32, Projection, Resolved, Start, resolve_constrained};
+use crate::walk::{DuffF32, Projection, Resolved, Start, Starts, resolve_constrained};
 
 /// Why rays could not be started from a viewpoint.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -88,7 +88,7 @@ struct EntryFace {
 /// The boundary face a previous ray entered through (coherent rays share
 /// it, so it is tested first).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct EntryHint(usize);
+pub struct EntryHint(pub(crate) usize);
 
 /// The boundary faces of a convex mesh, for rays that start outside it.
 #[derive(Clone, Debug)]
@@ -196,8 +196,23 @@ impl BoundaryEntry {
         ray: &Ray,
         hint: &mut EntryHint,
     ) -> Result<Start, TraceOutcome> {
+        if !ray.is_valid() {
+            return Err(miss_outside(ray));
+        }
+        self.start_projected(mesh, ray, &P::setup(ray), hint)
+    }
+
+    /// [`BoundaryEntry::start_with`] for a valid ray whose projection is set
+    /// up (the walk's own, reused).
+    pub(crate) fn start_projected<P: Projection>(
+        &self,
+        mesh: &TetMesh,
+        ray: &Ray,
+        proj: &P,
+        hint: &mut EntryHint,
+    ) -> Result<Start, TraceOutcome> {
         let f = self
-            .entered::<P>(mesh, ray, hint)
+            .entered(mesh, ray, proj, hint)
             .ok_or_else(|| miss_outside(ray))?;
         let Some(c) = f.link.as_constrained() else {
             return Ok(Start::Entry {
@@ -216,12 +231,12 @@ impl BoundaryEntry {
         &self,
         mesh: &TetMesh,
         ray: &Ray,
+        proj: &P,
         hint: &mut EntryHint,
     ) -> Option<EntryFace> {
-        if !ray.is_valid() || self.misses_bounds(ray) {
+        if self.misses_bounds(ray) {
             return None;
         }
-        let proj = P::setup(ray);
         let faced = self.seen_from == Some(ray.origin);
         let enters = |f: &EntryFace| {
             let p = f.ids.map(|i| proj.project(mesh.points[i as usize]));
@@ -351,34 +366,14 @@ impl Viewpoint {
     ) {
         match self {
             Viewpoint::Inside(t) => tracer.trace_batch(rays, Start::Tet(*t), out),
-            Viewpoint::Outside(entry) => {
-                let mut hint = EntryHint::default();
-                let mut kept = Vec::with_capacity(rays.len());
-                let mut starts = Vec::with_capacity(rays.len());
-                let mut index = Vec::with_capacity(rays.len());
-                for (i, (r, o)) in rays.iter().zip(out.iter_mut()).enumerate() {
-                    match tracer.start_outside(entry, r, &mut hint) {
-                        Ok(s) => {
-                            kept.push(*r);
-                            starts.push(s);
-                            index.push(i);
-                        }
-                        Err(done) => *o = done,
-                    }
-                }
-                let mut traced = vec![TraceOutcome::Miss { tets_visited: 0 }; kept.len()];
-                tracer.trace_batch_each(&kept, &starts, &mut traced);
-                for (i, o) in index.into_iter().zip(traced) {
-                    out[i] = o;
-                }
-            }
+            Viewpoint::Outside(entry) => tracer.trace_batch_from(rays, Starts::Outside(entry), out),
         }
     }
 }
 
 /// The outcome of a ray that never enters the mesh: a miss, or the walk's
 /// failure for an invalid ray.
-fn miss_outside(ray: &Ray) -> TraceOutcome {
+pub(crate) fn miss_outside(ray: &Ray) -> TraceOutcome {
     if ray.is_valid() {
         TraceOutcome::Miss { tets_visited: 0 }
     } else {

@@ -34,13 +34,23 @@ pub trait Tracer: Sync {
         }
     }
 
-    /// Traces many rays, ray `i` from `starts[i]`, into `out` (all three of
-    /// the same length), e.g. the primary rays of a tile entering the mesh
-    /// from a viewpoint outside it ([`crate::entry`]). Kernels may
-    /// interleave walks; the results equal [`Tracer::trace`] ray by ray.
-    fn trace_batch_each(&self, rays: &[Ray], starts: &[Start], out: &mut [TraceOutcome]) {
-        for ((r, s), o) in rays.iter().zip(starts).zip(out.iter_mut()) {
-            *o = self.trace(r, *s);
+    /// Traces many rays into `out` (same length) from `starts`: one start
+    /// for all, one per ray, or each ray's entry into the mesh from outside
+    /// ([`Starts::Outside`], [`crate::entry`]; the entry decided by
+    /// [`Tracer::start_outside`]). Kernels may interleave walks; the results
+    /// equal [`Tracer::trace`] ray by ray.
+    fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
+        let mut hint = EntryHint::default();
+        for (i, (r, o)) in rays.iter().zip(out.iter_mut()).enumerate() {
+            let start = match starts {
+                Starts::Same(s) => Ok(s),
+                Starts::Each(s) => Ok(s[i]),
+                Starts::Outside(entry) => self.start_outside(entry, r, &mut hint),
+            };
+            *o = match start {
+                Ok(s) => self.trace(r, s),
+                Err(done) => done,
+            };
         }
     }
 
@@ -134,16 +144,18 @@ impl<L: Topology, P: Projection> Tracer for WalkTracer<'_, L, P> {
             out,
         )
     }
-    fn trace_batch_each(&self, rays: &[Ray], starts: &[Start], out: &mut [TraceOutcome]) {
-        let n = rays.len().min(starts.len()).min(out.len());
-        let (rays, starts, out) = (&rays[..n], &starts[..n], &mut out[..n]);
+    fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
+        let mut n = rays.len().min(out.len());
+        if let Starts::Each(s) = starts {
+            n = n.min(s.len());
+        }
         P::trace_batch(
             self.mesh,
             &self.layout,
-            rays,
-            Starts::Each(starts),
+            &rays[..n],
+            starts,
             self.cap,
-            out,
+            &mut out[..n],
         )
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {

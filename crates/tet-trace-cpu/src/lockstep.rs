@@ -84,7 +84,9 @@ use glam::{Vec2, Vec3};
 use tet_core::{Link, TetMesh};
 
 use crate::ray::{Ray, TraceOutcome};
-use crate::walk::{Advance, DuffF32, Face2, Lane, Starts, State, Topology, finish_step, next_lane};
+use crate::walk::{
+    Advance, DuffF32, Face2, Lane, Queue, Starts, State, Topology, finish_step, next_lane,
+};
 
 /// Lanes of the AVX2 lockstep walk (256-bit vectors of f32 / u32).
 pub const WIDE: usize = 8;
@@ -381,7 +383,7 @@ fn run<T: Topology, const W: usize>(
 ) {
     let n = rays.len().min(out.len());
     let (rays, out) = (&rays[..n], &mut out[..n]);
-    let mut queued = 0;
+    let mut queued = Queue::default();
     let (mut pk, mut live) = fill::<W>(mesh, rays, start, &mut queued, out);
     // A walk started only if the mesh has points and tets (its start tet
     // and vertices exist), so the loads of `step` have something to clamp to.
@@ -404,7 +406,7 @@ fn fill<const W: usize>(
     mesh: &TetMesh,
     rays: &[Ray],
     start: Starts<'_>,
-    queued: &mut usize,
+    queued: &mut Queue,
     out: &mut [TraceOutcome],
 ) -> (Pack<W>, usize) {
     let mut pk = Pack::<W> {
@@ -567,7 +569,7 @@ fn lane_events<const W: usize>(
     mesh: &TetMesh,
     rays: &[Ray],
     start: Starts<'_>,
-    queued: &mut usize,
+    queued: &mut Queue,
     out: &mut [TraceOutcome],
     pk: &mut Pack<W>,
     events: u32,
@@ -907,7 +909,7 @@ mod avx2 {
             ids: ids as i32,
             links: links as i32,
         };
-        let mut queued = 0;
+        let mut queued = Queue::default();
         // `GROUPS` independent packs of 8 lanes, stepped in turn: the
         // out-of-order core overlaps their dependent gather chains.
         let mut pks: [(Pack<8>, usize); GROUPS] =
@@ -984,19 +986,119 @@ mod avx512 {
             }
         }
 
-        /// Writes the hot fields back (lane bookkeeping stays in `pk`).
-        fn store(&self, pk: &mut Pack<16>) {
-            let f = |a: __m512| bytemuck::cast::<__m512, [f32; 16]>(a);
-            let u = |a: __m512i| bytemuck::cast::<__m512i, [u32; 16]>(a);
-            pk.o = self.o.map(f);
-            pk.c = self.c.map(|a| a.map(f));
-            pk.ids = self.ids.map(u);
-            pk.xs = self.xs.map(f);
-            pk.ys = self.ys.map(f);
-            pk.next = u(self.next);
-            pk.entry = u(self.entry);
-            pk.visited = u(self.visited);
+        /// Lane `l` as a scalar lane; `tet` and `link` as the scalar
+        /// `advance` leaves them for `finish_step` (see [`Pack::get`]).
+        fn lane(&self, l: usize, link: u32) -> Lane<DuffF32> {
+            let f = |x: __m512| bytemuck::cast::<__m512, [f32; 16]>(x)[l];
+            let u = |x: __m512i| bytemuck::cast::<__m512i, [u32; 16]>(x)[l];
+            let col = |a: usize| glam::Vec4::new(f(self.c[a][0]), f(self.c[a][1]), 0.0, 0.0);
+            let pt = |k: usize| Vec2::new(f(self.xs[k]), f(self.ys[k]));
+            let next = u(self.next);
+            Lane {
+                proj: DuffF32 {
+                    o: Vec3::new(f(self.o[0]), f(self.o[1]), f(self.o[2])),
+                    cx: col(0),
+                    cy: col(1),
+                    cz: col(2),
+                },
+                st: State {
+                    tet: next,
+                    ids: [u(self.ids[0]), u(self.ids[1]), u(self.ids[2])],
+                    p: Face2::new([pt(0), pt(1), pt(2)]),
+                    link,
+                    visited: u(self.visited),
+                },
+                next,
+                entry_raw: u(self.entry),
+            }
         }
+
+        /// Loads scalar lane `lane` into lane `l` (masked broadcasts: the
+        /// other lanes stay in their registers).
+        #[target_feature(enable = "avx512f")]
+        fn put(&mut self, l: usize, lane: &Lane<DuffF32>) {
+            let k: __mmask16 = 1 << l;
+            let f = |x: &mut __m512, v: f32| *x = _mm512_mask_mov_ps(*x, k, _mm512_set1_ps(v));
+            let u = |x: &mut __m512i, v: u32| *x = _mm512_mask_set1_epi32(*x, k, v as i32);
+            let p = lane.proj;
+            f(&mut self.o[0], p.o.x);
+            f(&mut self.o[1], p.o.y);
+            f(&mut self.o[2], p.o.z);
+            for (a, col) in [p.cx, p.cy, p.cz].iter().enumerate() {
+                f(&mut self.c[a][0], col.x);
+                f(&mut self.c[a][1], col.y);
+            }
+            for s in 0..3 {
+                u(&mut self.ids[s], lane.st.ids[s]);
+                f(&mut self.xs[s], lane.st.p.xs[s]);
+                f(&mut self.ys[s], lane.st.p.ys[s]);
+            }
+            u(&mut self.next, lane.next);
+            u(&mut self.entry, lane.entry_raw);
+            u(&mut self.visited, lane.st.visited);
+            self.live |= k;
+        }
+
+        /// Parks lane `l` (see [`Pack::park`]).
+        #[target_feature(enable = "avx512f")]
+        fn park(&mut self, l: usize) {
+            let k: __mmask16 = 1 << l;
+            self.live &= !k;
+            self.next = _mm512_mask_set1_epi32(self.next, k, 0);
+        }
+    }
+
+    /// The cold part of a round in registers (see [`super::lane_events`]):
+    /// only the lanes with an event are read and rewritten. Returns the
+    /// number of lanes parked.
+    #[cold]
+    #[inline(never)]
+    #[target_feature(enable = "avx512f")]
+    // Lane `l` indexes the round's flags, the ray slots and the registers.
+    #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
+    fn events16(
+        mesh: &TetMesh,
+        rays: &[Ray],
+        start: Starts<'_>,
+        queued: &mut Queue,
+        out: &mut [TraceOutcome],
+        v: &mut V16,
+        ray: &mut [usize; 16],
+        events: u32,
+        round: &Round<16>,
+    ) -> usize {
+        let mut parked = 0;
+        for l in 0..16 {
+            if events >> l & 1 == 0 {
+                continue;
+            }
+            let adv = if round.capped[l] {
+                Advance::Cap
+            } else if round.lost[l] {
+                Advance::Lost
+            } else {
+                Advance::Face
+            };
+            let i = ray[l];
+            let mut lane = v.lane(l, round.raw[l]);
+            match finish_step(mesh, &rays[i], &mut lane, adv) {
+                None => v.put(l, &lane),
+                Some(o) => {
+                    out[i] = o;
+                    match next_lane::<DuffF32>(mesh, rays, start, queued, out) {
+                        Some((j, lane)) => {
+                            v.put(l, &lane);
+                            ray[l] = j;
+                        }
+                        None => {
+                            v.park(l);
+                            parked += 1;
+                        }
+                    }
+                }
+            }
+        }
+        parked
     }
 
     /// Array bases and bounds of the gathers (as [`avx2`]'s).
@@ -1223,21 +1325,22 @@ mod avx512 {
             ids: ids as i32,
             links: links as i32,
         };
-        let mut queued = 0;
-        let mut pks: [(Pack<16>, usize); GROUPS] =
-            std::array::from_fn(|_| fill::<16>(mesh, rays, start, &mut queued, out));
-        let mut vs: [V16; GROUPS] = std::array::from_fn(|k| V16::load(&pks[k].0));
+        let mut queued = Queue::default();
+        // The packs live in registers; a lane's ray index is the only cold
+        // state (its projection is rebuilt from the registers).
+        let mut groups: [(V16, [usize; 16], usize); GROUPS] = std::array::from_fn(|_| {
+            let (pk, live) = fill::<16>(mesh, rays, start, &mut queued, out);
+            (V16::load(&pk), pk.ray, live)
+        });
         loop {
             let mut any = false;
-            for (v, (pk, live)) in vs.iter_mut().zip(pks.iter_mut()) {
+            for (v, ray, live) in groups.iter_mut() {
                 if *live == 0 {
                     continue;
                 }
                 any = true;
                 if let Some((events, round)) = step::<RULE>(v, &g, cap) {
-                    v.store(pk);
-                    *live -= lane_events(mesh, rays, start, &mut queued, out, pk, events, &round);
-                    *v = V16::load(pk);
+                    *live -= events16(mesh, rays, start, &mut queued, out, v, ray, events, &round);
                 }
             }
             if !any {

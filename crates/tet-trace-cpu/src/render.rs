@@ -308,6 +308,45 @@ pub fn render_scene_with<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
     lights: &Lights<'_>,
     opts: &RenderOptions,
 ) -> Result<Frame, RenderError> {
+    let mut frame = Frame {
+        width: 0,
+        height: 0,
+        color: Vec::new(),
+        tets: Vec::new(),
+        triangle: Vec::new(),
+        stats: FrameStats::default(),
+    };
+    render_scene_into(tracer, shadow, camera, lights, opts, &mut frame)?;
+    Ok(frame)
+}
+
+/// [`render`] into `frame`, whose buffers are reused when they already
+/// have the image's size: a sequence of frames (a benchmark, an animation)
+/// then spends its time tracing and shading, not having the system zero
+/// fresh pages for every frame (10 % of a 1920×1440 Torus Knots frame).
+pub fn render_into<T: Tracer + ?Sized>(
+    tracer: &T,
+    camera: &Camera,
+    lights: &[PointLight],
+    opts: &RenderOptions,
+    frame: &mut Frame,
+) -> Result<(), RenderError> {
+    let lights = Lights {
+        points: lights,
+        areas: &[],
+    };
+    render_scene_into(tracer, &OwnShadows(tracer), camera, &lights, opts, frame)
+}
+
+/// [`render_scene_with`] into `frame` (see [`render_into`]).
+pub fn render_scene_into<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
+    tracer: &T,
+    shadow: &S,
+    camera: &Camera,
+    lights: &Lights<'_>,
+    opts: &RenderOptions,
+    frame: &mut Frame,
+) -> Result<(), RenderError> {
     let (w, h) = (opts.width, opts.height);
     if w == 0 || h == 0 {
         return Err(RenderError::EmptyImage {
@@ -349,14 +388,15 @@ pub fn render_scene_with<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
     };
     let cam = PinholeCamera::new(camera, w, h, opts.pixel_centers);
     let n = (w * h) as usize;
-    let mut frame = Frame {
-        width: w,
-        height: h,
-        color: vec![Vec3::ZERO; n],
-        tets: vec![0; n],
-        triangle: vec![u32::MAX; n],
-        stats: FrameStats::default(),
-    };
+    // Every pixel is written below: buffers of the right size are reused
+    // as they are.
+    if frame.color.len() != n || frame.tets.len() != n || frame.triangle.len() != n {
+        frame.color = vec![Vec3::ZERO; n];
+        frame.tets = vec![0; n];
+        frame.triangle = vec![u32::MAX; n];
+    }
+    frame.width = w;
+    frame.height = h;
     // One task per band of TILE rows: its tiles are traced in turn and
     // shaded straight into the band's rows of the frame (contiguous), so no
     // per-pixel record is collected and copied afterwards.
@@ -413,7 +453,7 @@ pub fn render_scene_with<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
         });
     frame.stats = stats;
     frame.stats.ms = t0.elapsed().as_secs_f64() * 1e3;
-    Ok(frame)
+    Ok(())
 }
 
 /// Per-pixel seed of the area-light jitter: the frame seed mixed with the

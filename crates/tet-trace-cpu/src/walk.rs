@@ -82,6 +82,7 @@
 use glam::{DVec2, DVec3, Vec2, Vec3, Vec4};
 use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
 
+use crate::entry::{BoundaryEntry, EntryHint};
 use crate::locate::star;
 use crate::ray::{DEFAULT_STEP_CAP, Failure, Hit, Ray, TraceOutcome};
 
@@ -548,24 +549,18 @@ impl Start {
 }
 
 /// The starts of a batch of rays: one for all (primary rays from a viewpoint
-/// inside the mesh) or one per ray.
+/// inside the mesh), one per ray, or each ray's entry into the mesh from
+/// outside.
 #[derive(Clone, Copy, Debug)]
 pub enum Starts<'a> {
     /// Every ray starts from this.
     Same(Start),
     /// Ray `i` starts from element `i` (same length as the rays).
     Each(&'a [Start]),
-}
-
-impl Starts<'_> {
-    /// The start of ray `i`.
-    #[inline(always)]
-    pub fn of(&self, i: usize) -> Start {
-        match self {
-            Starts::Same(s) => *s,
-            Starts::Each(s) => s[i],
-        }
-    }
+    /// Every ray's origin lies outside the mesh: each enters through the
+    /// boundary face its line crosses, decided with the walk's own
+    /// projection ([`BoundaryEntry::start_with`]).
+    Outside(&'a BoundaryEntry),
 }
 
 /// Which slot of the counter-clockwise entry face `(a, b, c)` the new vertex
@@ -748,7 +743,7 @@ pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
     let n = rays.len().min(out.len());
     let (rays, out) = (&rays[..n], &mut out[..n]);
     let points = &mesh.points[..];
-    let mut queued = 0;
+    let mut queued = Queue::default();
     // Lanes in flight, each with its ray index; a finished lane is replaced
     // in place by the next ray, or removed when none is left.
     let mut lanes: Vec<(usize, Lane<P>)> = Vec::with_capacity(K);
@@ -782,7 +777,7 @@ fn lane_event<P: Projection>(
     mesh: &TetMesh,
     rays: &[Ray],
     start: Starts<'_>,
-    queued: &mut usize,
+    queued: &mut Queue,
     out: &mut [TraceOutcome],
     lanes: &mut Vec<(usize, Lane<P>)>,
     j: usize,
@@ -806,24 +801,58 @@ fn lane_event<P: Projection>(
     }
 }
 
-/// Starts the next queued ray that does not end in its start tet (those are
+/// The rays of a batch not started yet: the next one, and the boundary
+/// face the last ray from outside entered through (tested first for the
+/// next, see [`crate::entry`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Queue {
+    next: usize,
+    hint: EntryHint,
+}
+
+/// Starts the next queued ray that does not end before its walk (those are
 /// written to `out` directly).
 pub(crate) fn next_lane<P: Projection>(
     mesh: &TetMesh,
     rays: &[Ray],
     start: Starts<'_>,
-    queued: &mut usize,
+    queue: &mut Queue,
     out: &mut [TraceOutcome],
 ) -> Option<(usize, Lane<P>)> {
-    while *queued < rays.len() {
-        let i = *queued;
-        *queued += 1;
-        match begin::<P>(mesh, &rays[i], start.of(i)) {
+    while queue.next < rays.len() {
+        let i = queue.next;
+        queue.next += 1;
+        let ray = &rays[i];
+        let lane = match start {
+            Starts::Same(s) => begin::<P>(mesh, ray, s),
+            Starts::Each(s) => begin::<P>(mesh, ray, s[i]),
+            Starts::Outside(entry) => begin_outside::<P>(mesh, ray, entry, &mut queue.hint),
+        };
+        match lane {
             Ok(l) => return Some((i, l)),
             Err(o) => out[i] = o,
         }
     }
     None
+}
+
+/// [`begin`] for a ray from outside the mesh: its entry is decided with the
+/// projection the walk then uses (set up once).
+fn begin_outside<P: Projection>(
+    mesh: &TetMesh,
+    ray: &Ray,
+    entry: &BoundaryEntry,
+    hint: &mut EntryHint,
+) -> Result<Lane<P>, TraceOutcome> {
+    if !ray.is_valid() {
+        return Err(TraceOutcome::Failed {
+            failure: Failure::InvalidRay,
+            tets_visited: 0,
+        });
+    }
+    let proj = P::setup(ray);
+    let start = entry.start_projected(mesh, ray, &proj, hint)?;
+    begin_with(mesh, ray, proj, start)
 }
 
 /// Everything before the hot loop: ray checks, projection set-up, the start
@@ -837,7 +866,16 @@ fn begin<P: Projection>(mesh: &TetMesh, ray: &Ray, start: Start) -> Result<Lane<
             tets_visited: 0,
         });
     }
-    let proj = P::setup(ray);
+    begin_with(mesh, ray, P::setup(ray), start)
+}
+
+/// [`begin`] of a valid ray whose projection `proj` is set up.
+fn begin_with<P: Projection>(
+    mesh: &TetMesh,
+    ray: &Ray,
+    proj: P,
+    start: Start,
+) -> Result<Lane<P>, TraceOutcome> {
     let st: State<P> = match start {
         Start::Tet(t) => {
             if t as usize >= mesh.tets.len() {

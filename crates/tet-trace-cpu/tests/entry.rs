@@ -14,7 +14,7 @@ use tet_trace_cpu::tet16::{Tet16Tracer, Tet16TracerF64};
 use tet_trace_cpu::tet20::{Tet20Tracer, Tet20TracerF64};
 use tet_trace_cpu::tet32::Tet32Tracer;
 use tet_trace_cpu::tet80::Tet80Tracer;
-use tet_trace_cpu::{DuffF32, Failure, Ray, Start, TraceOutcome, Tracer};
+use tet_trace_cpu::{DuffF32, Failure, Ray, Start, Starts, TraceOutcome, Tracer};
 
 mod common;
 use common::grid;
@@ -306,7 +306,7 @@ fn batches_from_outside_equal_single_rays() {
             }
         }
         let mut got = vec![TraceOutcome::Miss { tets_visited: 0 }; mixed.len()];
-        t.trace_batch_each(&mixed, &starts, &mut got);
+        t.trace_batch_from(&mixed, Starts::Each(&starts), &mut got);
         for ((r, s), o) in mixed.iter().zip(&starts).zip(&got) {
             assert_eq!(*o, t.trace(r, *s), "{} from {s:?}", t.name());
         }
