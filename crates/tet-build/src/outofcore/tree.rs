@@ -994,6 +994,10 @@ fn build_tree_with<M: Merge>(
         }
         parts.push(facets);
     }
+    // The clipping (pieces, walls, registries) and the cleaned scene are
+    // not needed while the parts run: every part's PLC is in `parts`.
+    drop(cut);
+    drop(cleaned);
     let inputs = PartInputs {
         faces: vec![Vec::new(); parts.len()],
         parts,
@@ -1096,6 +1100,7 @@ fn build_tree_with_memory_limit_with<M: Merge>(
         });
     }
     let mut tree = CutTree::from_split_tree(&plan);
+    drop(cleaned);
     let mut moves = 0;
     loop {
         match build_tree_with(scene, &tree, options, merge) {
