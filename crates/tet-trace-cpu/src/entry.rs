@@ -234,9 +234,6 @@ impl BoundaryEntry {
         proj: &P,
         hint: &mut EntryHint,
     ) -> Option<EntryFace> {
-        if self.misses_bounds(ray) {
-            return None;
-        }
         let faced = self.seen_from == Some(ray.origin);
         let enters = |f: &EntryFace| {
             let p = f.ids.map(|i| proj.project(mesh.points[i as usize]));
@@ -247,7 +244,15 @@ impl BoundaryEntry {
         };
         let n = self.faces.len();
         let first = hint.0.min(n.saturating_sub(1));
-        let k = (0..n)
+        // The previous ray's face first: coherent rays nearly always share
+        // it, and then need no bounds test.
+        if n > 0 && enters(&self.faces[first]) {
+            return Some(self.faces[first]);
+        }
+        if self.misses_bounds(ray) {
+            return None;
+        }
+        let k = (1..n)
             .map(|i| (first + i) % n)
             .find(|&k| enters(&self.faces[k]))?;
         hint.0 = k;
@@ -270,7 +275,8 @@ impl BoundaryEntry {
                 }
                 continue;
             }
-            let (u, v) = ((lo[a] - o[a]) / d[a], (hi[a] - o[a]) / d[a]);
+            let inv = 1.0 / d[a];
+            let (u, v) = ((lo[a] - o[a]) * inv, (hi[a] - o[a]) * inv);
             t0 = t0.max(u.min(v));
             t1 = t1.min(u.max(v));
         }

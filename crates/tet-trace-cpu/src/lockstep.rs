@@ -988,9 +988,14 @@ mod avx512 {
 
         /// Lane `l` as a scalar lane; `tet` and `link` as the scalar
         /// `advance` leaves them for `finish_step` (see [`Pack::get`]).
+        #[target_feature(enable = "avx512f")]
         fn lane(&self, l: usize, link: u32) -> Lane<DuffF32> {
-            let f = |x: __m512| bytemuck::cast::<__m512, [f32; 16]>(x)[l];
-            let u = |x: __m512i| bytemuck::cast::<__m512i, [u32; 16]>(x)[l];
+            // One permute per field brings lane `l` to element 0.
+            let at = _mm512_set1_epi32(l as i32);
+            let f = |x: __m512| _mm512_cvtss_f32(_mm512_permutexvar_ps(at, x));
+            let u = |x: __m512i| {
+                _mm_cvtsi128_si32(_mm512_castsi512_si128(_mm512_permutexvar_epi32(at, x))) as u32
+            };
             let col = |a: usize| glam::Vec4::new(f(self.c[a][0]), f(self.c[a][1]), 0.0, 0.0);
             let pt = |k: usize| Vec2::new(f(self.xs[k]), f(self.ys[k]));
             let next = u(self.next);
