@@ -20,16 +20,8 @@ impl Tracer for BruteTracer<'_> {
     fn mesh(&self) -> &TetMesh {
         self.mesh
     }
-    /// Every ray is traced from its origin, whatever the tet mesh's
-    /// boundary: a camera outside the mesh needs no entry face (the start
-    /// is ignored, like every `Start::Tet`).
-    fn start_outside(
-        &self,
-        _entry: &tet_trace_cpu::entry::BoundaryEntry,
-        _ray: &Ray,
-        _hint: &mut tet_trace_cpu::entry::EntryHint,
-    ) -> Result<Start, TraceOutcome> {
-        Ok(Start::Tet(0))
+    fn walks_tets(&self) -> bool {
+        false
     }
 
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {

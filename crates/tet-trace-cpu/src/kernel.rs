@@ -65,7 +65,18 @@ pub trait Tracer: Sync {
         ray: &Ray,
         hint: &mut EntryHint,
     ) -> Result<Start, TraceOutcome> {
+        if !self.walks_tets() {
+            // Traced from its origin; `Start::Tet` is ignored.
+            return Ok(Start::Tet(0));
+        }
         entry.start_with::<crate::DuffF32>(self.mesh(), ray, hint)
+    }
+
+    /// False for a tracer that does not walk the tets (a BVH, a brute
+    /// force): it traces every ray from its origin, so a ray from outside
+    /// the mesh needs no entry face ([`Tracer::start_outside`]).
+    fn walks_tets(&self) -> bool {
+        true
     }
 
     /// A shadow ray: [`Tracer::trace`], except that a tet walk reports

@@ -607,6 +607,45 @@ fn lane_events<const W: usize>(
     parked
 }
 
+/// Array bases and bounds of the gathers of the AVX2 and AVX-512 walks.
+#[cfg(target_arch = "x86_64")]
+struct Geo<'a> {
+    points: &'a [Vec3],
+    words: &'a [u32],
+    last_point: i32,
+    last_tet: i32,
+    stride: i32,
+    vx: i32,
+    ids: i32,
+    links: i32,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<'a> Geo<'a> {
+    /// The gathers' view of `mesh` and its records `rw`, which must be
+    /// [`RecordWords::gatherable`] (checked: the gathers' bounds rest on it).
+    fn new(mesh: &'a TetMesh, rw: &RecordWords<'a>) -> Geo<'a> {
+        assert!(
+            rw.gatherable(mesh.points.len()),
+            "record words not gatherable"
+        );
+        let (ids, links) = match rw.rule {
+            ExitRule::Rank { links } | ExitRule::RankXor { links } => (0, links),
+            ExitRule::Slot { ids, links } => (ids, links),
+        };
+        Geo {
+            points: &mesh.points,
+            words: rw.words,
+            last_point: (mesh.points.len() - 1) as i32,
+            last_tet: (rw.words.len() / rw.stride - 1) as i32,
+            stride: rw.stride as i32,
+            vx: rw.vx as i32,
+            ids: ids as i32,
+            links: links as i32,
+        }
+    }
+}
+
 #[cfg(target_arch = "x86_64")]
 const RANK: u8 = 0;
 #[cfg(target_arch = "x86_64")]
@@ -667,18 +706,6 @@ mod avx2 {
             pk.entry = u(self.entry);
             pk.visited = u(self.visited);
         }
-    }
-
-    /// Array bases and bounds of the gathers.
-    struct Geo<'a> {
-        points: &'a [Vec3],
-        words: &'a [u32],
-        last_point: i32,
-        last_tet: i32,
-        stride: i32,
-        vx: i32,
-        ids: i32,
-        links: i32,
     }
 
     #[target_feature(enable = "avx2")]
@@ -890,25 +917,7 @@ mod avx2 {
     ) {
         let n = rays.len().min(out.len());
         let (rays, out) = (&rays[..n], &mut out[..n]);
-        // The dispatcher checked it; the gathers' bounds rest on it.
-        assert!(
-            rw.gatherable(mesh.points.len()),
-            "record words not gatherable"
-        );
-        let (ids, links) = match rw.rule {
-            ExitRule::Rank { links } | ExitRule::RankXor { links } => (0, links),
-            ExitRule::Slot { ids, links } => (ids, links),
-        };
-        let g = Geo {
-            points: &mesh.points,
-            words: rw.words,
-            last_point: (mesh.points.len() - 1) as i32,
-            last_tet: (rw.words.len() / rw.stride - 1) as i32,
-            stride: rw.stride as i32,
-            vx: rw.vx as i32,
-            ids: ids as i32,
-            links: links as i32,
-        };
+        let g = Geo::new(mesh, &rw);
         let mut queued = Queue::default();
         // `GROUPS` independent packs of 8 lanes, stepped in turn: the
         // out-of-order core overlaps their dependent gather chains.
@@ -1106,18 +1115,6 @@ mod avx512 {
         parked
     }
 
-    /// Array bases and bounds of the gathers (as [`avx2`]'s).
-    struct Geo<'a> {
-        points: &'a [Vec3],
-        words: &'a [u32],
-        last_point: i32,
-        last_tet: i32,
-        stride: i32,
-        vx: i32,
-        ids: i32,
-        links: i32,
-    }
-
     #[target_feature(enable = "avx512f")]
     #[inline]
     fn splat(x: i32) -> __m512i {
@@ -1312,24 +1309,7 @@ mod avx512 {
     ) {
         let n = rays.len().min(out.len());
         let (rays, out) = (&rays[..n], &mut out[..n]);
-        assert!(
-            rw.gatherable(mesh.points.len()),
-            "record words not gatherable"
-        );
-        let (ids, links) = match rw.rule {
-            ExitRule::Rank { links } | ExitRule::RankXor { links } => (0, links),
-            ExitRule::Slot { ids, links } => (ids, links),
-        };
-        let g = Geo {
-            points: &mesh.points,
-            words: rw.words,
-            last_point: (mesh.points.len() - 1) as i32,
-            last_tet: (rw.words.len() / rw.stride - 1) as i32,
-            stride: rw.stride as i32,
-            vx: rw.vx as i32,
-            ids: ids as i32,
-            links: links as i32,
-        };
+        let g = Geo::new(mesh, &rw);
         let mut queued = Queue::default();
         // The packs live in registers; a lane's ray index is the only cold
         // state (its projection is rebuilt from the registers).

@@ -900,39 +900,27 @@ fn begin_with<P: Projection>(
                 }
             }
         }
-        Start::Face { face, tet } => {
-            let side = mesh
-                .constrained
-                .get(face as usize)
-                .and_then(|cf| cf.side_of(tet));
-            let Some(side) = side else {
-                return Err(TraceOutcome::Failed {
-                    failure: Failure::Lost,
-                    tets_visited: 0,
-                });
+        Start::Face { .. } | Start::Entry { .. } => {
+            // Entering `tet` through face `k`: past a constrained face, or
+            // through the mesh boundary from outside.
+            let through = match start {
+                Start::Face { face, tet } => mesh
+                    .constrained
+                    .get(face as usize)
+                    .and_then(|cf| cf.side_of(tet))
+                    .map(|side| (tet, side.face as usize, Link::constrained(face))),
+                Start::Entry { tet, face } => {
+                    mesh.is_boundary_face(tet, face)
+                        .then_some((tet, face as usize, Link::BOUNDARY))
+                }
+                Start::Tet(_) => None,
             };
-            return Ok(enter_through(
-                mesh,
-                proj,
-                tet,
-                side.face as usize,
-                Link::constrained(face),
-            ));
-        }
-        Start::Entry { tet, face } => {
-            if !mesh.is_boundary_face(tet, face) {
-                return Err(TraceOutcome::Failed {
+            return through
+                .map(|(tet, k, behind)| enter_through(mesh, proj, tet, k, behind))
+                .ok_or(TraceOutcome::Failed {
                     failure: Failure::Lost,
                     tets_visited: 0,
                 });
-            }
-            return Ok(enter_through(
-                mesh,
-                proj,
-                tet,
-                face as usize,
-                Link::BOUNDARY,
-            ));
         }
     };
     // Resolve the start tet's exit link.

@@ -17,11 +17,7 @@ use tet_trace_cpu::tet80::Tet80Tracer;
 use tet_trace_cpu::{DuffF32, Failure, Ray, Start, Starts, TraceOutcome, Tracer};
 
 mod common;
-use common::grid;
-
-/// As in `tests/kernels.rs`: hits this close to an edge, to the origin or to
-/// a second hit are ambiguous in f32.
-const EDGE_TOL: f64 = 1e-3;
+use common::{EDGE_TOL, assert_outcomes_match, grid, unambiguous_reference};
 
 /// The watertight f32 kernels (identical decisions) and the f64 ones.
 fn exact(mesh: &TetMesh) -> Vec<Box<dyn Tracer + '_>> {
@@ -60,7 +56,6 @@ fn check(mesh: &TetMesh, tracers: &[Box<dyn Tracer + '_>], ray: &Ray, strict: bo
             .seen_from(mesh, ray.origin),
     );
     let all = Viewpoint::Outside(BoundaryEntry::new(mesh).unwrap());
-    let reference = closest_hit(mesh, ray);
     let outcomes: Vec<TraceOutcome> = tracers
         .iter()
         .map(|t| trace_outside(t.as_ref(), &view, ray))
@@ -79,28 +74,10 @@ fn check(mesh: &TetMesh, tracers: &[Box<dyn Tracer + '_>], ray: &Ray, strict: bo
             assert_eq!(*failure, Failure::StepCap, "{}", t.name());
         }
     }
-    let clear = !grazes_an_edge(mesh, ray, EDGE_TOL)
-        && reference.is_none_or(|h| h.t > EDGE_TOL && h.t_gap > EDGE_TOL);
-    if !clear {
+    let Some(reference) = unambiguous_reference(mesh, ray) else {
         return 0;
-    }
-    for (t, o) in tracers.iter().zip(&outcomes) {
-        match (reference, o) {
-            (_, TraceOutcome::Failed { .. }) => {}
-            (None, TraceOutcome::Miss { .. }) => {}
-            (Some(r), TraceOutcome::Hit(h)) => {
-                assert_eq!(h.face, r.face, "{} on {ray:?}: {h:?} vs {r:?}", t.name());
-                assert!(
-                    (h.t as f64 - r.t).abs() < 1e-4 * (1.0 + r.t),
-                    "{}: t {} vs {}",
-                    t.name(),
-                    h.t,
-                    r.t
-                );
-            }
-            _ => panic!("{} on {ray:?}: {o:?} vs reference {reference:?}", t.name()),
-        }
-    }
+    };
+    assert_outcomes_match(tracers, &outcomes, ray, reference);
     1
 }
 

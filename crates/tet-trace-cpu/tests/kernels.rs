@@ -5,9 +5,7 @@ use glam::Vec3;
 use proptest::prelude::*;
 use tet_core::TetMesh;
 use tet_core::synthetic::SplitMix64;
-use tet_trace_cpu::reference::{
-    Aim, axis_ray, closest_hit, grazes_an_edge, random_ray, ray_from_feature,
-};
+use tet_trace_cpu::reference::{Aim, axis_ray, closest_hit, random_ray, ray_from_feature};
 use tet_trace_cpu::sctp::SctpTracer;
 use tet_trace_cpu::tet16::{Tet16Tracer, Tet16TracerF64};
 use tet_trace_cpu::tet20::{Tet20Tracer, Tet20TracerF64};
@@ -16,13 +14,7 @@ use tet_trace_cpu::tet80::Tet80Tracer;
 use tet_trace_cpu::{OriginF32, Ray, Start, TraceOutcome, Tracer, locate};
 
 mod common;
-use common::grid;
-
-/// Hits closer than this to an edge of the reference triangle (in units of
-/// the grid cell, i.e. ~1/1000 of a cell) may legitimately land on the
-/// neighbouring triangle in f32; hits closer than this to the origin or to a
-/// second hit are ambiguous too.
-const EDGE_TOL: f64 = 1e-3;
+use common::{assert_outcomes_match, grid, unambiguous_reference};
 
 fn all_f32(mesh: &TetMesh) -> Vec<Box<dyn Tracer + '_>> {
     vec![
@@ -67,7 +59,6 @@ fn check_ray_with(
     start: u32,
     strict: bool,
 ) -> usize {
-    let reference = closest_hit(mesh, ray);
     let outcomes: Vec<TraceOutcome> = tracers
         .iter()
         .map(|t| t.trace(ray, Start::Tet(start)))
@@ -84,29 +75,10 @@ fn check_ray_with(
             assert!(*tets_visited <= 2 * mesh.tets.len() as u32 + 1024);
         }
     }
-    let clear = !grazes_an_edge(mesh, ray, EDGE_TOL)
-        && reference.is_none_or(|h| h.t > EDGE_TOL && h.t_gap > EDGE_TOL);
-    if !clear {
+    let Some(reference) = unambiguous_reference(mesh, ray) else {
         return 0;
-    }
-    for (t, o) in tracers.iter().zip(&outcomes) {
-        match (reference, o) {
-            (_, TraceOutcome::Failed { .. }) => {}
-            (None, TraceOutcome::Miss { .. }) => {}
-            (Some(r), TraceOutcome::Hit(h)) => {
-                assert_eq!(h.face, r.face, "{} on {ray:?}: {h:?} vs {r:?}", t.name());
-                assert!(
-                    (h.t as f64 - r.t).abs() < 1e-4 * (1.0 + r.t),
-                    "{}: t",
-                    t.name()
-                );
-                for k in 0..3 {
-                    assert!((h.barycentrics[k] as f64 - r.barycentrics[k]).abs() < 1e-4);
-                }
-            }
-            _ => panic!("{} on {ray:?}: {o:?} vs reference {reference:?}", t.name()),
-        }
-    }
+    };
+    assert_outcomes_match(tracers, &outcomes, ray, reference);
     1
 }
 

@@ -201,6 +201,27 @@ pub struct GpuFrame {
 }
 
 impl GpuFrame {
+    /// The frame of `outcomes`, with the wall time since `t0` and the
+    /// outcomes counted into `stats`.
+    fn done(
+        width: u32,
+        height: u32,
+        outcomes: Vec<TraceOutcome>,
+        mut stats: DispatchStats,
+        t0: Instant,
+        retraced: u64,
+    ) -> GpuFrame {
+        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        stats.count(&outcomes);
+        GpuFrame {
+            width,
+            height,
+            outcomes,
+            stats,
+            retraced,
+        }
+    }
+
     /// Hit triangle per pixel (`u32::MAX` for none), as in the CPU `Frame`.
     pub fn triangles(&self) -> Vec<u32> {
         self.outcomes
@@ -646,15 +667,14 @@ impl<'a> GpuTracer<'a> {
                 outcomes[i] = o;
             }
         }
-        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        stats.count(&outcomes);
-        Ok(GpuFrame {
+        Ok(GpuFrame::done(
             width,
             height,
             outcomes,
             stats,
-            retraced: lost.len() as u64,
-        })
+            t0,
+            lost.len() as u64,
+        ))
     }
 
     /// [`GpuTracer::render`] from a located viewpoint: the GPU's own camera
@@ -700,23 +720,15 @@ impl<'a> GpuTracer<'a> {
         for (i, o) in index.into_iter().zip(traced) {
             outcomes[i] = o;
         }
-        // Counted again below over every pixel.
-        let mut stats = DispatchStats {
+        // Counted again over every pixel.
+        let stats = DispatchStats {
             rays: 0,
             hits: 0,
             failures: 0,
             tets_visited: 0,
             ..s
         };
-        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        stats.count(&outcomes);
-        Ok(GpuFrame {
-            width,
-            height,
-            outcomes,
-            stats,
-            retraced: 0,
-        })
+        Ok(GpuFrame::done(width, height, outcomes, stats, t0, 0))
     }
 
     fn new_stats(&self) -> DispatchStats {

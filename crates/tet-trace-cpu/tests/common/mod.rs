@@ -1,7 +1,10 @@
-//! Helpers shared by the kernel test binaries.
+//! Helpers shared by the kernel test binaries (each uses some of them).
+#![allow(dead_code)]
 
 use tet_core::TetMesh;
 use tet_core::synthetic::{GridSpec, kuhn_grid};
+use tet_trace_cpu::reference::{RefHit, closest_hit, grazes_an_edge};
+use tet_trace_cpu::{Ray, TraceOutcome, Tracer};
 
 /// A validated jittered Kuhn grid of `cells³` cells with a `fraction` of
 /// random constrained faces, or (with `shell`) a closed shell one cell in.
@@ -16,4 +19,56 @@ pub fn grid(cells: u32, jitter: f32, fraction: f64, shell: bool, seed: u64) -> T
     });
     m.validate().unwrap();
     m
+}
+
+/// Hits closer than this to an edge of the reference triangle (in units of
+/// the grid cell, i.e. ~1/1000 of a cell) may legitimately land on the
+/// neighbouring triangle in f32; hits closer than this to the origin or to a
+/// second hit are ambiguous too.
+pub const EDGE_TOL: f64 = 1e-3;
+
+/// The f64 brute-force hit of `ray`, or `None` when the ray is ambiguous
+/// (it grazes an edge of a constrained face, or its hit lies within
+/// [`EDGE_TOL`] of its origin or of a second hit): `Some(reference)` when
+/// the outcomes must match it.
+pub fn unambiguous_reference(mesh: &TetMesh, ray: &Ray) -> Option<Option<RefHit>> {
+    let reference = closest_hit(mesh, ray);
+    let clear = !grazes_an_edge(mesh, ray, EDGE_TOL)
+        && reference.is_none_or(|h| h.t > EDGE_TOL && h.t_gap > EDGE_TOL);
+    clear.then_some(reference)
+}
+
+/// Asserts that each tracer's outcome (failures aside, checked by the
+/// caller) is the brute-force `reference`: the same face, `t` and
+/// barycentrics to 1e-4, or a miss.
+pub fn assert_outcomes_match(
+    tracers: &[Box<dyn Tracer + '_>],
+    outcomes: &[TraceOutcome],
+    ray: &Ray,
+    reference: Option<RefHit>,
+) {
+    for (t, o) in tracers.iter().zip(outcomes) {
+        match (reference, o) {
+            (_, TraceOutcome::Failed { .. }) => {}
+            (None, TraceOutcome::Miss { .. }) => {}
+            (Some(r), TraceOutcome::Hit(h)) => {
+                assert_eq!(h.face, r.face, "{} on {ray:?}: {h:?} vs {r:?}", t.name());
+                assert!(
+                    (h.t as f64 - r.t).abs() < 1e-4 * (1.0 + r.t),
+                    "{}: t {} vs {}",
+                    t.name(),
+                    h.t,
+                    r.t
+                );
+                for k in 0..3 {
+                    assert!(
+                        (h.barycentrics[k] as f64 - r.barycentrics[k]).abs() < 1e-4,
+                        "{}: barycentrics",
+                        t.name()
+                    );
+                }
+            }
+            _ => panic!("{} on {ray:?}: {o:?} vs reference {reference:?}", t.name()),
+        }
+    }
 }
