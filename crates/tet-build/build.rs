@@ -27,6 +27,10 @@ fn main() {
     println!("cargo:rerun-if-changed=cpp/tet_shim.cpp");
     println!("cargo:rerun-if-changed=cpp/tet_shim.h");
     println!("cargo:rerun-if-env-changed=TET_BUILD_TETGEN_SRC");
+    // The target triple, for the test of the `cargo metadata` route.
+    if let Ok(target) = env::var("TARGET") {
+        println!("cargo:rustc-env=TET_BUILD_TARGET={target}");
+    }
     if env::var_os("CARGO_FEATURE_TETGEN").is_none() {
         return;
     }
@@ -91,5 +95,6 @@ fn find_tetgen() -> Result<PathBuf, String> {
     let cargo = env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let manifest = PathBuf::from(env::var("CARGO_MANIFEST_DIR").map_err(|e| e.to_string())?)
         .join("Cargo.toml");
-    locate::from_cargo_metadata(&cargo, &manifest)
+    let target = env::var("TARGET").map_err(|e| e.to_string())?;
+    locate::from_cargo_metadata(&cargo, &manifest, &target)
 }

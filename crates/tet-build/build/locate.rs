@@ -40,14 +40,18 @@ pub fn from_registry(cargo_home: &Path) -> Option<PathBuf> {
 
 /// Asks Cargo (`cargo metadata --offline`) where the `tritet` package of the
 /// pinned version lives: handles vendored sources, `[patch]` and a
-/// non-default `CARGO_HOME` layout.
-pub fn from_cargo_metadata(cargo: &str, manifest: &Path) -> Result<PathBuf, String> {
+/// non-default `CARGO_HOME` layout. Only the packages of `target` (a target
+/// triple) are resolved, so an offline cache that holds what this build
+/// downloaded (not every other platform's dependencies) suffices.
+pub fn from_cargo_metadata(cargo: &str, manifest: &Path, target: &str) -> Result<PathBuf, String> {
     let out = Command::new(cargo)
         .args([
             "metadata",
             "--format-version",
             "1",
             "--offline",
+            "--filter-platform",
+            target,
             "--manifest-path",
         ])
         .arg(manifest)

@@ -422,8 +422,9 @@ fn build_script_finds_tetgen_through_cargo_metadata_too() {
         "workspace Cargo.toml lacks `{pin}`"
     );
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let target = env!("TET_BUILD_TARGET");
     let via_metadata =
-        locate::from_cargo_metadata(&cargo, &manifest_dir.join("Cargo.toml")).unwrap();
+        locate::from_cargo_metadata(&cargo, &manifest_dir.join("Cargo.toml"), target).unwrap();
     assert!(locate::has_sources(&via_metadata), "{via_metadata:?}");
     let home = std::env::var_os("CARGO_HOME")
         .map(PathBuf::from)
@@ -436,7 +437,7 @@ fn build_script_finds_tetgen_through_cargo_metadata_too() {
         );
     }
     // A manifest that does not exist is an error message, not a panic.
-    let err = locate::from_cargo_metadata(&cargo, Path::new("/nonexistent/Cargo.toml"));
+    let err = locate::from_cargo_metadata(&cargo, Path::new("/nonexistent/Cargo.toml"), target);
     assert!(err.unwrap_err().contains("cargo metadata failed"));
     // An empty registry directory finds nothing.
     let empty = tempfile::tempdir().unwrap();
