@@ -1142,6 +1142,32 @@ mod avx512 {
         unsafe { _mm512_i32gather_ps::<4>(i3, base.wrapping_add(axis)) }
     }
 
+    /// Gathers `(x, y)` of `points[i]` per lane (`i3 = 3·i`, `i ≤
+    /// last_point`) as two 8-lane gathers of 64-bit pairs, deinterleaved:
+    /// 16 loads instead of the 32 of two 16-lane gathers.
+    #[target_feature(enable = "avx512f")]
+    #[inline]
+    fn gather_xy(g: &Geo<'_>, i3: __m512i) -> (__m512, __m512) {
+        let base = g.points.as_ptr() as *const i64;
+        let lo = _mm512_castsi512_si256(i3);
+        let hi = _mm512_extracti64x4_epi64::<1>(i3);
+        // SAFETY: as `gather_points`: lane `k` reads the 8 bytes at word
+        // `3·i`, the point's x and y, inside `points`.
+        let (a, b) = unsafe {
+            (
+                _mm512_i32gather_epi64::<4>(lo, base),
+                _mm512_i32gather_epi64::<4>(hi, base),
+            )
+        };
+        let (a, b) = (_mm512_castsi512_ps(a), _mm512_castsi512_ps(b));
+        let even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+        let odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+        (
+            _mm512_permutex2var_ps(a, even, b),
+            _mm512_permutex2var_ps(a, odd, b),
+        )
+    }
+
     /// Per-lane flags of a mask.
     fn flags(m: __mmask16) -> [bool; 16] {
         std::array::from_fn(|l| m >> l & 1 != 0)
@@ -1164,8 +1190,9 @@ mod avx512 {
         let dc = _mm512_min_epu32(d, splat(g.last_point));
         let lost = _mm512_cmpneq_epi32_mask(dc, d);
         let i3 = _mm512_add_epi32(_mm512_add_epi32(dc, dc), dc);
-        let qx = _mm512_sub_ps(gather_points(g, i3, 0), v.o[0]);
-        let qy = _mm512_sub_ps(gather_points(g, i3, 1), v.o[1]);
+        let (px3, py3) = gather_xy(g, i3);
+        let qx = _mm512_sub_ps(px3, v.o[0]);
+        let qy = _mm512_sub_ps(py3, v.o[1]);
         let qz = _mm512_sub_ps(gather_points(g, i3, 2), v.o[2]);
         // Projection: `(c₀·qₓ + c₁·q_y) + c₂·q_z`, no FMA.
         let proj = |k: usize| {
