@@ -129,7 +129,7 @@ pub fn with_mesh(scene: Scene, mesh: TetMesh, build: Option<BuildSummary>) -> Lo
 
 /// Relative margin of the tight enclosing box (of the scene's largest
 /// extent): thin, so that few tets lie between the box and the scene.
-pub const TIGHT_BOX_MARGIN: f32 = 0.01;
+pub const TIGHT_BOX_MARGIN: f32 = 0.002;
 
 /// The enclosing box. By default it holds the scene only, grown by
 /// [`TIGHT_BOX_MARGIN`] of its largest extent: cameras and lights may lie

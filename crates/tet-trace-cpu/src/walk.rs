@@ -812,7 +812,7 @@ pub(crate) struct Queue {
 
 /// Starts the next queued ray that does not end before its walk (those are
 /// written to `out` directly).
-#[inline]
+#[inline(always)]
 pub(crate) fn next_lane<P: Projection>(
     mesh: &TetMesh,
     rays: &[Ray],
@@ -839,7 +839,7 @@ pub(crate) fn next_lane<P: Projection>(
 
 /// [`begin`] for a ray from outside the mesh: its entry is decided with the
 /// projection the walk then uses (set up once).
-#[inline]
+#[inline(always)]
 fn begin_outside<P: Projection>(
     mesh: &TetMesh,
     ray: &Ray,
@@ -872,7 +872,7 @@ fn begin<P: Projection>(mesh: &TetMesh, ray: &Ray, start: Start) -> Result<Lane<
 }
 
 /// [`begin`] of a valid ray whose projection `proj` is set up.
-#[inline]
+#[inline(always)]
 fn begin_with<P: Projection>(
     mesh: &TetMesh,
     ray: &Ray,
@@ -951,7 +951,7 @@ fn begin_with<P: Projection>(
 /// A lane about to enter `tet` through its face `face` (slot index), whose
 /// raw link on the far side is `behind` (the constrained face crossed, or
 /// the boundary): the entry face in counter-clockwise (= inward) order.
-#[inline]
+#[inline(always)]
 fn enter_through<P: Projection>(
     mesh: &TetMesh,
     proj: P,
