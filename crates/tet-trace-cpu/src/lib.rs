@@ -26,6 +26,7 @@ pub mod reference;
 pub mod render;
 pub mod scaled;
 pub mod sctp;
+mod sctp_lockstep;
 pub mod secondary;
 pub mod tet16;
 pub mod tet20;

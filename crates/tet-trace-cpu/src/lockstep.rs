@@ -116,6 +116,16 @@ pub enum ExitRule {
         /// Word of the slot-0 link.
         links: usize,
     },
+    /// The 32-byte baseline (ScTP): no `VX` word; the new vertex is the one
+    /// of the four ids at words `ids..ids + 4` not on the entry face, the
+    /// link that of the exiting vertex's slot among the first three (3:
+    /// none), at `links + slot`. Walked by [`crate::sctp_lockstep`] only.
+    Ids {
+        /// Word of the slot-0 vertex id.
+        ids: usize,
+        /// Word of the slot-0 link.
+        links: usize,
+    },
 }
 
 /// A layout's records as 32-bit words, for the gathers of the AVX2 lockstep
@@ -137,12 +147,13 @@ impl RecordWords<'_> {
     /// stays inside a record (`next` and the decoded vertex are clamped to
     /// the arrays, ranks and slots to 0..=3).
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-    fn gatherable(&self, points: usize) -> bool {
+    pub(crate) fn gatherable(&self, points: usize) -> bool {
         let s = self.stride;
         let inside = match self.rule {
             ExitRule::Rank { links } => links + 3 < s,
             ExitRule::RankXor { links } => links + 2 < s,
             ExitRule::Slot { ids, links } => ids + 2 < s && links + 3 < s,
+            ExitRule::Ids { ids, links } => ids + 3 < s && links + 3 < s,
         };
         inside
             && self.vx < s
@@ -201,11 +212,16 @@ fn dispatch<T: Topology>(
     #[cfg(not(target_arch = "x86_64"))]
     let _ = wide;
     #[cfg(target_arch = "x86_64")]
+    // Records the gathers of the projected walks can read (the baseline's
+    // `Ids` rule is ScTP's, `crate::sctp_lockstep`).
+    #[cfg(target_arch = "x86_64")]
+    let words = topo
+        .record_words()
+        .filter(|rw| rw.gatherable(mesh.points.len()) && !matches!(rw.rule, ExitRule::Ids { .. }));
+    #[cfg(target_arch = "x86_64")]
     if wide
         && std::arch::is_x86_feature_detected!("avx512f")
-        && let Some(rw) = topo
-            .record_words()
-            .filter(|rw| rw.gatherable(mesh.points.len()))
+        && let Some(rw) = words
     {
         // SAFETY (all three): the `avx512f` functions only require the
         // CPU to support AVX-512F, which was detected just above.
@@ -216,7 +232,7 @@ fn dispatch<T: Topology>(
             ExitRule::RankXor { .. } => unsafe {
                 avx512::run_gather::<RANK_XOR>(mesh, rw, rays, start, cap, out)
             },
-            ExitRule::Slot { .. } => unsafe {
+            ExitRule::Slot { .. } | ExitRule::Ids { .. } => unsafe {
                 avx512::run_gather::<SLOT>(mesh, rw, rays, start, cap, out)
             },
         }
@@ -224,8 +240,8 @@ fn dispatch<T: Topology>(
     }
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
-        match topo.record_words() {
-            Some(rw) if rw.gatherable(mesh.points.len()) => {
+        match words {
+            Some(rw) => {
                 // SAFETY (all three): the `avx2` functions only require the
                 // CPU to support AVX2, which was detected just above.
                 match rw.rule {
@@ -235,7 +251,7 @@ fn dispatch<T: Topology>(
                     ExitRule::RankXor { .. } => unsafe {
                         avx2::run_gather::<RANK_XOR>(mesh, rw, rays, start, cap, out)
                     },
-                    ExitRule::Slot { .. } => unsafe {
+                    ExitRule::Slot { .. } | ExitRule::Ids { .. } => unsafe {
                         avx2::run_gather::<SLOT>(mesh, rw, rays, start, cap, out)
                     },
                 }
@@ -609,29 +625,29 @@ fn lane_events<const W: usize>(
 
 /// Array bases and bounds of the gathers of the AVX2 and AVX-512 walks.
 #[cfg(target_arch = "x86_64")]
-struct Geo<'a> {
-    points: &'a [Vec3],
-    words: &'a [u32],
-    last_point: i32,
-    last_tet: i32,
-    stride: i32,
-    vx: i32,
-    ids: i32,
-    links: i32,
+pub(crate) struct Geo<'a> {
+    pub(crate) points: &'a [Vec3],
+    pub(crate) words: &'a [u32],
+    pub(crate) last_point: i32,
+    pub(crate) last_tet: i32,
+    pub(crate) stride: i32,
+    pub(crate) vx: i32,
+    pub(crate) ids: i32,
+    pub(crate) links: i32,
 }
 
 #[cfg(target_arch = "x86_64")]
 impl<'a> Geo<'a> {
     /// The gathers' view of `mesh` and its records `rw`, which must be
     /// [`RecordWords::gatherable`] (checked: the gathers' bounds rest on it).
-    fn new(mesh: &'a TetMesh, rw: &RecordWords<'a>) -> Geo<'a> {
+    pub(crate) fn new(mesh: &'a TetMesh, rw: &RecordWords<'a>) -> Geo<'a> {
         assert!(
             rw.gatherable(mesh.points.len()),
             "record words not gatherable"
         );
         let (ids, links) = match rw.rule {
             ExitRule::Rank { links } | ExitRule::RankXor { links } => (0, links),
-            ExitRule::Slot { ids, links } => (ids, links),
+            ExitRule::Slot { ids, links } | ExitRule::Ids { ids, links } => (ids, links),
         };
         Geo {
             points: &mesh.points,
@@ -953,7 +969,7 @@ mod avx2 {
 /// by lane the same IEEE operations), one pack of 16 lanes in flight per
 /// group.
 #[cfg(target_arch = "x86_64")]
-mod avx512 {
+pub(crate) mod avx512 {
     use std::arch::x86_64::*;
 
     use super::*;
@@ -1117,14 +1133,14 @@ mod avx512 {
 
     #[target_feature(enable = "avx512f")]
     #[inline]
-    fn splat(x: i32) -> __m512i {
+    pub(crate) fn splat(x: i32) -> __m512i {
         _mm512_set1_epi32(x)
     }
 
     /// Gathers `words[idx]` per lane.
     #[target_feature(enable = "avx512f")]
     #[inline]
-    fn gather_words(g: &Geo<'_>, idx: __m512i) -> __m512i {
+    pub(crate) fn gather_words(g: &Geo<'_>, idx: __m512i) -> __m512i {
         // SAFETY: every caller forms `idx = min(next, last_tet) · stride + k`
         // with `0 ≤ k < stride` (checked by `RecordWords::gatherable`), so
         // each lane reads a word inside `g.words`.
@@ -1134,7 +1150,7 @@ mod avx512 {
     /// Gathers coordinate `axis` (0..=2) of `points[i]` per lane, `i ≤ last_point`.
     #[target_feature(enable = "avx512f")]
     #[inline]
-    fn gather_points(g: &Geo<'_>, i3: __m512i, axis: usize) -> __m512 {
+    pub(crate) fn gather_points(g: &Geo<'_>, i3: __m512i, axis: usize) -> __m512 {
         let base = g.points.as_ptr() as *const f32;
         // SAFETY: `i3 = 3·i` with `i ≤ last_point = points.len() − 1` per
         // lane, so word `i3 + axis` (axis ≤ 2) lies inside `points`;
@@ -1147,7 +1163,7 @@ mod avx512 {
     /// 16 loads instead of the 32 of two 16-lane gathers.
     #[target_feature(enable = "avx512f")]
     #[inline]
-    fn gather_xy(g: &Geo<'_>, i3: __m512i) -> (__m512, __m512) {
+    pub(crate) fn gather_xy(g: &Geo<'_>, i3: __m512i) -> (__m512, __m512) {
         let base = g.points.as_ptr() as *const i64;
         let lo = _mm512_castsi512_si256(i3);
         let hi = _mm512_extracti64x4_epi64::<1>(i3);

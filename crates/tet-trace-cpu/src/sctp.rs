@@ -20,15 +20,23 @@
 //! wrong face or loop to the step cap (reported as a failure). The 2-D
 //! projection removes the `d` component before multiplying and does not
 //! suffer from this (see the robustness census in `tests/robustness.rs`).
+//!
+//! Batches (a tile of primary rays) walk 16 rays in AVX-512 lockstep where
+//! the CPU has AVX-512F ([`crate::sctp_lockstep`], the same decisions bit
+//! for bit), else the scalar interleaved walk: Torus Knots, 1920×1440, 2
+//! threads, 2.05 → 8.13 Mrays/s (neptun's ScTP: 2.79).
 
 use tet_core::layout::{Baseline32, Baseline32Mesh};
 
 use crate::kernel::{WalkRecord, WalkTracer, slot_exit_link};
+use crate::lockstep::ExitRule;
 use crate::walk::TripleF32;
 
 impl WalkRecord for Baseline32 {
     const KERNEL: &'static str = "sctp";
     const PREFETCH: bool = false;
+    /// Ids at words 0..4, links at 4..8 (no `VX`: word 0 stands in).
+    const WORDS: Option<(usize, ExitRule)> = Some((0, ExitRule::Ids { ids: 0, links: 4 }));
     #[inline(always)]
     fn vx(&self) -> u32 {
         let v = self.v;

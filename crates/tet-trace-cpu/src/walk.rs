@@ -399,7 +399,7 @@ impl Projection for DuffF64 {
 /// decided as in 2-D by perturbing the origin by `ε u + ε² v` (`u, v` the
 /// Duff basis): first `sign((qa − qb) · v)`, then `sign((qb − qa) · u)`, then
 /// the vertex indices (`a < b` ⇒ left), each antisymmetric.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct TripleF32 {
     o: Vec3,
     d: Vec3,
@@ -408,9 +408,14 @@ pub struct TripleF32 {
 }
 
 impl TripleF32 {
+    /// The ray's origin and direction (for the SIMD lockstep walk).
+    pub(crate) fn origin_direction(&self) -> (Vec3, Vec3) {
+        (self.o, self.d)
+    }
+
     #[cold]
     #[inline(never)]
-    fn left_mask_ties(&self, pd: Vec3, d: u32, f: &[Vec3; 3], ids: &[u32; 3]) -> usize {
+    pub(crate) fn left_mask_ties(&self, pd: Vec3, d: u32, f: &[Vec3; 3], ids: &[u32; 3]) -> usize {
         self.left(pd, d, f[0], ids[0]) as usize
             | (self.left(pd, d, f[1], ids[1]) as usize) << 1
             | (self.left(pd, d, f[2], ids[2]) as usize) << 2
@@ -433,6 +438,23 @@ impl Projection for TripleF32 {
         }
     }
     const NAME: &'static str = "f32-stp";
+    /// On x86-64 with AVX-512F over the baseline layout: 16 lanes in
+    /// lockstep ([`crate::sctp_lockstep`], identical outcomes); otherwise
+    /// the scalar interleaved walk.
+    fn trace_batch<T: Topology>(
+        mesh: &TetMesh,
+        topo: &T,
+        rays: &[Ray],
+        starts: Starts<'_>,
+        cap: u32,
+        out: &mut [TraceOutcome],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::sctp_lockstep::trace(mesh, topo, rays, starts, cap, out) {
+            return;
+        }
+        trace_interleaved::<Self, T, { crate::kernel::LANES }>(mesh, topo, rays, starts, cap, out)
+    }
     fn setup(ray: &Ray) -> Self {
         let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
         TripleF32 {

@@ -139,7 +139,31 @@ fn check_batch<L: Topology>(t: &WalkTracer<'_, L, DuffF32>, rays: &[Ray], start:
     }
 }
 
+/// ScTP's batch path (16-lane lockstep where the CPU has AVX-512F, else the
+/// interleaved walk) gives its single-ray outcomes bit for bit.
+fn check_sctp_batch(t: &tet_trace_cpu::sctp::SctpTracer<'_>, rays: &[Ray], start: Start) {
+    let mut got = vec![
+        TraceOutcome::Miss {
+            tets_visited: u32::MAX
+        };
+        rays.len()
+    ];
+    t.trace_batch(rays, start, &mut got);
+    for (r, g) in rays.iter().zip(&got) {
+        assert_eq!(
+            bits(g),
+            bits(&t.trace(r, start)),
+            "sctp batch differs on {r:?} from {start:?}"
+        );
+    }
+}
+
 fn check_mesh(mesh: &TetMesh, seed: u64, origins: usize, per: usize, cap: Option<u32>) {
+    let sctp = tet_trace_cpu::sctp::SctpTracer::new(mesh).unwrap();
+    let sctp = match cap {
+        Some(c) => sctp.with_step_cap(c),
+        None => sctp,
+    };
     let t20 = tet_trace_cpu::tet20::Tet20Tracer::<DuffF32>::new(mesh).unwrap();
     let t16 = tet_trace_cpu::tet16::Tet16Tracer::<DuffF32>::new(mesh).unwrap();
     let t32 = tet_trace_cpu::tet32::Tet32Tracer::<DuffF32>::new(mesh).unwrap();
@@ -166,6 +190,7 @@ fn check_mesh(mesh: &TetMesh, seed: u64, origins: usize, per: usize, cap: Option
         check_batch(&t20, &rays, start);
         check_batch(&t16, &rays, start);
         check_batch(&t32, &rays, start);
+        check_sctp_batch(&sctp, &rays, start);
     }
     // Restarts just past a constrained face (secondary rays).
     for _ in 0..origins.min(mesh.constrained.len()) {
@@ -185,6 +210,7 @@ fn check_mesh(mesh: &TetMesh, seed: u64, origins: usize, per: usize, cap: Option
             check_batch(&t20, &rays, start);
             check_batch(&t16, &rays, start);
             check_batch(&t32, &rays, start);
+            check_sctp_batch(&sctp, &rays, start);
         }
     }
 }

@@ -1,0 +1,391 @@
+//! ScTP (Lagae & Dutré's scalar triple products, [`TripleF32`]) walked in
+//! 16-lane AVX-512 lockstep over the 32-byte baseline layout: the batch path
+//! of [`crate::sctp::SctpTracer`].
+//!
+//! Each round every lane gathers the four vertex ids of the tet it enters
+//! (the baseline layout stores no `VX`: the new vertex is the one id that is
+//! not on the entry face, `v₀ ⊕ v₁ ⊕ v₂ ⊕ v₃ ⊕ idx₀ ⊕ idx₁ ⊕ idx₂`), its point
+//! (`x, y` as one 64-bit pair, then `z`), and evaluates the three triple
+//! products `d · (q₃ × qᵢ)` with `q = P − o` exactly as
+//! [`TripleF32::left_mask`] does (glam's `cross` and `dot`, operand for
+//! operand, no fused multiply-add), so every lane decides bit for bit as the
+//! scalar walk and the antisymmetry that makes the walk watertight
+//! (`a × b = −(b × a)` componentwise) is kept. A zero product takes the
+//! scalar tie rule for that lane. The exit link is found by the slot of the
+//! exiting vertex among the gathered ids (Algorithm 3). Lanes whose walk
+//! needs the rare path go through the scalar engine's `finish_step`, and are
+//! refilled at once, as in [`crate::lockstep`].
+//!
+//! Why: the scalar interleaved walk spends about 146 instructions per ScTP
+//! step; in lockstep the arithmetic is shared by 16 rays.
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) use avx512::trace;
+
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    use std::arch::x86_64::*;
+
+    use glam::Vec3;
+    use tet_core::{Link, TetMesh};
+
+    use crate::lockstep::avx512::{gather_points, gather_words, gather_xy, splat};
+    use crate::lockstep::{ExitRule, Geo, RecordWords};
+    use crate::ray::{Ray, TraceOutcome};
+    use crate::walk::{
+        Advance, Lane, Queue, Starts, State, Topology, TripleF32, finish_step, next_lane,
+    };
+
+    /// Traces the batch in lockstep when the CPU has AVX-512F and the
+    /// layout exposes baseline records ([`ExitRule::Ids`]); false (nothing
+    /// traced) otherwise.
+    pub(crate) fn trace<T: Topology>(
+        mesh: &TetMesh,
+        topo: &T,
+        rays: &[Ray],
+        start: Starts<'_>,
+        cap: u32,
+        out: &mut [TraceOutcome],
+    ) -> bool {
+        if !std::arch::is_x86_feature_detected!("avx512f") {
+            return false;
+        }
+        match topo.record_words() {
+            Some(rw)
+                if matches!(rw.rule, ExitRule::Ids { .. }) && rw.gatherable(mesh.points.len()) =>
+            {
+                // SAFETY: `run` only requires AVX-512F, detected above.
+                unsafe { run(mesh, rw, rays, start, cap, out) };
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// 16 walks in registers, and per lane the cold part of its ray.
+    struct Pack {
+        o: [__m512; 3],
+        dir: [__m512; 3],
+        /// Entry face points `q = P − o`, `[vertex][axis]`.
+        q: [[__m512; 3]; 3],
+        ids: [__m512i; 3],
+        next: __m512i,
+        entry: __m512i,
+        visited: __m512i,
+        live: __mmask16,
+        ray: [usize; 16],
+        proj: [TripleF32; 16],
+    }
+
+    /// `(x, y, z)` of `points[i]` per lane, `i3 = 3·i`, `i ≤ last_point`.
+    #[target_feature(enable = "avx512f")]
+    #[inline]
+    fn gather_point(g: &Geo<'_>, i3: __m512i) -> [__m512; 3] {
+        let (x, y) = gather_xy(g, i3);
+        [x, y, gather_points(g, i3, 2)]
+    }
+
+    impl Pack {
+        /// Lane `l` as a scalar lane, `tet` and `link` as `advance` leaves
+        /// them for `finish_step`.
+        #[target_feature(enable = "avx512f")]
+        fn lane(&self, l: usize, link: u32) -> Lane<TripleF32> {
+            let at = _mm512_set1_epi32(l as i32);
+            let f = |x: __m512| _mm512_cvtss_f32(_mm512_permutexvar_ps(at, x));
+            let u = |x: __m512i| {
+                _mm_cvtsi128_si32(_mm512_castsi512_si128(_mm512_permutexvar_epi32(at, x))) as u32
+            };
+            let pt = |k: usize| Vec3::new(f(self.q[k][0]), f(self.q[k][1]), f(self.q[k][2]));
+            let next = u(self.next);
+            Lane {
+                proj: self.proj[l],
+                st: State {
+                    tet: next,
+                    ids: [u(self.ids[0]), u(self.ids[1]), u(self.ids[2])],
+                    p: [pt(0), pt(1), pt(2)],
+                    link,
+                    visited: u(self.visited),
+                },
+                next,
+                entry_raw: u(self.entry),
+            }
+        }
+
+        /// Loads scalar lane `lane` of ray `ray` into lane `l`.
+        #[target_feature(enable = "avx512f")]
+        fn put(&mut self, l: usize, ray: usize, lane: &Lane<TripleF32>) {
+            let k: __mmask16 = 1 << l;
+            let f = |x: &mut __m512, v: f32| *x = _mm512_mask_mov_ps(*x, k, _mm512_set1_ps(v));
+            let u = |x: &mut __m512i, v: u32| *x = _mm512_mask_set1_epi32(*x, k, v as i32);
+            let (o, d) = lane.proj.origin_direction();
+            for a in 0..3 {
+                f(&mut self.o[a], o[a]);
+                f(&mut self.dir[a], d[a]);
+            }
+            for s in 0..3 {
+                for a in 0..3 {
+                    f(&mut self.q[s][a], lane.st.p[s][a]);
+                }
+                u(&mut self.ids[s], lane.st.ids[s]);
+            }
+            u(&mut self.next, lane.next);
+            u(&mut self.entry, lane.entry_raw);
+            u(&mut self.visited, lane.st.visited);
+            self.live |= k;
+            self.ray[l] = ray;
+            self.proj[l] = lane.proj;
+        }
+
+        /// Parks lane `l` (tet 0 keeps its loads in range).
+        #[target_feature(enable = "avx512f")]
+        fn park(&mut self, l: usize) {
+            let k: __mmask16 = 1 << l;
+            self.live &= !k;
+            self.next = _mm512_mask_set1_epi32(self.next, k, 0);
+        }
+
+        /// Lanes filled with the next walks of the batch (parked when none).
+        #[target_feature(enable = "avx512f")]
+        fn fill(
+            mesh: &TetMesh,
+            rays: &[Ray],
+            start: Starts<'_>,
+            queued: &mut Queue,
+            out: &mut [TraceOutcome],
+        ) -> (Pack, usize) {
+            let zf = _mm512_setzero_ps();
+            let zi = _mm512_setzero_si512();
+            let mut pk = Pack {
+                o: [zf; 3],
+                dir: [zf; 3],
+                q: [[zf; 3]; 3],
+                ids: [zi; 3],
+                next: zi,
+                entry: zi,
+                visited: zi,
+                live: 0,
+                ray: [0; 16],
+                proj: [TripleF32::default(); 16],
+            };
+            let mut live = 0;
+            for l in 0..16 {
+                if let Some((i, lane)) = next_lane::<TripleF32>(mesh, rays, start, queued, out) {
+                    pk.put(l, i, &lane);
+                    live += 1;
+                }
+            }
+            (pk, live)
+        }
+    }
+
+    /// What the cold path needs of a round.
+    struct Events {
+        mask: __mmask16,
+        raw: [u32; 16],
+        lost: __mmask16,
+        capped: __mmask16,
+    }
+
+    /// One round (the decisions of `walk::advance` with [`TripleF32`]).
+    #[target_feature(enable = "avx512f")]
+    #[inline]
+    fn step(v: &mut Pack, g: &Geo<'_>, cap: u32) -> Option<Events> {
+        let zero = _mm512_setzero_ps();
+        let tet = _mm512_min_epu32(v.next, splat(g.last_tet));
+        let base = _mm512_mullo_epi32(tet, splat(g.stride));
+        let ids = _mm512_add_epi32(base, splat(g.ids));
+        let vid: [__m512i; 4] =
+            std::array::from_fn(|k| gather_words(g, _mm512_add_epi32(ids, splat(k as i32))));
+        // The vertex not on the entry face.
+        let d = _mm512_xor_si512(
+            _mm512_xor_si512(
+                _mm512_xor_si512(vid[0], vid[1]),
+                _mm512_xor_si512(vid[2], vid[3]),
+            ),
+            _mm512_xor_si512(_mm512_xor_si512(v.ids[0], v.ids[1]), v.ids[2]),
+        );
+        let dc = _mm512_min_epu32(d, splat(g.last_point));
+        let lost = _mm512_cmpneq_epi32_mask(dc, d);
+        let i3 = _mm512_add_epi32(_mm512_add_epi32(dc, dc), dc);
+        let p = gather_point(g, i3);
+        // `TripleF32::project`: q₃ = P − o.
+        let q3: [__m512; 3] = std::array::from_fn(|a| _mm512_sub_ps(p[a], v.o[a]));
+        let mul = _mm512_mul_ps;
+        let sub = _mm512_sub_ps;
+        // `d · (q₃ × qₖ)` as glam computes it: `cross(q₃, qₖ)` is
+        // `(q₃.y·qₖ.z − qₖ.y·q₃.z, q₃.z·qₖ.x − qₖ.z·q₃.x, q₃.x·qₖ.y − qₖ.x·q₃.y)`,
+        // then `(d.x·c.x + d.y·c.y) + d.z·c.z`.
+        let s: [__m512; 3] = std::array::from_fn(|k| {
+            let qk = &v.q[k];
+            let cx = sub(mul(q3[1], qk[2]), mul(qk[1], q3[2]));
+            let cy = sub(mul(q3[2], qk[0]), mul(qk[2], q3[0]));
+            let cz = sub(mul(q3[0], qk[1]), mul(qk[0], q3[1]));
+            _mm512_add_ps(
+                _mm512_add_ps(mul(v.dir[0], cx), mul(v.dir[1], cy)),
+                mul(v.dir[2], cz),
+            )
+        });
+        let mut left = s.map(|x| _mm512_cmp_ps_mask::<_CMP_GT_OQ>(x, zero));
+        let tie = (_mm512_cmp_ps_mask::<_CMP_EQ_OQ>(s[0], zero)
+            | _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(s[1], zero)
+            | _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(s[2], zero))
+            & v.live;
+        if tie != 0 {
+            left = ties(v, d, q3, tie, left);
+        }
+        // Exit slot (`EXIT_SLOT`) and the exiting vertex.
+        let s2 = left[0] & !left[1];
+        let s1 = !left[0] & left[2];
+        let s0 = !(s1 | s2);
+        let e = _mm512_mask_blend_epi32(
+            s1,
+            _mm512_mask_blend_epi32(s2, v.ids[0], v.ids[2]),
+            v.ids[1],
+        );
+        // Algorithm 3: the link of the exiting vertex's slot (3: none of
+        // the first three).
+        let mut slot = splat(3);
+        for (k, &vk) in vid[..3].iter().enumerate().rev() {
+            slot = _mm512_mask_blend_epi32(_mm512_cmpeq_epi32_mask(e, vk), slot, splat(k as i32));
+        }
+        let link = gather_words(
+            g,
+            _mm512_add_epi32(_mm512_add_epi32(base, splat(g.links)), slot),
+        );
+        // Commit.
+        let capped = _mm512_cmpge_epu32_mask(v.visited, splat(cap as i32));
+        let go = v.live & !(capped | lost);
+        for (k, sel) in [s0, s1, s2].into_iter().enumerate() {
+            let sel = go & sel;
+            v.ids[k] = _mm512_mask_blend_epi32(sel, v.ids[k], d);
+            for (qa, &na) in v.q[k].iter_mut().zip(&q3) {
+                *qa = _mm512_mask_blend_ps(sel, *qa, na);
+            }
+        }
+        v.visited = _mm512_mask_add_epi32(v.visited, go, v.visited, splat(1));
+        let is_tet = _mm512_cmplt_epu32_mask(link, splat(Link::BOUNDARY.0 as i32));
+        let moving = go & is_tet;
+        v.entry = _mm512_mask_blend_epi32(moving, v.entry, v.next);
+        v.next = _mm512_mask_blend_epi32(moving, v.next, link);
+        let mask = v.live & !moving;
+        (mask != 0).then(|| Events {
+            mask,
+            raw: bytemuck::cast::<__m512i, [u32; 16]>(link),
+            lost,
+            capped,
+        })
+    }
+
+    /// The scalar tie rule for the lanes of `tie`.
+    #[target_feature(enable = "avx512f")]
+    #[inline(never)]
+    #[cold]
+    fn ties(
+        v: &Pack,
+        d: __m512i,
+        q3: [__m512; 3],
+        tie: __mmask16,
+        left: [__mmask16; 3],
+    ) -> [__mmask16; 3] {
+        let f = |x: __m512| bytemuck::cast::<__m512, [f32; 16]>(x);
+        let u = |x: __m512i| bytemuck::cast::<__m512i, [u32; 16]>(x);
+        let (q, ids, d, q3) = (v.q.map(|p| p.map(f)), v.ids.map(u), u(d), q3.map(f));
+        let mut left = left;
+        for l in 0..16 {
+            if tie >> l & 1 == 0 {
+                continue;
+            }
+            let face = [0, 1, 2].map(|k| Vec3::new(q[k][0][l], q[k][1][l], q[k][2][l]));
+            let id = [ids[0][l], ids[1][l], ids[2][l]];
+            let pd = Vec3::new(q3[0][l], q3[1][l], q3[2][l]);
+            let m = v.proj[l].left_mask_ties(pd, d[l], &face, &id);
+            let bit = 1u16 << l;
+            for (k, lk) in left.iter_mut().enumerate() {
+                *lk = if m >> k & 1 != 0 {
+                    *lk | bit
+                } else {
+                    *lk & !bit
+                };
+            }
+        }
+        left
+    }
+
+    /// The cold part of a round: finish the lanes of `ev`, refill or park
+    /// them. Returns the number parked.
+    #[cold]
+    #[inline(never)]
+    #[target_feature(enable = "avx512f")]
+    fn events(
+        mesh: &TetMesh,
+        rays: &[Ray],
+        start: Starts<'_>,
+        queued: &mut Queue,
+        out: &mut [TraceOutcome],
+        v: &mut Pack,
+        ev: &Events,
+    ) -> usize {
+        let mut parked = 0;
+        for l in 0..16 {
+            if ev.mask >> l & 1 == 0 {
+                continue;
+            }
+            let adv = if ev.capped >> l & 1 != 0 {
+                Advance::Cap
+            } else if ev.lost >> l & 1 != 0 {
+                Advance::Lost
+            } else {
+                Advance::Face
+            };
+            let i = v.ray[l];
+            let mut lane = v.lane(l, ev.raw[l]);
+            match finish_step(mesh, &rays[i], &mut lane, adv) {
+                None => v.put(l, i, &lane),
+                Some(o) => {
+                    out[i] = o;
+                    match next_lane::<TripleF32>(mesh, rays, start, queued, out) {
+                        Some((j, lane)) => v.put(l, j, &lane),
+                        None => {
+                            v.park(l);
+                            parked += 1;
+                        }
+                    }
+                }
+            }
+        }
+        parked
+    }
+
+    /// The driver: two packs of 16 lanes stepped in turn.
+    #[target_feature(enable = "avx512f")]
+    fn run(
+        mesh: &TetMesh,
+        rw: RecordWords<'_>,
+        rays: &[Ray],
+        start: Starts<'_>,
+        cap: u32,
+        out: &mut [TraceOutcome],
+    ) {
+        let n = rays.len().min(out.len());
+        let (rays, out) = (&rays[..n], &mut out[..n]);
+        let g = Geo::new(mesh, &rw);
+        let mut queued = Queue::default();
+        let mut packs: [(Pack, usize); 2] =
+            std::array::from_fn(|_| Pack::fill(mesh, rays, start, &mut queued, out));
+        loop {
+            let mut any = false;
+            for (v, live) in packs.iter_mut() {
+                if *live == 0 {
+                    continue;
+                }
+                any = true;
+                if let Some(ev) = step(v, &g, cap) {
+                    *live -= events(mesh, rays, start, &mut queued, out, v, &ev);
+                }
+            }
+            if !any {
+                break;
+            }
+        }
+    }
+}
