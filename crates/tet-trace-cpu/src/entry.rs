@@ -24,7 +24,7 @@
 //! boundary edge gets one answer whichever face asks, so the symbolically
 //! perturbed line enters a closed convex boundary through exactly one face
 //! or through none. The face must also be ahead of the origin: the origin
-//! lies on or outside its plane (exact [`orient3d`]). [`BoundaryEntry::new`]
+//! lies on or outside its plane (exact `orient3d`). [`BoundaryEntry::new`]
 //! checks that the boundary is convex (every pair of boundary faces sharing
 //! an edge bends outward or is flat, exact); a walk that reaches the boundary
 //! reports a miss, which is right only for a convex mesh (a ray could

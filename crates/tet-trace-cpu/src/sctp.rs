@@ -22,7 +22,7 @@
 //! suffer from this (see the robustness census in `tests/robustness.rs`).
 //!
 //! Batches (a tile of primary rays) walk 16 rays in AVX-512 lockstep where
-//! the CPU has AVX-512F ([`crate::sctp_lockstep`], the same decisions bit
+//! the CPU has AVX-512F (`crate::sctp_lockstep`, the same decisions bit
 //! for bit), else the scalar interleaved walk: Torus Knots, 1920×1440, 2
 //! threads, 2.05 → 8.13 Mrays/s (neptun's ScTP: 2.79).
 

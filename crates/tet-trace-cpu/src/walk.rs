@@ -70,9 +70,10 @@
 //! Batches of [`DuffF32`] kernels (Tet20, Tet16, Tet32) take the SIMD
 //! lockstep walk of [`crate::lockstep`] instead (one ray per SIMD lane, the
 //! same operations lane by lane, identical outcomes; Tet20 43.5 instructions
-//! per step, about 2× the rays per CPU-second of the interleaved walk); the
-//! interleaved walk serves the other projections and stays the reference
-//! ([`crate::kernel::Interleaved`]).
+//! per step, about 2× the rays per CPU-second of the interleaved walk), and
+//! so do ScTP's ([`TripleF32`] on the baseline layout, with AVX-512:
+//! `crate::sctp_lockstep`); the interleaved walk serves the other
+//! projections and stays the reference ([`crate::kernel::Interleaved`]).
 //!
 //! Each kernel's operation count is in its module docs. The engine is generic
 //! over the projection (f32, f64, projected origin of Eq. 4–5, or the 3-D
@@ -439,7 +440,7 @@ impl Projection for TripleF32 {
     }
     const NAME: &'static str = "f32-stp";
     /// On x86-64 with AVX-512F over the baseline layout: 16 lanes in
-    /// lockstep ([`crate::sctp_lockstep`], identical outcomes); otherwise
+    /// lockstep (`crate::sctp_lockstep`, identical outcomes); otherwise
     /// the scalar interleaved walk.
     fn trace_batch<T: Topology>(
         mesh: &TetMesh,
