@@ -92,9 +92,7 @@ use glam::{Vec2, Vec3};
 use tet_core::{Link, TetMesh};
 
 use crate::ray::{Ray, TraceOutcome};
-use crate::walk::{
-    Advance, DuffF32, Face2, Lane, Queue, Starts, State, Topology, finish_step, next_lane,
-};
+use crate::walk::{DuffF32, Face2, Lane, Queue, Starts, State, Topology, finish_lane, next_lane};
 
 /// Lanes of the AVX2 lockstep walk (256-bit vectors of f32 / u32).
 pub const WIDE: usize = 8;
@@ -604,27 +602,14 @@ fn lane_events<const W: usize>(
         if events >> l & 1 == 0 {
             continue;
         }
-        // The order of the scalar `advance`: cap, then range, then face.
-        let adv = if round.capped[l] {
-            Advance::Cap
-        } else if round.lost[l] {
-            Advance::Lost
-        } else {
-            Advance::Face
-        };
         let i = pk.ray[l];
-        let mut lane = pk.get(l, round.raw[l]);
-        match finish_step(mesh, &rays[i], &mut lane, adv) {
-            None => pk.set(l, i, &lane),
-            Some(o) => {
-                out[i] = o;
-                match next_lane::<DuffF32>(mesh, rays, start, queued, out) {
-                    Some((j, lane)) => pk.set(l, j, &lane),
-                    None => {
-                        pk.park(l);
-                        parked += 1;
-                    }
-                }
+        let lane = pk.get(l, round.raw[l]);
+        let (capped, lost) = (round.capped[l], round.lost[l]);
+        match finish_lane(mesh, rays, start, queued, out, i, lane, capped, lost) {
+            Some((j, lane)) => pk.set(l, j, &lane),
+            None => {
+                pk.park(l);
+                parked += 1;
             }
         }
     }
@@ -1110,29 +1095,16 @@ pub(crate) mod avx512 {
             if events >> l & 1 == 0 {
                 continue;
             }
-            let adv = if round.capped[l] {
-                Advance::Cap
-            } else if round.lost[l] {
-                Advance::Lost
-            } else {
-                Advance::Face
-            };
-            let i = ray[l];
-            let mut lane = v.lane(l, round.raw[l]);
-            match finish_step(mesh, &rays[i], &mut lane, adv) {
-                None => v.put(l, &lane),
-                Some(o) => {
-                    out[i] = o;
-                    match next_lane::<DuffF32>(mesh, rays, start, queued, out) {
-                        Some((j, lane)) => {
-                            v.put(l, &lane);
-                            ray[l] = j;
-                        }
-                        None => {
-                            v.park(l);
-                            parked += 1;
-                        }
-                    }
+            let lane = v.lane(l, round.raw[l]);
+            let (capped, lost) = (round.capped[l], round.lost[l]);
+            match finish_lane(mesh, rays, start, queued, out, ray[l], lane, capped, lost) {
+                Some((j, lane)) => {
+                    v.put(l, &lane);
+                    ray[l] = j;
+                }
+                None => {
+                    v.park(l);
+                    parked += 1;
                 }
             }
         }

@@ -32,9 +32,7 @@ mod avx512 {
     use crate::lockstep::avx512::{gather_points, gather_words, gather_xy, splat};
     use crate::lockstep::{ExitRule, Geo, RecordWords};
     use crate::ray::{Ray, TraceOutcome};
-    use crate::walk::{
-        Advance, Lane, Queue, Starts, State, Topology, TripleF32, finish_step, next_lane,
-    };
+    use crate::walk::{Lane, Queue, Starts, State, Topology, TripleF32, finish_lane, next_lane};
 
     /// Traces the batch in lockstep when the CPU has AVX-512F and the
     /// layout exposes baseline records ([`ExitRule::Ids`]); false (nothing
@@ -330,26 +328,13 @@ mod avx512 {
             if ev.mask >> l & 1 == 0 {
                 continue;
             }
-            let adv = if ev.capped >> l & 1 != 0 {
-                Advance::Cap
-            } else if ev.lost >> l & 1 != 0 {
-                Advance::Lost
-            } else {
-                Advance::Face
-            };
-            let i = v.ray[l];
-            let mut lane = v.lane(l, ev.raw[l]);
-            match finish_step(mesh, &rays[i], &mut lane, adv) {
-                None => v.put(l, i, &lane),
-                Some(o) => {
-                    out[i] = o;
-                    match next_lane::<TripleF32>(mesh, rays, start, queued, out) {
-                        Some((j, lane)) => v.put(l, j, &lane),
-                        None => {
-                            v.park(l);
-                            parked += 1;
-                        }
-                    }
+            let lane = v.lane(l, ev.raw[l]);
+            let (capped, lost) = (ev.capped >> l & 1 != 0, ev.lost >> l & 1 != 0);
+            match finish_lane(mesh, rays, start, queued, out, v.ray[l], lane, capped, lost) {
+                Some((j, lane)) => v.put(l, j, &lane),
+                None => {
+                    v.park(l);
+                    parked += 1;
                 }
             }
         }

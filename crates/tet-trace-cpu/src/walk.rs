@@ -1157,6 +1157,40 @@ pub(crate) fn advance<P: Projection, T: Topology>(
     }
 }
 
+/// The cold path of a SIMD lane that stopped in a round (`capped`: at the
+/// step cap, `lost`: its new vertex out of range, else at a non-tet link,
+/// checked in the order of [`advance`]): finishes ray `i`'s step, and when
+/// its walk ended stores the outcome and starts the next queued ray. The
+/// ray and lane to load back into the slot (the same ray walking on, or the
+/// next one), or `None` when the batch has no ray left (park the slot).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn finish_lane<P: Projection>(
+    mesh: &TetMesh,
+    rays: &[Ray],
+    start: Starts<'_>,
+    queued: &mut Queue,
+    out: &mut [TraceOutcome],
+    i: usize,
+    mut lane: Lane<P>,
+    capped: bool,
+    lost: bool,
+) -> Option<(usize, Lane<P>)> {
+    let adv = if capped {
+        Advance::Cap
+    } else if lost {
+        Advance::Lost
+    } else {
+        Advance::Face
+    };
+    match finish_step(mesh, &rays[i], &mut lane, adv) {
+        None => Some((i, lane)),
+        Some(o) => {
+            out[i] = o;
+            next_lane::<P>(mesh, rays, start, queued, out)
+        }
+    }
+}
+
 /// The rare outcomes of [`advance`]: `Some` when the walk ended, `None` when
 /// it crossed a constrained face before `t_min` and goes on.
 #[cold]
