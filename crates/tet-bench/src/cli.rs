@@ -53,7 +53,7 @@ pub struct BuildFlags {
     pub no_box: bool,
     /// Make the enclosing box hold the camera and lights too (10 % margin),
     /// so that primary rays start in the camera's tet; by default it is
-    /// tight around the scene (1 % margin) and rays from a camera outside
+    /// tight around the scene (0.2 % margin) and rays from a camera outside
     /// enter through the mesh boundary.
     #[arg(long, conflicts_with = "no_box")]
     pub wide_box: bool,

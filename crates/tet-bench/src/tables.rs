@@ -990,7 +990,7 @@ pub fn markdown(doc: &TablesDoc) -> String {
     );
     let _ = writeln!(
         m,
-        "Tight: the enclosing box holds the scene only (1 % margin) and primary rays from the camera outside enter through the mesh boundary (rays that miss it visit no tet). Wide (`--wide-box`): the box also holds the camera and lights (10 % margin), as in the papers' meshes, and every ray walks from the camera's tet.\n"
+        "Tight: the enclosing box holds the scene only (0.2 % margin) and primary rays from the camera outside enter through the mesh boundary (rays that miss it visit no tet). Wide (`--wide-box`): the box also holds the camera and lights (10 % margin), as in the papers' meshes, and every ray walks from the camera's tet.\n"
     );
     let _ = writeln!(
         m,
