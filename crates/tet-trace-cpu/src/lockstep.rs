@@ -966,6 +966,7 @@ pub(crate) mod avx512 {
     use std::arch::x86_64::*;
 
     use super::*;
+    use crate::walk::{Advance, Resolved, stop};
 
     /// [`Pack`] in registers (the hot fields only).
     #[derive(Clone, Copy)]
@@ -1001,38 +1002,6 @@ pub(crate) mod avx512 {
                 entry: u(pk.entry),
                 visited: u(pk.visited),
                 live,
-            }
-        }
-
-        /// Lane `l` as a scalar lane; `tet` and `link` as the scalar
-        /// `advance` leaves them for `finish_step` (see [`Pack::get`]).
-        #[target_feature(enable = "avx512f")]
-        fn lane(&self, l: usize, link: u32) -> Lane<DuffF32> {
-            // One permute per field brings lane `l` to element 0.
-            let at = _mm512_set1_epi32(l as i32);
-            let f = |x: __m512| _mm512_cvtss_f32(_mm512_permutexvar_ps(at, x));
-            let u = |x: __m512i| {
-                _mm_cvtsi128_si32(_mm512_castsi512_si128(_mm512_permutexvar_epi32(at, x))) as u32
-            };
-            let col = |a: usize| glam::Vec4::new(f(self.c[a][0]), f(self.c[a][1]), 0.0, 0.0);
-            let pt = |k: usize| Vec2::new(f(self.xs[k]), f(self.ys[k]));
-            let next = u(self.next);
-            Lane {
-                proj: DuffF32 {
-                    o: Vec3::new(f(self.o[0]), f(self.o[1]), f(self.o[2])),
-                    cx: col(0),
-                    cy: col(1),
-                    cz: col(2),
-                },
-                st: State {
-                    tet: next,
-                    ids: [u(self.ids[0]), u(self.ids[1]), u(self.ids[2])],
-                    p: Face2::new([pt(0), pt(1), pt(2)]),
-                    link,
-                    visited: u(self.visited),
-                },
-                next,
-                entry_raw: u(self.entry),
             }
         }
 
@@ -1095,16 +1064,33 @@ pub(crate) mod avx512 {
             if events >> l & 1 == 0 {
                 continue;
             }
-            let lane = v.lane(l, round.raw[l]);
-            let (capped, lost) = (round.capped[l], round.lost[l]);
-            match finish_lane(mesh, rays, start, queued, out, ray[l], lane, capped, lost) {
-                Some((j, lane)) => {
-                    v.put(l, &lane);
-                    ray[l] = j;
+            // Only what ending or crossing needs is read from the registers;
+            // a lane that crosses keeps them all but its next tet.
+            let k: __mmask16 = 1 << l;
+            let at = _mm512_set1_epi32(l as i32);
+            let u = |x: __m512i| {
+                _mm_cvtsi128_si32(_mm512_castsi512_si128(_mm512_permutexvar_epi32(at, x))) as u32
+            };
+            let ids = [u(v.ids[0]), u(v.ids[1]), u(v.ids[2])];
+            let (tet, visited, link) = (u(v.next), u(v.visited), round.raw[l]);
+            let adv = Advance::stopped(round.capped[l], round.lost[l]);
+            match stop(mesh, &rays[ray[l]], adv, ids, tet, visited, link) {
+                Resolved::Cross(n) => {
+                    v.entry = _mm512_mask_set1_epi32(v.entry, k, link as i32);
+                    v.next = _mm512_mask_set1_epi32(v.next, k, n as i32);
                 }
-                None => {
-                    v.park(l);
-                    parked += 1;
+                Resolved::Done(o) => {
+                    out[ray[l]] = o;
+                    match next_lane::<DuffF32>(mesh, rays, start, queued, out) {
+                        Some((j, lane)) => {
+                            v.put(l, &lane);
+                            ray[l] = j;
+                        }
+                        None => {
+                            v.park(l);
+                            parked += 1;
+                        }
+                    }
                 }
             }
         }

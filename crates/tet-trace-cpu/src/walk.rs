@@ -1175,14 +1175,7 @@ pub(crate) fn finish_lane<P: Projection>(
     capped: bool,
     lost: bool,
 ) -> Option<(usize, Lane<P>)> {
-    let adv = if capped {
-        Advance::Cap
-    } else if lost {
-        Advance::Lost
-    } else {
-        Advance::Face
-    };
-    match finish_step(mesh, &rays[i], &mut lane, adv) {
+    match finish_step(mesh, &rays[i], &mut lane, Advance::stopped(capped, lost)) {
         None => Some((i, lane)),
         Some(o) => {
             out[i] = o;
@@ -1201,25 +1194,63 @@ pub(crate) fn finish_step<P: Projection>(
     lane: &mut Lane<P>,
     adv: Advance,
 ) -> Option<TraceOutcome> {
+    if adv == Advance::Go {
+        return None;
+    }
     let st = &lane.st;
+    match stop(mesh, ray, adv, st.ids, st.tet, st.visited, st.link) {
+        Resolved::Done(out) => Some(out),
+        Resolved::Cross(n) => {
+            lane.entry_raw = st.link;
+            lane.next = n;
+            None
+        }
+    }
+}
+
+/// Where a walk that stopped with `adv` (not [`Advance::Go`]) goes, from
+/// the few fields this needs: the entry face `ids` of tet `tet` just
+/// entered, the tets `visited` and the exit link `link`. The SIMD walks call
+/// it with fields read from their registers.
+pub(crate) fn stop(
+    mesh: &TetMesh,
+    ray: &Ray,
+    adv: Advance,
+    ids: [u32; 3],
+    tet: u32,
+    visited: u32,
+    link: u32,
+) -> Resolved {
     let failed = |failure| {
-        Some(TraceOutcome::Failed {
+        Resolved::Done(TraceOutcome::Failed {
             failure,
-            tets_visited: st.visited,
+            tets_visited: visited,
         })
     };
     match adv {
-        Advance::Go => None,
         Advance::Cap => failed(Failure::StepCap),
         Advance::Lost => failed(Failure::Lost),
-        Advance::Face => match resolve_face(mesh, ray, st, Link(st.link)) {
-            Resolved::Done(out) => Some(out),
-            Resolved::Cross(n) => {
-                lane.entry_raw = st.link;
-                lane.next = n;
-                None
-            }
+        Advance::Go | Advance::Face => match Link(link).as_constrained() {
+            Some(c) => resolve_constrained(mesh, ray, c, ids, tet, visited),
+            None => Resolved::Done(TraceOutcome::Miss {
+                tets_visited: visited,
+            }),
         },
+    }
+}
+
+impl Advance {
+    /// The stop of a SIMD lane that did not move on in a round, checked in
+    /// the order of [`advance`]: the step cap, then a new vertex out of
+    /// range, else a non-tet exit link.
+    pub(crate) fn stopped(capped: bool, lost: bool) -> Advance {
+        if capped {
+            Advance::Cap
+        } else if lost {
+            Advance::Lost
+        } else {
+            Advance::Face
+        }
     }
 }
 
