@@ -1067,10 +1067,7 @@ pub(crate) mod avx512 {
             // Only what ending or crossing needs is read from the registers;
             // a lane that crosses keeps them all but its next tet.
             let k: __mmask16 = 1 << l;
-            let at = _mm512_set1_epi32(l as i32);
-            let u = |x: __m512i| {
-                _mm_cvtsi128_si32(_mm512_castsi512_si128(_mm512_permutexvar_epi32(at, x))) as u32
-            };
+            let u = |x: __m512i| lane_u32(x, l);
             let ids = [u(v.ids[0]), u(v.ids[1]), u(v.ids[2])];
             let (tet, visited, link) = (u(v.next), u(v.visited), round.raw[l]);
             let adv = Advance::stopped(round.capped[l], round.lost[l]);
@@ -1095,6 +1092,14 @@ pub(crate) mod avx512 {
             }
         }
         parked
+    }
+
+    /// Element `l` of `x` (one permute brings it to element 0).
+    #[target_feature(enable = "avx512f")]
+    #[inline]
+    pub(crate) fn lane_u32(x: __m512i, l: usize) -> u32 {
+        let at = _mm512_set1_epi32(l as i32);
+        _mm_cvtsi128_si32(_mm512_castsi512_si128(_mm512_permutexvar_epi32(at, x))) as u32
     }
 
     #[target_feature(enable = "avx512f")]

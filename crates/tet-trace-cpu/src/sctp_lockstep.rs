@@ -29,10 +29,12 @@ mod avx512 {
     use glam::Vec3;
     use tet_core::{Link, TetMesh};
 
-    use crate::lockstep::avx512::{gather_points, gather_words, gather_xy, splat};
+    use crate::lockstep::avx512::{gather_points, gather_words, gather_xy, lane_u32, splat};
     use crate::lockstep::{ExitRule, Geo, RecordWords};
     use crate::ray::{Ray, TraceOutcome};
-    use crate::walk::{Lane, Queue, Starts, State, Topology, TripleF32, finish_lane, next_lane};
+    use crate::walk::{
+        Advance, Lane, Queue, Resolved, Starts, Topology, TripleF32, next_lane, stop,
+    };
 
     /// Traces the batch in lockstep when the CPU has AVX-512F and the
     /// layout exposes baseline records ([`ExitRule::Ids`]); false (nothing
@@ -84,31 +86,6 @@ mod avx512 {
     }
 
     impl Pack {
-        /// Lane `l` as a scalar lane, `tet` and `link` as `advance` leaves
-        /// them for `finish_step`.
-        #[target_feature(enable = "avx512f")]
-        fn lane(&self, l: usize, link: u32) -> Lane<TripleF32> {
-            let at = _mm512_set1_epi32(l as i32);
-            let f = |x: __m512| _mm512_cvtss_f32(_mm512_permutexvar_ps(at, x));
-            let u = |x: __m512i| {
-                _mm_cvtsi128_si32(_mm512_castsi512_si128(_mm512_permutexvar_epi32(at, x))) as u32
-            };
-            let pt = |k: usize| Vec3::new(f(self.q[k][0]), f(self.q[k][1]), f(self.q[k][2]));
-            let next = u(self.next);
-            Lane {
-                proj: self.proj[l],
-                st: State {
-                    tet: next,
-                    ids: [u(self.ids[0]), u(self.ids[1]), u(self.ids[2])],
-                    p: [pt(0), pt(1), pt(2)],
-                    link,
-                    visited: u(self.visited),
-                },
-                next,
-                entry_raw: u(self.entry),
-            }
-        }
-
         /// Loads scalar lane `lane` of ray `ray` into lane `l`.
         #[target_feature(enable = "avx512f")]
         fn put(&mut self, l: usize, ray: usize, lane: &Lane<TripleF32>) {
@@ -328,13 +305,25 @@ mod avx512 {
             if ev.mask >> l & 1 == 0 {
                 continue;
             }
-            let lane = v.lane(l, ev.raw[l]);
-            let (capped, lost) = (ev.capped >> l & 1 != 0, ev.lost >> l & 1 != 0);
-            match finish_lane(mesh, rays, start, queued, out, v.ray[l], lane, capped, lost) {
-                Some((j, lane)) => v.put(l, j, &lane),
-                None => {
-                    v.park(l);
-                    parked += 1;
+            let k: __mmask16 = 1 << l;
+            let u = |x: __m512i| lane_u32(x, l);
+            let ids = [u(v.ids[0]), u(v.ids[1]), u(v.ids[2])];
+            let (tet, visited, link, i) = (u(v.next), u(v.visited), ev.raw[l], v.ray[l]);
+            let adv = Advance::stopped(ev.capped & k != 0, ev.lost & k != 0);
+            match stop(mesh, &rays[i], adv, ids, tet, visited, link) {
+                Resolved::Cross(n) => {
+                    v.entry = _mm512_mask_set1_epi32(v.entry, k, link as i32);
+                    v.next = _mm512_mask_set1_epi32(v.next, k, n as i32);
+                }
+                Resolved::Done(o) => {
+                    out[i] = o;
+                    match next_lane::<TripleF32>(mesh, rays, start, queued, out) {
+                        Some((j, lane)) => v.put(l, j, &lane),
+                        None => {
+                            v.park(l);
+                            parked += 1;
+                        }
+                    }
                 }
             }
         }
