@@ -72,6 +72,20 @@ fn build_then_info_reports_exact_layout_bytes() {
     }
     // The torus knot is closed: two regions (inside and outside the tube).
     assert_eq!(info["regions"]["count"], 2);
+
+    // The tight box leaves the camera and the light outside the mesh: rays
+    // from there enter through the boundary, so the region around the tube
+    // is kept and the tube's inside, which no ray reaches, is removed.
+    let pruned = json(&["info", file, "--prune"]);
+    let p = &pruned["pruned"];
+    assert_eq!(p["regions_kept"], 1, "{p}");
+    assert_eq!(p["regions_removed"], 1, "{p}");
+    let removed = p["tets_removed"].as_u64().unwrap() as usize;
+    assert!(removed > 0 && removed < tets / 2, "{removed} of {tets}");
+    assert_eq!(
+        p["constrained_removed"], 0,
+        "the tube's faces keep their outer side"
+    );
 }
 
 #[test]
