@@ -82,11 +82,12 @@
 //!
 //! Later, with the tight enclosing box (40.9 tets per ray, rays entering
 //! through the boundary) and the AVX-512 walk (packs kept in registers,
-//! only event lanes rewritten, `x, y` gathered as one 64-bit pair): tet20
-//! 10.15 Mrays/s against 8.62 with `TET_LOCKSTEP=avx2`, same build, same
-//! machine (`tet-bench render FILE --method tet20 --width 1920 --height
-//! 1440 --threads 2 --frames 5`). Three packs of 16 in flight: 3–4 %
-//! slower than two; one: 13 % slower.
+//! only the fields a stopped lane needs read, `x, y` gathered as one 64-bit
+//! pair): tet20 11.06 Mrays/s; the AVX2 walk (`TET_LOCKSTEP=avx2`, packs
+//! likewise kept in registers) 9.65, same build, same machine (`tet-bench
+//! render FILE --method tet20 --width 1920 --height 1440 --threads 2
+//! --frames 5`). Three packs of 16 in flight: 3–4 % slower than two; one:
+//! 13 % slower.
 
 use glam::{Vec2, Vec3};
 use tet_core::{Link, TetMesh};
@@ -669,6 +670,7 @@ mod avx2 {
     use std::arch::x86_64::*;
 
     use super::*;
+    use crate::walk::{Advance, Resolved, stop};
 
     /// [`Pack`] in registers (the hot fields only).
     #[derive(Clone, Copy)]
@@ -702,19 +704,110 @@ mod avx2 {
             }
         }
 
-        /// Writes the hot fields back (lane bookkeeping stays in `pk`).
-        fn store(&self, pk: &mut Pack<8>) {
-            let f = |a: __m256| bytemuck::cast::<__m256, [f32; 8]>(a);
-            let u = |a: __m256i| bytemuck::cast::<__m256i, [u32; 8]>(a);
-            pk.o = self.o.map(f);
-            pk.c = self.c.map(|a| a.map(f));
-            pk.ids = self.ids.map(u);
-            pk.xs = self.xs.map(f);
-            pk.ys = self.ys.map(f);
-            pk.next = u(self.next);
-            pk.entry = u(self.entry);
-            pk.visited = u(self.visited);
+        /// Loads scalar lane `lane` into lane `l` (blends of broadcasts: the
+        /// other lanes stay in their registers).
+        #[target_feature(enable = "avx2")]
+        fn put(&mut self, l: usize, lane: &Lane<DuffF32>) {
+            let sel = lane_mask(l);
+            let self_ps = _mm256_castsi256_ps(sel);
+            let f = |x: &mut __m256, v: f32| *x = _mm256_blendv_ps(*x, _mm256_set1_ps(v), self_ps);
+            let u = |x: &mut __m256i, v: u32| {
+                *x = _mm256_blendv_epi8(*x, _mm256_set1_epi32(v as i32), sel)
+            };
+            let p = lane.proj;
+            f(&mut self.o[0], p.o.x);
+            f(&mut self.o[1], p.o.y);
+            f(&mut self.o[2], p.o.z);
+            for (a, col) in [p.cx, p.cy, p.cz].iter().enumerate() {
+                f(&mut self.c[a][0], col.x);
+                f(&mut self.c[a][1], col.y);
+            }
+            for s in 0..3 {
+                u(&mut self.ids[s], lane.st.ids[s]);
+                f(&mut self.xs[s], lane.st.p.xs[s]);
+                f(&mut self.ys[s], lane.st.p.ys[s]);
+            }
+            u(&mut self.next, lane.next);
+            u(&mut self.entry, lane.entry_raw);
+            u(&mut self.visited, lane.st.visited);
+            self.live = _mm256_or_si256(self.live, sel);
         }
+
+        /// Parks lane `l` (tet 0 keeps its loads in range).
+        #[target_feature(enable = "avx2")]
+        fn park(&mut self, l: usize) {
+            let sel = lane_mask(l);
+            self.live = _mm256_andnot_si256(sel, self.live);
+            self.next = _mm256_andnot_si256(sel, self.next);
+        }
+    }
+
+    /// All ones in lane `l`, zeros elsewhere.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn lane_mask(l: usize) -> __m256i {
+        _mm256_cmpeq_epi32(
+            _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
+            _mm256_set1_epi32(l as i32),
+        )
+    }
+
+    /// Element `l` of `x`.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn lane_u32(x: __m256i, l: usize) -> u32 {
+        _mm256_cvtsi256_si32(_mm256_permutevar8x32_epi32(x, _mm256_set1_epi32(l as i32))) as u32
+    }
+
+    /// The cold part of a round in registers (as the AVX-512 walk's): a
+    /// stopped lane reads only what ending or crossing needs; a crossing
+    /// rewrites its next tet and entry link. Returns the lanes parked.
+    #[cold]
+    #[inline(never)]
+    #[target_feature(enable = "avx2")]
+    #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
+    fn events8(
+        mesh: &TetMesh,
+        rays: &[Ray],
+        start: Starts<'_>,
+        queued: &mut Queue,
+        out: &mut [TraceOutcome],
+        v: &mut V8,
+        ray: &mut [usize; 8],
+        events: u32,
+        round: &Round<8>,
+    ) -> usize {
+        let mut parked = 0;
+        for l in 0..8 {
+            if events >> l & 1 == 0 {
+                continue;
+            }
+            let u = |x: __m256i| lane_u32(x, l);
+            let ids = [u(v.ids[0]), u(v.ids[1]), u(v.ids[2])];
+            let (tet, visited, link) = (u(v.next), u(v.visited), round.raw[l]);
+            let adv = Advance::stopped(round.capped[l], round.lost[l]);
+            match stop(mesh, &rays[ray[l]], adv, ids, tet, visited, link) {
+                Resolved::Cross(n) => {
+                    let sel = lane_mask(l);
+                    v.entry = _mm256_blendv_epi8(v.entry, _mm256_set1_epi32(link as i32), sel);
+                    v.next = _mm256_blendv_epi8(v.next, _mm256_set1_epi32(n as i32), sel);
+                }
+                Resolved::Done(o) => {
+                    out[ray[l]] = o;
+                    match next_lane::<DuffF32>(mesh, rays, start, queued, out) {
+                        Some((j, lane)) => {
+                            v.put(l, &lane);
+                            ray[l] = j;
+                        }
+                        None => {
+                            v.park(l);
+                            parked += 1;
+                        }
+                    }
+                }
+            }
+        }
+        parked
     }
 
     #[target_feature(enable = "avx2")]
@@ -930,21 +1023,29 @@ mod avx2 {
         let mut queued = Queue::default();
         // `GROUPS` independent packs of 8 lanes, stepped in turn: the
         // out-of-order core overlaps their dependent gather chains.
-        let mut pks: [(Pack<8>, usize); GROUPS] =
-            std::array::from_fn(|_| fill::<8>(mesh, rays, start, &mut queued, out));
-        let mut vs: [V8; GROUPS] = std::array::from_fn(|k| V8::load(&pks[k].0));
+        let mut groups: [(V8, [usize; 8], usize); GROUPS] = std::array::from_fn(|_| {
+            let (pk, live) = fill::<8>(mesh, rays, start, &mut queued, out);
+            (V8::load(&pk), pk.ray, live)
+        });
         loop {
             let mut any = false;
-            for (v, (pk, live)) in vs.iter_mut().zip(pks.iter_mut()) {
+            for (v, ray, live) in groups.iter_mut() {
                 if *live == 0 {
                     continue;
                 }
                 any = true;
                 if let Some(c) = step::<RULE>(v, &g, cap) {
-                    v.store(pk);
-                    *live -=
-                        lane_events(mesh, rays, start, &mut queued, out, pk, c.events, &c.round);
-                    *v = V8::load(pk);
+                    *live -= events8(
+                        mesh,
+                        rays,
+                        start,
+                        &mut queued,
+                        out,
+                        v,
+                        ray,
+                        c.events,
+                        &c.round,
+                    );
                 }
             }
             if !any {
