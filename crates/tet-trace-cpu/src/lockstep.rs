@@ -93,7 +93,9 @@ use glam::{Vec2, Vec3};
 use tet_core::{Link, TetMesh};
 
 use crate::ray::{Ray, TraceOutcome};
-use crate::walk::{DuffF32, Face2, Lane, Queue, Starts, State, Topology, finish_lane, next_lane};
+use crate::walk::{
+    Advance, AfterStop, DuffF32, Face2, Lane, Queue, Starts, Topology, after_stop, next_lane,
+};
 
 /// Lanes of the AVX2 lockstep walk (256-bit vectors of f32 / u32).
 pub const WIDE: usize = 8;
@@ -368,24 +370,6 @@ impl<const W: usize> Pack<W> {
         self.proj[l] = p;
     }
 
-    /// Slot `l` as a scalar lane; `tet` and `link` as the scalar `advance`
-    /// leaves them for `finish_step` (the tet entered, its exit link).
-    fn get(&self, l: usize, link: u32) -> Lane<DuffF32> {
-        let pt = |k: usize| Vec2::new(self.xs[k][l], self.ys[k][l]);
-        Lane {
-            proj: self.proj[l],
-            st: State {
-                tet: self.next[l],
-                ids: [self.ids[0][l], self.ids[1][l], self.ids[2][l]],
-                p: Face2::new([pt(0), pt(1), pt(2)]),
-                link,
-                visited: self.visited[l],
-            },
-            next: self.next[l],
-            entry_raw: self.entry[l],
-        }
-    }
-
     /// Parks slot `l`: tet 0 (exists whenever a walk started) keeps its
     /// loads in range.
     fn park(&mut self, l: usize) {
@@ -603,12 +587,18 @@ fn lane_events<const W: usize>(
         if events >> l & 1 == 0 {
             continue;
         }
-        let i = pk.ray[l];
-        let lane = pk.get(l, round.raw[l]);
-        let (capped, lost) = (round.capped[l], round.lost[l]);
-        match finish_lane(mesh, rays, start, queued, out, i, lane, capped, lost) {
-            Some((j, lane)) => pk.set(l, j, &lane),
-            None => {
+        let ids = [pk.ids[0][l], pk.ids[1][l], pk.ids[2][l]];
+        let adv = Advance::stopped(round.capped[l], round.lost[l]);
+        let (tet, visited, link) = (pk.next[l], pk.visited[l], round.raw[l]);
+        match after_stop(
+            mesh, rays, start, queued, out, pk.ray[l], adv, ids, tet, visited, link,
+        ) {
+            AfterStop::Cross(n) => {
+                pk.entry[l] = link;
+                pk.next[l] = n;
+            }
+            AfterStop::Refill(j, lane) => pk.set(l, j, &lane),
+            AfterStop::Park => {
                 pk.park(l);
                 parked += 1;
             }
@@ -670,7 +660,6 @@ mod avx2 {
     use std::arch::x86_64::*;
 
     use super::*;
-    use crate::walk::{Advance, Resolved, stop};
 
     /// [`Pack`] in registers (the hot fields only).
     #[derive(Clone, Copy)]
@@ -786,24 +775,21 @@ mod avx2 {
             let ids = [u(v.ids[0]), u(v.ids[1]), u(v.ids[2])];
             let (tet, visited, link) = (u(v.next), u(v.visited), round.raw[l]);
             let adv = Advance::stopped(round.capped[l], round.lost[l]);
-            match stop(mesh, &rays[ray[l]], adv, ids, tet, visited, link) {
-                Resolved::Cross(n) => {
+            match after_stop(
+                mesh, rays, start, queued, out, ray[l], adv, ids, tet, visited, link,
+            ) {
+                AfterStop::Cross(n) => {
                     let sel = lane_mask(l);
                     v.entry = _mm256_blendv_epi8(v.entry, _mm256_set1_epi32(link as i32), sel);
                     v.next = _mm256_blendv_epi8(v.next, _mm256_set1_epi32(n as i32), sel);
                 }
-                Resolved::Done(o) => {
-                    out[ray[l]] = o;
-                    match next_lane::<DuffF32>(mesh, rays, start, queued, out) {
-                        Some((j, lane)) => {
-                            v.put(l, &lane);
-                            ray[l] = j;
-                        }
-                        None => {
-                            v.park(l);
-                            parked += 1;
-                        }
-                    }
+                AfterStop::Refill(j, lane) => {
+                    v.put(l, &lane);
+                    ray[l] = j;
+                }
+                AfterStop::Park => {
+                    v.park(l);
+                    parked += 1;
                 }
             }
         }
@@ -1067,7 +1053,6 @@ pub(crate) mod avx512 {
     use std::arch::x86_64::*;
 
     use super::*;
-    use crate::walk::{Advance, Resolved, stop};
 
     /// [`Pack`] in registers (the hot fields only).
     #[derive(Clone, Copy)]
@@ -1172,23 +1157,20 @@ pub(crate) mod avx512 {
             let ids = [u(v.ids[0]), u(v.ids[1]), u(v.ids[2])];
             let (tet, visited, link) = (u(v.next), u(v.visited), round.raw[l]);
             let adv = Advance::stopped(round.capped[l], round.lost[l]);
-            match stop(mesh, &rays[ray[l]], adv, ids, tet, visited, link) {
-                Resolved::Cross(n) => {
+            match after_stop(
+                mesh, rays, start, queued, out, ray[l], adv, ids, tet, visited, link,
+            ) {
+                AfterStop::Cross(n) => {
                     v.entry = _mm512_mask_set1_epi32(v.entry, k, link as i32);
                     v.next = _mm512_mask_set1_epi32(v.next, k, n as i32);
                 }
-                Resolved::Done(o) => {
-                    out[ray[l]] = o;
-                    match next_lane::<DuffF32>(mesh, rays, start, queued, out) {
-                        Some((j, lane)) => {
-                            v.put(l, &lane);
-                            ray[l] = j;
-                        }
-                        None => {
-                            v.park(l);
-                            parked += 1;
-                        }
-                    }
+                AfterStop::Refill(j, lane) => {
+                    v.put(l, &lane);
+                    ray[l] = j;
+                }
+                AfterStop::Park => {
+                    v.park(l);
+                    parked += 1;
                 }
             }
         }

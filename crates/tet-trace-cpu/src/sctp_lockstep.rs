@@ -33,7 +33,7 @@ mod avx512 {
     use crate::lockstep::{ExitRule, Geo, RecordWords};
     use crate::ray::{Ray, TraceOutcome};
     use crate::walk::{
-        Advance, Lane, Queue, Resolved, Starts, Topology, TripleF32, next_lane, stop,
+        Advance, AfterStop, Lane, Queue, Starts, Topology, TripleF32, after_stop, next_lane,
     };
 
     /// Traces the batch in lockstep when the CPU has AVX-512F and the
@@ -310,20 +310,17 @@ mod avx512 {
             let ids = [u(v.ids[0]), u(v.ids[1]), u(v.ids[2])];
             let (tet, visited, link, i) = (u(v.next), u(v.visited), ev.raw[l], v.ray[l]);
             let adv = Advance::stopped(ev.capped & k != 0, ev.lost & k != 0);
-            match stop(mesh, &rays[i], adv, ids, tet, visited, link) {
-                Resolved::Cross(n) => {
+            match after_stop(
+                mesh, rays, start, queued, out, i, adv, ids, tet, visited, link,
+            ) {
+                AfterStop::Cross(n) => {
                     v.entry = _mm512_mask_set1_epi32(v.entry, k, link as i32);
                     v.next = _mm512_mask_set1_epi32(v.next, k, n as i32);
                 }
-                Resolved::Done(o) => {
-                    out[i] = o;
-                    match next_lane::<TripleF32>(mesh, rays, start, queued, out) {
-                        Some((j, lane)) => v.put(l, j, &lane),
-                        None => {
-                            v.park(l);
-                            parked += 1;
-                        }
-                    }
+                AfterStop::Refill(j, lane) => v.put(l, j, &lane),
+                AfterStop::Park => {
+                    v.park(l);
+                    parked += 1;
                 }
             }
         }

@@ -1157,29 +1157,44 @@ pub(crate) fn advance<P: Projection, T: Topology>(
     }
 }
 
-/// The cold path of a SIMD lane that stopped in a round (`capped`: at the
-/// step cap, `lost`: its new vertex out of range, else at a non-tet link,
-/// checked in the order of [`advance`]): finishes ray `i`'s step, and when
-/// its walk ended stores the outcome and starts the next queued ray. The
-/// ray and lane to load back into the slot (the same ray walking on, or the
-/// next one), or `None` when the batch has no ray left (park the slot).
+/// What a SIMD slot does after its lane stopped in a round.
+pub(crate) enum AfterStop<P: Projection> {
+    /// The ray crossed a constrained face before `t_min` and walks on:
+    /// its next tet, entered through the raw link it stopped at.
+    Cross(u32),
+    /// Its walk ended (outcome stored): load this ray and lane instead.
+    Refill(usize, Lane<P>),
+    /// Its walk ended and the batch has no ray left: park the slot.
+    Park,
+}
+
+/// The cold path of the SIMD walks: ray `i` stopped with `adv` (see
+/// [`Advance::stopped`]) in tet `tet` entered through face `ids`, after
+/// `visited` tets, at exit link `link` (the fields [`stop`] needs, read from
+/// the walk's registers). Stores its outcome when its walk ended and starts
+/// the next queued ray.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn finish_lane<P: Projection>(
+pub(crate) fn after_stop<P: Projection>(
     mesh: &TetMesh,
     rays: &[Ray],
     start: Starts<'_>,
     queued: &mut Queue,
     out: &mut [TraceOutcome],
     i: usize,
-    mut lane: Lane<P>,
-    capped: bool,
-    lost: bool,
-) -> Option<(usize, Lane<P>)> {
-    match finish_step(mesh, &rays[i], &mut lane, Advance::stopped(capped, lost)) {
-        None => Some((i, lane)),
-        Some(o) => {
+    adv: Advance,
+    ids: [u32; 3],
+    tet: u32,
+    visited: u32,
+    link: u32,
+) -> AfterStop<P> {
+    match stop(mesh, &rays[i], adv, ids, tet, visited, link) {
+        Resolved::Cross(n) => AfterStop::Cross(n),
+        Resolved::Done(o) => {
             out[i] = o;
-            next_lane::<P>(mesh, rays, start, queued, out)
+            match next_lane::<P>(mesh, rays, start, queued, out) {
+                Some((j, lane)) => AfterStop::Refill(j, lane),
+                None => AfterStop::Park,
+            }
         }
     }
 }
