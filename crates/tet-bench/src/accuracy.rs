@@ -61,12 +61,7 @@ fn a3(v: Vec3) -> Vec3A {
 
 /// Grazing tolerance of a mesh (see the module docs).
 pub fn tolerance(mesh: &TetMesh) -> f64 {
-    let (lo, hi) = mesh
-        .points
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
-            (a.min(*p), b.max(*p))
-        });
+    let (lo, hi) = mesh.point_bounds();
     let diag = (hi - lo).length() as f64;
     let mag = lo.abs().max(hi.abs()).max_element() as f64;
     (1e-5 * diag).max(4e-7 * mag)

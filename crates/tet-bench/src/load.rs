@@ -265,12 +265,7 @@ pub fn build_scene_in(
 /// mesh's bounding box (inside the enclosing box a build adds), looking at
 /// the centre, so that walks can start in the tet containing it.
 pub fn framing_camera(mesh: &TetMesh) -> Camera {
-    let (min, max) = mesh
-        .points
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
-            (a.min(*p), b.max(*p))
-        });
+    let (min, max) = mesh.point_bounds();
     if !min.is_finite() {
         return Camera::default();
     }

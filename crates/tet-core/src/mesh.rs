@@ -204,6 +204,16 @@ impl TetMesh {
             .is_some_and(|l| *l == Link::BOUNDARY)
     }
 
+    /// The bounds `(min, max)` of the points (infinite and inverted when
+    /// there are none). Every tet lies inside them.
+    pub fn point_bounds(&self) -> (Vec3, Vec3) {
+        self.points
+            .iter()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
+                (a.min(*p), b.max(*p))
+            })
+    }
+
     /// Positions of the four vertices of `tet`.
     #[inline]
     pub fn tet_points(&self, tet: u32) -> [Vec3; 4] {

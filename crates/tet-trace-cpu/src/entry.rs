@@ -34,10 +34,11 @@
 //! # Cost
 //!
 //! [`BoundaryEntry::seen_from`] keeps the faces whose outer side holds the
-//! viewpoint (at most three sides of a box: 6 triangles); per ray, a slab
-//! test against the mesh bounds rejects most misses, then the face that the
-//! previous ray of the batch entered through is tested first, which
-//! neighbouring pixels nearly always share.
+//! viewpoint (at most three sides of a box: 6 triangles); per ray, the face
+//! that the previous ray of the batch entered through is tested first
+//! (neighbouring pixels nearly always share it); when that fails, a slab
+//! test against the mesh bounds rejects most misses before the other faces
+//! are tested.
 
 use std::collections::HashMap;
 
@@ -132,17 +133,12 @@ impl BoundaryEntry {
             return Err(ViewpointError::NoBoundary);
         }
         check_convex(mesh, &faces)?;
-        let (lo, hi) = mesh
-            .points
-            .iter()
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), p| {
-                (a.min(p.as_dvec3()), b.max(p.as_dvec3()))
-            });
+        let (lo, hi) = mesh.point_bounds();
         Ok(BoundaryEntry {
             faces,
             seen_from: None,
-            lo,
-            hi,
+            lo: lo.as_dvec3(),
+            hi: hi.as_dvec3(),
         })
     }
 

@@ -94,12 +94,7 @@ pub fn locate(mesh: &TetMesh, p: Vec3, source: u32) -> Result<u32, LocateError> 
     }
     // A point beyond the bounds of the mesh points lies in no tet: no scan
     // (a camera or light outside a tight enclosing box, every frame).
-    let (lo, hi) = mesh
-        .points
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), x| {
-            (a.min(*x), b.max(*x))
-        });
+    let (lo, hi) = mesh.point_bounds();
     if p.cmplt(lo).any() || p.cmpgt(hi).any() {
         return Err(LocateError::OutsideMesh { point: p });
     }

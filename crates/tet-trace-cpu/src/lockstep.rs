@@ -1201,10 +1201,18 @@ pub(crate) mod avx512 {
         unsafe { _mm512_i32gather_epi32::<4>(idx, g.words.as_ptr() as *const i32) }
     }
 
+    /// `(x, y, z)` of `points[i]` per lane, `i3 = 3·i`, `i ≤ last_point`.
+    #[target_feature(enable = "avx512f")]
+    #[inline]
+    pub(crate) fn gather_point(g: &Geo<'_>, i3: __m512i) -> [__m512; 3] {
+        let (x, y) = gather_xy(g, i3);
+        [x, y, gather_points(g, i3, 2)]
+    }
+
     /// Gathers coordinate `axis` (0..=2) of `points[i]` per lane, `i ≤ last_point`.
     #[target_feature(enable = "avx512f")]
     #[inline]
-    pub(crate) fn gather_points(g: &Geo<'_>, i3: __m512i, axis: usize) -> __m512 {
+    fn gather_points(g: &Geo<'_>, i3: __m512i, axis: usize) -> __m512 {
         let base = g.points.as_ptr() as *const f32;
         // SAFETY: `i3 = 3·i` with `i ≤ last_point = points.len() − 1` per
         // lane, so word `i3 + axis` (axis ≤ 2) lies inside `points`;
@@ -1217,7 +1225,7 @@ pub(crate) mod avx512 {
     /// 16 loads instead of the 32 of two 16-lane gathers.
     #[target_feature(enable = "avx512f")]
     #[inline]
-    pub(crate) fn gather_xy(g: &Geo<'_>, i3: __m512i) -> (__m512, __m512) {
+    fn gather_xy(g: &Geo<'_>, i3: __m512i) -> (__m512, __m512) {
         let base = g.points.as_ptr() as *const i64;
         let lo = _mm512_castsi512_si256(i3);
         let hi = _mm512_extracti64x4_epi64::<1>(i3);
@@ -1260,10 +1268,10 @@ pub(crate) mod avx512 {
         let dc = _mm512_min_epu32(d, splat(g.last_point));
         let lost = _mm512_cmpneq_epi32_mask(dc, d);
         let i3 = _mm512_add_epi32(_mm512_add_epi32(dc, dc), dc);
-        let (px3, py3) = gather_xy(g, i3);
+        let [px3, py3, pz3] = gather_point(g, i3);
         let qx = _mm512_sub_ps(px3, v.o[0]);
         let qy = _mm512_sub_ps(py3, v.o[1]);
-        let qz = _mm512_sub_ps(gather_points(g, i3, 2), v.o[2]);
+        let qz = _mm512_sub_ps(pz3, v.o[2]);
         // Projection: `(c₀·qₓ + c₁·q_y) + c₂·q_z`, no FMA.
         let proj = |k: usize| {
             _mm512_add_ps(

@@ -29,7 +29,7 @@ mod avx512 {
     use glam::Vec3;
     use tet_core::{Link, TetMesh};
 
-    use crate::lockstep::avx512::{gather_points, gather_words, gather_xy, lane_u32, splat};
+    use crate::lockstep::avx512::{gather_point, gather_words, lane_u32, splat};
     use crate::lockstep::{ExitRule, Geo, RecordWords};
     use crate::ray::{Ray, TraceOutcome};
     use crate::walk::{
@@ -75,14 +75,6 @@ mod avx512 {
         live: __mmask16,
         ray: [usize; 16],
         proj: [TripleF32; 16],
-    }
-
-    /// `(x, y, z)` of `points[i]` per lane, `i3 = 3·i`, `i ≤ last_point`.
-    #[target_feature(enable = "avx512f")]
-    #[inline]
-    fn gather_point(g: &Geo<'_>, i3: __m512i) -> [__m512; 3] {
-        let (x, y) = gather_xy(g, i3);
-        [x, y, gather_points(g, i3, 2)]
     }
 
     impl Pack {
