@@ -17,7 +17,7 @@
 use std::time::Duration;
 
 use glam::Vec3;
-use glam_obvhs::Vec3A;
+use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::builder::build_bvh2_from_tris;

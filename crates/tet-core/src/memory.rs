@@ -22,8 +22,45 @@ use std::fmt;
 
 use glam::Vec3;
 
-use crate::layout::{Anchor, Baseline32, Tet16, Tet20, Tet32, Tet80, component_roots};
+use crate::layout::tet80::NAME as TET80_NAME;
+use crate::layout::{
+    Anchor, Baseline32, LayoutMesh, LayoutRecord, Tet16, Tet20, Tet32, Tet80, Tet80Mesh,
+    component_roots,
+};
 use crate::mesh::{ConstrainedFace, TetMesh};
+
+impl<R: LayoutRecord> LayoutMesh<R> {
+    /// Exact memory of this container (see [`crate::memory`]).
+    pub fn memory(&self) -> LayoutMemory {
+        LayoutMemory {
+            name: R::NAME,
+            tets: self.tets.len() * size_of::<R>(),
+            points: self.points.len() * size_of::<Vec3>(),
+            constrained: self.constrained.len() * size_of::<ConstrainedFace>(),
+            attributes: self.attributes.bytes(),
+            anchors: self.anchors.len() * size_of::<Anchor>(),
+            reconstruction: 0,
+        }
+    }
+}
+
+impl Tet80Mesh {
+    /// Exact memory of this container (see [`crate::memory`]): Tet80 keeps
+    /// its positions inline, so its point array and vertex ids are
+    /// reconstruction-only data.
+    pub fn memory(&self) -> LayoutMemory {
+        LayoutMemory {
+            name: TET80_NAME,
+            tets: self.tets.len() * size_of::<Tet80>(),
+            points: 0,
+            constrained: self.constrained.len() * size_of::<ConstrainedFace>(),
+            attributes: self.attributes.bytes(),
+            anchors: 0,
+            reconstruction: self.points.len() * size_of::<Vec3>()
+                + self.vertex_ids.len() * size_of::<[u32; 4]>(),
+        }
+    }
+}
 
 /// Layout names, in report order.
 pub const LAYOUT_NAMES: [&str; 5] = ["baseline32", "tet32", "tet20", "tet16", "tet80"];

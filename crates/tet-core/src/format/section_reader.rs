@@ -11,10 +11,15 @@ use bytemuck::Pod;
 use crc32fast::Hasher;
 use glam::{Vec2, Vec3};
 
-use super::{
-    ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCENE, FLAG_UVS, FormatError, HEADER_LEN,
-    Header, OptionalSections, SECTION_NAMES, decode_scene, from_le_words, parse_header,
+use super::error::FormatError;
+use super::header::{Header, parse_header};
+use super::scene_block::decode_scene;
+use super::spec::{
+    ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCENE, FLAG_UVS, HEADER_LEN,
+    SCENE_RECORD_BYTES, SECTION_NAMES,
 };
+use super::stream_writer::OptionalSections;
+use super::words::from_le_words;
 use crate::link::Link;
 use crate::mesh::ConstrainedFace;
 use crate::scene::SceneInfo;
@@ -190,7 +195,7 @@ impl SectionReader {
             return Ok(SceneInfo::default());
         }
         let (offset, length) = self.header.scene;
-        let mut records = vec![[0u32; 12]; (length / super::SCENE_RECORD_BYTES) as usize];
+        let mut records = vec![[0u32; 12]; (length / SCENE_RECORD_BYTES) as usize];
         self.read_at(offset, &mut records)?;
         decode_scene(&records, &self.path)
     }

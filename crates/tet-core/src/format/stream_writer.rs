@@ -5,15 +5,19 @@
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use crc32fast::Hasher;
 use glam::{Vec2, Vec3};
 
-use super::{
-    ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCENE, FLAG_UVS, FormatError, HEADER_LEN,
-    HeaderFields, SECTION_NAMES, hash_le_words, header_bytes, padding, scene_records, temp_path,
-    write_le_words,
+use super::error::FormatError;
+use super::header::{HeaderFields, header_bytes};
+use super::scene_block::scene_records;
+use super::spec::{
+    ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCENE, FLAG_UVS, HEADER_FIELDS, HEADER_LEN,
+    SECTION_NAMES,
 };
+use super::words::{hash_le_words, padding, write_le_words};
 use crate::link::{Link, MAX_TETS};
 use crate::mesh::{Attributes, ConstrainedFace};
 use crate::scene::SceneInfo;
@@ -276,7 +280,7 @@ impl StreamWriter {
         let (points, tets, constrained) = (count(0), count(1), count(3));
         let mismatch = |i: usize, expected: u64| FormatError::SizeMismatch {
             path: self.path.clone(),
-            field: super::HEADER_FIELDS[10 + 2 * i].0,
+            field: HEADER_FIELDS[10 + 2 * i].0,
             expected: expected * ELEMENT_BYTES[i],
             found: self.table[i].1,
         };
@@ -340,4 +344,24 @@ impl Drop for StreamWriter {
             let _ = fs::remove_file(&self.tmp);
         }
     }
+}
+
+/// A fresh temporary path in `path`'s directory, named after it (so that
+/// renaming it over `path` is atomic: same file system).
+fn temp_path(path: &Path) -> Result<PathBuf, FormatError> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let name = path.file_name().ok_or_else(|| FormatError::Io {
+        path: path.to_path_buf(),
+        source: io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"),
+    })?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    Ok(dir.join(format!(
+        ".{}.tmp-{}-{}",
+        name.to_string_lossy(),
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    )))
 }

@@ -334,19 +334,6 @@ impl<R: LayoutRecord> LayoutMesh<R> {
             .collect();
         Ok((ids, neighbors))
     }
-
-    /// Exact memory of this container (see [`crate::memory`]).
-    pub fn memory(&self) -> crate::memory::LayoutMemory {
-        crate::memory::LayoutMemory {
-            name: R::NAME,
-            tets: self.tets.len() * size_of::<R>(),
-            points: self.points.len() * size_of::<Vec3>(),
-            constrained: self.constrained.len() * size_of::<ConstrainedFace>(),
-            attributes: self.attributes.bytes(),
-            anchors: self.anchors.len() * size_of::<Anchor>(),
-            reconstruction: 0,
-        }
-    }
 }
 
 // ---------------------------------------------------------------------------

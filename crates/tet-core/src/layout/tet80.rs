@@ -234,20 +234,6 @@ impl Tet80Mesh {
         })?;
         Ok(mesh)
     }
-
-    /// Exact memory of this container (see [`crate::memory`]).
-    pub fn memory(&self) -> crate::memory::LayoutMemory {
-        crate::memory::LayoutMemory {
-            name: NAME,
-            tets: self.tets.len() * size_of::<Tet80>(),
-            points: 0,
-            constrained: self.constrained.len() * size_of::<ConstrainedFace>(),
-            attributes: self.attributes.bytes(),
-            anchors: 0,
-            reconstruction: self.points.len() * size_of::<Vec3>()
-                + self.vertex_ids.len() * size_of::<[u32; 4]>(),
-        }
-    }
 }
 
 #[cfg(test)]
