@@ -11,8 +11,8 @@ use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
 
 use super::input::Bytes;
 
-/// (scale, offset) pairs whose lattice f32 can resolve (see the report of
-/// issue 7: `kuhn_grid` loops forever when it cannot).
+/// (scale, offset) pairs whose lattice f32 can resolve (`kuhn_grid` loops
+/// forever when it cannot, as fuzzing found).
 const PLACEMENTS: [(f32, [f32; 3]); 6] = [
     (1.0, [0.0, 0.0, 0.0]),
     (1e-3, [0.0, 0.0, 0.0]),

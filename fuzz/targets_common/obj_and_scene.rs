@@ -10,8 +10,8 @@
 // Scenes load their OBJ files relative to the json file: here a fixture
 // directory of generated meshes (`tet.obj`, `quad.obj`). Inputs naming a
 // path with a separator are parsed but not loaded, so the fuzzer cannot make
-// the loader read arbitrary files of the machine (e.g. `/dev/zero`; see the
-// report of issue 7).
+// the loader read arbitrary files of the machine (e.g. `/dev/zero`, as
+// fuzzing found).
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
