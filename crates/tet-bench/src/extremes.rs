@@ -9,8 +9,9 @@ use tet_core::TetMesh;
 use tet_core::scene::{Camera, PointLight};
 use tet_core::synthetic::{GridSpec, kuhn_grid};
 
+use crate::camera::framing_camera;
 use crate::cli::BuildFlags;
-use crate::load::{Loaded, framing_camera, from_scene};
+use crate::load::{Loaded, from_scene};
 
 /// The transforms applied to the scene.
 const TRANSFORMS: [(&str, f32, f32); 3] = [

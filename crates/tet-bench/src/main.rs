@@ -1,23 +1,40 @@
 //! `tet-bench`: the user-facing command-line tool and benchmark harness.
 //! See the README for every subcommand and the `--json` schema.
+//!
+//! The modules lie in layers; each uses only the layers below it:
+//!
+//! 1. commands — [`commands`] (`build`, `info`, `render`, `accuracy`) and
+//!    [`tables`] (one module per paper table, the driver, and the report
+//!    writers: Markdown, CSV, JSON, SVG figures);
+//! 2. measurement, returning plain serialisable data — [`timing`], [`gpu`],
+//!    [`layouts`], [`accuracy`], [`extremes`], [`exitface`], [`outofcore`];
+//! 3. plumbing — [`load`] (scenes and mesh files), [`camera`] (the default
+//!    view and the view flags), [`methods`] with the tracers that are not
+//!    in `tet-trace-cpu` ([`bvh`], [`brute`], `embree`), [`plots`] (SVG
+//!    drawing), [`output`] (stdout and error text) and [`cli`] (the
+//!    arguments).
+#![deny(missing_docs)]
+#![deny(clippy::print_stdout)]
 
 mod accuracy;
 mod brute;
-mod build;
 mod bvh;
+mod camera;
 mod cli;
+mod commands;
 #[cfg(feature = "embree")]
 mod embree;
 mod exitface;
 mod extremes;
 mod gpu;
-mod info;
+mod layouts;
 mod load;
 mod methods;
 mod outofcore;
+mod output;
 mod plots;
-mod render;
 mod tables;
+mod timing;
 
 use std::process::ExitCode;
 
@@ -28,35 +45,21 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::TetgenWorker => return tetgen_worker(),
-        Command::Build(a) => build::run(a, cli.json),
-        Command::Info(a) => info::run(a, cli.json),
-        Command::Render(a) => render::run(a, cli.json),
-        Command::Accuracy(a) => accuracy::run(a, cli.json),
+        Command::Build(a) => commands::build::run(a, cli.json),
+        Command::Info(a) => commands::info::run(a, cli.json),
+        Command::Render(a) => commands::render::run(a, cli.json),
+        Command::Accuracy(a) => commands::accuracy::run(a, cli.json),
         Command::Tables(a) => tables::run(a, cli.json),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader has gone (`… | head`): stop quietly, as Unix tools do.
+        Err(e) if output::is_stdout_closed(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", error_chain(&e));
+            eprintln!("error: {}", output::error_chain(&e));
             ExitCode::FAILURE
         }
     }
-}
-
-/// The error and its causes on one line; a cause whose text the message
-/// already contains (many of our errors quote their source) is not repeated.
-fn error_chain(e: &anyhow::Error) -> String {
-    let mut text = String::new();
-    for cause in e.chain() {
-        let c = cause.to_string();
-        if !text.contains(&c) {
-            if !text.is_empty() {
-                text.push_str(": ");
-            }
-            text.push_str(&c);
-        }
-    }
-    text
 }
 
 #[cfg(feature = "tetgen")]

@@ -21,7 +21,9 @@ use tet_build::tetgen::TetgenOptions;
 use tet_core::TetMesh;
 use tet_core::scene::SceneInfo;
 
-use super::{Limited, MemoryReport, Planner, Written, mib, predict};
+use super::predict::predict;
+use super::types::{Limited, MemoryReport, Written, mib};
+use crate::cli::Planner;
 use crate::load::{BuildSummary, CleaningSummary};
 
 /// The split chosen.
