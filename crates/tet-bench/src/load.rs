@@ -140,6 +140,7 @@ pub fn with_mesh(scene: Scene, mesh: TetMesh, build: Option<BuildSummary>) -> Lo
 
 /// Relative margin of the tight enclosing box (of the scene's largest
 /// extent): thin, so that few tets lie between the box and the scene.
+#[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
 pub const TIGHT_BOX_MARGIN: f32 = 0.002;
 
 /// The enclosing box. By default it holds the scene only, grown by

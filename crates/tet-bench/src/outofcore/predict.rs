@@ -4,7 +4,9 @@
 use anyhow::Result;
 use tet_build::scene::Scene;
 
-use super::types::{ModelDoc, Prediction};
+#[cfg(feature = "tetgen")]
+use super::types::ModelDoc;
+use super::types::Prediction;
 
 /// Cleaned scene size as TetGen would receive it (with the box unless `no_box`).
 #[cfg(feature = "tetgen")]

@@ -7,6 +7,7 @@ use tet_build::scene::Scene;
 use crate::cli::{BuildFlags, Planner};
 
 /// Bytes as MiB.
+#[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
 pub fn mib(bytes: u64) -> f64 {
     bytes as f64 / (1024.0 * 1024.0)
 }

@@ -23,7 +23,7 @@
 //!   and peaks under limits of ½ and ⅓ of the in-core TetGen peak, full
 //!   mode ([`out_of_core`]).
 //!
-//! This module is the driver: it plans the scenes ([`plan`]), measures
+//! This module is the driver: it plans the scenes ([`plan`](mod@plan)), measures
 //! each table into a [`doc::TablesDoc`], and hands it to the report
 //! writers: Markdown, CSV and JSON ([`report`]) and SVG ([`figures`]).
 //!
