@@ -44,7 +44,9 @@ use crate::output::error_chain;
 /// The f64 reference hit of one ray.
 #[derive(Clone, Copy, Debug)]
 struct RefHit {
+    /// Constrained face hit.
     face: u32,
+    /// Its scene triangle.
     triangle: u32,
     /// Closest hit point within `tol` of an edge, or another hit within `tol`.
     ambiguous: bool,
@@ -52,12 +54,15 @@ struct RefHit {
 
 /// f64 reference over a padded-box BVH.
 pub struct Reference<'m> {
+    /// The mesh whose constrained faces are tested.
     mesh: &'m TetMesh,
+    /// BVH over the faces' boxes, padded by the tolerance.
     bvh: Bvh2,
     /// Grazing tolerance (world units).
     pub tol: f64,
 }
 
+/// `v` in obvhs's vector type.
 fn a3(v: Vec3) -> Vec3A {
     Vec3A::new(v.x, v.y, v.z)
 }
@@ -94,6 +99,8 @@ impl<'m> Reference<'m> {
         Reference { mesh, bvh, tol }
     }
 
+    /// The reference hit of `ray`: its closest constrained face in f64, or
+    /// `None` when it hits none.
     fn closest(&self, ray: &Ray) -> Option<RefHit> {
         let mesh = self.mesh;
         let dlen = ray.direction.as_dvec3().length();
@@ -202,7 +209,9 @@ pub struct CaseAccuracy {
 /// `view` by each tracer; see `tet_trace_cpu::entry` for a camera outside
 /// the mesh).
 pub struct RaySet {
+    /// Each ray with its start (`None` for camera rays).
     rays: Vec<(Ray, Option<Start>)>,
+    /// Where camera rays start (when there are camera rays).
     view: Option<Viewpoint>,
 }
 

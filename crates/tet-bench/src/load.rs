@@ -273,6 +273,7 @@ pub fn build_scene_in(
     )
 }
 
+/// A white point light of intensity 1 at `position`.
 fn light_at(position: Vec3) -> PointLight {
     PointLight {
         position,

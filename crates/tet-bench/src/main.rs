@@ -14,6 +14,9 @@
 //!    drawing), [`output`] (stdout and error text) and [`cli`] (the
 //!    arguments).
 #![deny(missing_docs)]
+// A binary exports nothing, so `missing_docs` checks only the crate root;
+// clippy's lint holds every module, item and field to the same rule.
+#![deny(clippy::missing_docs_in_private_items)]
 #![deny(clippy::print_stdout)]
 
 mod accuracy;
@@ -41,6 +44,8 @@ use std::process::ExitCode;
 use clap::Parser;
 use cli::{Cli, Command};
 
+/// Parses the arguments, runs the subcommand, and maps its result to the
+/// exit code.
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
@@ -62,11 +67,13 @@ fn main() -> ExitCode {
     }
 }
 
+/// `tet-bench tetgen-worker`: one TetGen request on stdin/stdout.
 #[cfg(feature = "tetgen")]
 fn tetgen_worker() -> ExitCode {
     ExitCode::from(tet_build::tetgen::worker::serve_stdio().clamp(0, 255) as u8)
 }
 
+/// Without TetGen there is no worker.
 #[cfg(not(feature = "tetgen"))]
 fn tetgen_worker() -> ExitCode {
     eprintln!("error: built without the `tetgen` feature");

@@ -72,6 +72,7 @@ pub fn build_limited(
 /// Without TetGen, scenes cannot be built.
 #[cfg(not(feature = "tetgen"))]
 impl Limited<'_> {
+    /// The error of every build without TetGen.
     fn no_tetgen<T>(&self) -> Result<T> {
         anyhow::bail!(
             "`{}` is a scene, but this tet-bench was built without the `tetgen` feature",

@@ -38,10 +38,12 @@ pub struct BarGroup {
     pub bars: Vec<(String, f64)>,
 }
 
+/// A plotters error as ours.
 fn err(e: impl Display) -> anyhow::Error {
     anyhow!("cannot draw the plot: {e}")
 }
 
+/// The `i`-th series colour (a ten-colour cycle).
 fn colour(i: usize) -> RGBColor {
     const C: [RGBColor; 10] = [
         RGBColor(31, 119, 180),
@@ -69,6 +71,7 @@ fn series_of<'a>(names: impl Iterator<Item = &'a str>) -> Vec<String> {
     out
 }
 
+/// The top of an axis that holds `max`, with room above it.
 fn upper(max: f64) -> f64 {
     if max.is_finite() && max > 0.0 {
         max * 1.15

@@ -9,6 +9,7 @@ use crate::layouts::{LayoutBytes, info};
 use crate::load::load;
 use crate::output::{outln, print_json};
 
+/// Bytes as MB (10⁶ bytes).
 fn mb(b: usize) -> f64 {
     b as f64 / 1e6
 }
@@ -55,6 +56,7 @@ pub fn run(args: &InfoArgs, json: bool) -> Result<()> {
     Ok(())
 }
 
+/// The bytes-per-layout table.
 fn print_layouts(layouts: &[LayoutBytes]) -> Result<()> {
     outln!(
         "  {:<11} {:>10} {:>10} {:>10} {:>10}",

@@ -115,6 +115,7 @@ pub fn plan(specs: &[String]) -> Vec<Planned> {
 /// Meshes built for a group of scenes with the same geometry, by build flags.
 #[derive(Default)]
 pub struct MeshCache {
+    /// By geometry key and build flags (as `Debug` text).
     meshes: HashMap<(u64, String), (TetMesh, BuildSummary)>,
 }
 

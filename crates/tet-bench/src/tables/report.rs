@@ -14,6 +14,7 @@ use super::{
     sorting, speed_accuracy, zoom,
 };
 
+/// The Markdown report (`tables.md`, and stdout without `--json`).
 pub fn markdown(doc: &TablesDoc) -> String {
     let s = &doc.setup;
     let mut m = String::new();
