@@ -222,16 +222,20 @@ pub struct RenderArgs {
 /// sight, and a field of view strictly between 0 and 180 degrees.
 #[derive(Debug, Clone, Copy, Default, Args)]
 pub struct ViewArgs {
-    /// Camera position, `X,Y,Z`.
+    /// Camera position `X,Y,Z`, replacing the scene's camera position (without
+    /// a scene camera: outside the scene on its +z side, framing it).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub eye: Option<glam::Vec3>,
-    /// Point the camera looks at, `X,Y,Z`.
+    /// Point `X,Y,Z` the camera looks at (default: the scene camera's target,
+    /// or the centre of the scene).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub target: Option<glam::Vec3>,
-    /// Up direction of the image, `X,Y,Z`.
+    /// Up direction `X,Y,Z` of the image, across the line of sight (default:
+    /// the scene camera's, or +y).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<glam::Vec3>,
-    /// Vertical field of view, degrees.
+    /// Vertical field of view in degrees, between 0 and 180 (default: the
+    /// scene camera's, or 60).
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub fov: Option<f32>,
 }
