@@ -1,4 +1,5 @@
-//! `tet-bench accuracy`: every method against an f64 reference.
+//! Accuracy of every method against an f64 reference (the `accuracy`
+//! command, and the robustness and speed-vs-accuracy tables of `tables`).
 //!
 //! The reference is exact in structure: every candidate triangle is tested
 //! with the f64 ray–triangle test of `tet_trace_cpu::reference`; candidates
@@ -15,7 +16,7 @@
 
 use std::time::{Duration, Instant};
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use glam::{DVec3, Vec3};
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
@@ -34,14 +35,18 @@ use tet_trace_cpu::reference::{Aim, edge_distance, random_ray, ray_triangle};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Start;
 
-use crate::cli::{AccuracyArgs, BuildFlags, Method, Precision};
-use crate::load::{Loaded, load, require_tets};
+use crate::cli::{BuildFlags, Method, Precision};
+use crate::extremes;
+use crate::load::Loaded;
 use crate::methods::{has_f64, tracer};
+use crate::output::error_chain;
 
 /// The f64 reference hit of one ray.
 #[derive(Clone, Copy, Debug)]
 struct RefHit {
+    /// Constrained face hit.
     face: u32,
+    /// Its scene triangle.
     triangle: u32,
     /// Closest hit point within `tol` of an edge, or another hit within `tol`.
     ambiguous: bool,
@@ -49,12 +54,15 @@ struct RefHit {
 
 /// f64 reference over a padded-box BVH.
 pub struct Reference<'m> {
+    /// The mesh whose constrained faces are tested.
     mesh: &'m TetMesh,
+    /// BVH over the faces' boxes, padded by the tolerance.
     bvh: Bvh2,
     /// Grazing tolerance (world units).
     pub tol: f64,
 }
 
+/// `v` in obvhs's vector type.
 fn a3(v: Vec3) -> Vec3A {
     Vec3A::new(v.x, v.y, v.z)
 }
@@ -91,6 +99,8 @@ impl<'m> Reference<'m> {
         Reference { mesh, bvh, tol }
     }
 
+    /// The reference hit of `ray`: its closest constrained face in f64, or
+    /// `None` when it hits none.
     fn closest(&self, ray: &Ray) -> Option<RefHit> {
         let mesh = self.mesh;
         let dlen = ray.direction.as_dvec3().length();
@@ -195,26 +205,13 @@ pub struct CaseAccuracy {
     pub skipped: Option<String>,
 }
 
-/// The `accuracy` document.
-#[derive(Clone, Debug, Serialize)]
-pub struct AccuracyDoc {
-    /// Scene name.
-    pub scene: String,
-    /// Random seed.
-    pub seed: u64,
-    /// Side of the square camera image traced.
-    pub image: u32,
-    /// Random interior rays per case.
-    pub random_rays: usize,
-    /// Cases.
-    pub cases: Vec<CaseAccuracy>,
-}
-
 /// A batch of rays with their start (`None`: a camera ray, started from
 /// `view` by each tracer; see `tet_trace_cpu::entry` for a camera outside
 /// the mesh).
 pub struct RaySet {
+    /// Each ray with its start (`None` for camera rays).
     rays: Vec<(Ray, Option<Start>)>,
+    /// Where camera rays start (when there are camera rays).
     view: Option<Viewpoint>,
 }
 
@@ -324,21 +321,6 @@ fn check(
     m
 }
 
-/// Parses `--methods`.
-pub fn parse_methods(s: &str) -> Result<Vec<Method>> {
-    use clap::ValueEnum;
-    if s == "all" {
-        return Ok(crate::methods::cpu_methods());
-    }
-    s.split(',')
-        .map(|m| {
-            Method::from_str(m.trim(), true).map_err(|_| {
-                anyhow::anyhow!("unknown method `{m}` (expected sctp, tet80, tet32, tet20, tet16, obvhs, embree, embree8, brute or all)")
-            })
-        })
-        .collect()
-}
-
 /// Runs every method on one mesh.
 pub fn run_case(
     case: &str,
@@ -400,7 +382,7 @@ pub fn all_cases(
         "as-is", loaded, methods, precision, side, n, seed,
     )?];
     if let Some(flags) = extremes {
-        for (name, result) in crate::extremes::cases(loaded, flags, quiet) {
+        for (name, result) in extremes::cases(loaded, flags, quiet) {
             cases.push(match result {
                 Ok(l) => run_case(&name, &l, methods, precision, side, n, seed)?,
                 Err(e) => CaseAccuracy {
@@ -410,91 +392,10 @@ pub fn all_cases(
                     rays: 0,
                     reference_ambiguous: 0,
                     methods: Vec::new(),
-                    skipped: Some(crate::error_chain(&e)),
+                    skipped: Some(error_chain(&e)),
                 },
             });
         }
     }
     Ok(cases)
-}
-
-/// `tet-bench accuracy`.
-pub fn run(args: &AccuracyArgs, json: bool) -> Result<()> {
-    let methods = parse_methods(&args.methods)?;
-    if methods.is_empty() {
-        bail!("no methods given");
-    }
-    let loaded = load(&args.scene, &args.build, json)?;
-    require_tets(&loaded)?;
-    let cases = all_cases(
-        &loaded,
-        &methods,
-        args.precision,
-        args.image,
-        args.rays,
-        args.seed,
-        args.extremes.then_some(&args.build),
-        json,
-    )?;
-    let doc = AccuracyDoc {
-        scene: loaded.name.clone(),
-        seed: args.seed,
-        image: args.image,
-        random_rays: args.rays,
-        cases,
-    };
-    if json {
-        println!("{}", serde_json::to_string_pretty(&doc)?);
-    } else {
-        print_doc(&doc);
-    }
-    Ok(())
-}
-
-/// Prints the accuracy tables.
-pub fn print_doc(doc: &AccuracyDoc) {
-    println!(
-        "{}: {}² camera rays + {} random interior rays per case, seed {}",
-        doc.scene, doc.image, doc.random_rays, doc.seed
-    );
-    for c in &doc.cases {
-        if let Some(why) = &c.skipped {
-            println!("\n[{}] skipped: {why}", c.case);
-            continue;
-        }
-        println!(
-            "\n[{}] {} tets, tolerance {:.3e}, {} rays ({} grazing by the reference)",
-            c.case, c.tets, c.tolerance, c.rays, c.reference_ambiguous
-        );
-        println!(
-            "  {:<18} {:>9} {:>9} {:>7} {:>7} {:>7} {:>6} {:>6} {:>5} {:>9} {:>9}",
-            "method",
-            "agree",
-            "grazing",
-            "wrong",
-            "f.miss",
-            "f.hit",
-            "cap",
-            "lost",
-            "nan",
-            "fail/1024²",
-            "Mrays/s"
-        );
-        for m in &c.methods {
-            println!(
-                "  {:<18} {:>9} {:>9} {:>7} {:>7} {:>7} {:>6} {:>6} {:>5} {:>9.2} {:>9.2}",
-                m.method,
-                m.agree,
-                m.ambiguous,
-                m.wrong_triangle,
-                m.false_misses,
-                m.false_hits,
-                m.step_cap,
-                m.lost,
-                m.nans,
-                m.failures_per_1024_squared,
-                m.mrays_per_s
-            );
-        }
-    }
 }

@@ -31,7 +31,9 @@ use tet_trace_cpu::walk::Start;
 
 /// A BVH2 over the constrained faces of a mesh (the scene triangles).
 pub struct BvhTracer<'m> {
+    /// The mesh whose constrained faces are the primitives.
     mesh: &'m TetMesh,
+    /// obvhs's BVH2 over the faces.
     bvh: Bvh2,
     /// Intersection triangles in BVH primitive order.
     tris: Vec<RtTriangle>,
@@ -42,6 +44,7 @@ pub struct BvhTracer<'m> {
     count_nodes: bool,
 }
 
+/// `v` in obvhs's vector type.
 fn a(v: Vec3) -> Vec3A {
     Vec3A::new(v.x, v.y, v.z)
 }

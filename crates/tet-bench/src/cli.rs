@@ -71,14 +71,14 @@ pub struct BuildArgs {
     #[arg(short, long, required_unless_present = "predict_memory")]
     pub output: Option<PathBuf>,
     /// Print TetGen's predicted peak memory for this scene (the memory
-    /// model of issue 8) and exit without building.
+    /// model of Erkoç et al., seed 003 §3.2) and exit without building.
     #[arg(long)]
     pub predict_memory: bool,
     /// Keep every TetGen run's predicted peak under this size (bytes, or
     /// with a unit K, M, G: powers of 1024, e.g. 512M): over it, the scene
     /// is split into parts with exact seams, built by parallel workers and
     /// merged.
-    #[arg(long, value_name = "BYTES", value_parser = crate::outofcore::parse_memory_limit)]
+    #[arg(long, value_name = "BYTES", value_parser = parse_memory_limit)]
     pub memory_limit: Option<u64>,
     /// With `--memory-limit`: at most this many TetGen workers at once
     /// (default: all cores); their predictions together stay under the limit.
@@ -87,13 +87,13 @@ pub struct BuildArgs {
     /// With `--memory-limit`: how to split (default: the paper's recursive
     /// tree, parallel slabs when no tree fits).
     #[arg(long, value_enum, default_value_t, requires = "memory_limit")]
-    pub planner: crate::outofcore::Planner,
+    pub planner: Planner,
     /// With `--memory-limit`: how to merge the parts. `stream` (default)
     /// writes each part to a part file as it finishes and merges the files
     /// into the output a part at a time, each part Hilbert-sorted on its
     /// own; `memory` merges the whole mesh in memory and sorts it as a whole.
     #[arg(long, value_enum, default_value_t, requires = "memory_limit")]
-    pub merge: crate::outofcore::MergeMode,
+    pub merge: MergeMode,
     /// After writing, trace the written mesh with tet20 (640×480, best of 3
     /// frames, all cores) and report its speed (`tet20` in `--json`).
     #[arg(long)]
@@ -207,9 +207,57 @@ pub struct RenderArgs {
     /// Trace shadow rays to the point lights.
     #[arg(long)]
     pub shadows: bool,
+    /// View (overrides the scene's camera).
+    #[command(flatten)]
+    pub view: ViewArgs,
     /// Build options (ignored for mesh files).
     #[command(flatten)]
     pub build: BuildFlags,
+}
+
+/// The view: each flag given replaces that part of the scene's camera (or
+/// of the default camera, which frames the whole scene from outside on
+/// its +z side). Checked before anything is traced: finite coordinates,
+/// an eye away from the target, an up direction not along the line of
+/// sight, and a field of view strictly between 0 and 180 degrees.
+#[derive(Debug, Clone, Copy, Default, Args)]
+pub struct ViewArgs {
+    /// Camera position `X,Y,Z`, replacing the scene's camera position (without
+    /// a scene camera: outside the scene on its +z side, framing it).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<glam::Vec3>,
+    /// Point `X,Y,Z` the camera looks at (default: the scene camera's target,
+    /// or the centre of the scene).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<glam::Vec3>,
+    /// Up direction `X,Y,Z` of the image, across the line of sight (default:
+    /// the scene camera's, or +y).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<glam::Vec3>,
+    /// Vertical field of view in degrees, between 0 and 180 (default: the
+    /// scene camera's, or 60).
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub fov: Option<f32>,
+}
+
+/// Parses `X,Y,Z` (three finite numbers separated by commas).
+pub fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [x, y, z] = parts.as_slice() else {
+        return Err(format!(
+            "`{s}` is not a point: give three numbers separated by commas, e.g. 0,1.5,-4"
+        ));
+    };
+    let mut v = [0.0f32; 3];
+    for (out, text) in v.iter_mut().zip([x, y, z]) {
+        *out = text
+            .parse::<f32>()
+            .map_err(|_| format!("`{text}` in `{s}` is not a number"))?;
+        if !out.is_finite() {
+            return Err(format!("`{text}` in `{s}` is not finite"));
+        }
+    }
+    Ok(glam::Vec3::from_array(v))
 }
 
 /// Floating-point precision of the kernels.
@@ -248,6 +296,9 @@ pub struct AccuracyArgs {
     /// Kernel precision.
     #[arg(long, value_enum, default_value_t = Precision::F32)]
     pub precision: Precision,
+    /// View of the camera rays (overrides the scene's camera).
+    #[command(flatten)]
+    pub view: ViewArgs,
     /// Build options (ignored for mesh files).
     #[command(flatten)]
     pub build: BuildFlags,
@@ -284,4 +335,91 @@ pub struct TablesArgs {
     /// Timed frames per method (default: 5, or 3 with `--quick`).
     #[arg(long)]
     pub frames: Option<u32>,
+}
+
+/// How `build --memory-limit` splits a scene whose prediction exceeds the
+/// limit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum Planner {
+    /// The paper's recursive tree, parallel slabs when no tree fits.
+    #[default]
+    Auto,
+    /// Only the paper's recursive tree (perpendicular planes).
+    Tree,
+    /// Only parallel slabs on the axis of largest variance.
+    Slabs,
+}
+
+/// How the parts of an out-of-core build are merged.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum MergeMode {
+    /// Part files merged into the mesh file a part at a time (each part
+    /// Hilbert-sorted on its own): the merge holds one part and the seams.
+    #[default]
+    Stream,
+    /// The whole mesh merged in memory and Hilbert-sorted as a whole.
+    Memory,
+}
+
+/// Parses a memory size: a byte count, or a number with a unit `K`, `M`,
+/// `G`, `T` (also `KB`/`KiB`, …, any case), all powers of 1024: `512M`,
+/// `1.5G`, `2097152`.
+pub fn parse_memory_limit(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let unit = unit.trim().to_ascii_lowercase();
+    let scale: f64 = match unit.as_str() {
+        "" | "b" => 1.0,
+        "k" | "kb" | "kib" => 1024.0,
+        "m" | "mb" | "mib" => 1024.0 * 1024.0,
+        "g" | "gb" | "gib" => 1024.0 * 1024.0 * 1024.0,
+        "t" | "tb" | "tib" => 1024.0 * 1024.0 * 1024.0 * 1024.0,
+        _ => {
+            return Err(format!(
+                "unknown unit `{unit}` in `{s}`: give bytes or a number with K, M, G or T (powers of 1024), e.g. 512M or 1.5G"
+            ));
+        }
+    };
+    let value: f64 = num.parse().map_err(|_| {
+        format!("`{s}` is not a memory size: give bytes or a number with K, M, G or T, e.g. 512M or 1.5G")
+    })?;
+    let bytes = value * scale;
+    if !(bytes >= 1.0 && bytes < u64::MAX as f64) {
+        return Err(format!(
+            "memory limit `{s}` must be at least one byte and finite"
+        ));
+    }
+    Ok(bytes.round() as u64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn memory_sizes_parse_with_binary_units() {
+        assert_eq!(parse_memory_limit("2097152"), Ok(2_097_152));
+        assert_eq!(parse_memory_limit("512M"), Ok(512 << 20));
+        assert_eq!(parse_memory_limit("512mb"), Ok(512 << 20));
+        assert_eq!(parse_memory_limit("1.5G"), Ok(3 << 29));
+        assert_eq!(parse_memory_limit("64 KiB"), Ok(64 << 10));
+        for bad in ["", "M", "12X", "-5M", "1.2.3G", "0", "0.1"] {
+            let e = parse_memory_limit(bad).unwrap_err();
+            assert!(e.contains(bad.trim()), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn points_parse_as_three_finite_numbers() {
+        assert_eq!(
+            parse_vec3("1,-2.5, 3e2"),
+            Ok(glam::Vec3::new(1.0, -2.5, 300.0))
+        );
+        for bad in ["", "1,2", "1,2,3,4", "1,x,3", "1,inf,3", "NaN,0,0", "1;2;3"] {
+            assert!(parse_vec3(bad).is_err(), "{bad}");
+        }
+    }
 }

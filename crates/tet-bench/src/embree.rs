@@ -18,9 +18,7 @@
 //! retraced from just beyond it (at most a few times).
 //!
 //! Flush-to-zero / denormals-are-zero (MXCSR), which Embree recommends, is
-//! not set: measured on Torus Knots 640×480, 2 threads, it changed nothing
-//! beyond noise (single rays 7.12 → 7.14, packets 9.66 → 9.99 Mrays/s in
-//! one run, 6.96 → 7.02 and 10.06 → 10.58 in the next), and setting it
+//! not set: on Torus Knots it changed nothing beyond noise, and setting it
 //! needs `unsafe` and would leak into the other methods' threads.
 
 use embree3::{

@@ -9,8 +9,9 @@ use tet_core::TetMesh;
 use tet_core::scene::{Camera, PointLight};
 use tet_core::synthetic::{GridSpec, kuhn_grid};
 
+use crate::camera::framing_camera;
 use crate::cli::BuildFlags;
-use crate::load::{Loaded, framing_camera, from_scene};
+use crate::load::{Loaded, from_scene};
 
 /// The transforms applied to the scene.
 const TRANSFORMS: [(&str, f32, f32); 3] = [
@@ -19,6 +20,7 @@ const TRANSFORMS: [(&str, f32, f32); 3] = [
     ("translate-1e5", 1.0, 1e5),
 ];
 
+/// `p` scaled, then shifted along every axis.
 fn apply(p: Vec3, scale: f32, shift: f32) -> Vec3 {
     p * scale + Vec3::splat(shift)
 }
@@ -38,6 +40,8 @@ pub fn cases(loaded: &Loaded, flags: &BuildFlags, quiet: bool) -> Vec<(String, R
     out
 }
 
+/// The scene (rebuilt) or mesh file (points moved) scaled and shifted,
+/// with its camera and lights.
 fn transformed(
     loaded: &Loaded,
     flags: &BuildFlags,

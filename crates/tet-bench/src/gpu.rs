@@ -1,11 +1,12 @@
-//! GPU methods of `render`: camera rays generated and walked on the GPU
-//! (wgpu), timed with timestamp queries when the adapter has them.
+//! Timing the GPU methods (`gpu-tet20`, …): camera rays generated and
+//! walked on the GPU (wgpu), timed with timestamp queries when the adapter
+//! has them, reported as a [`RenderDoc`] like the CPU methods.
 
 use anyhow::{Result, bail};
 
 use crate::cli::Method;
 use crate::load::Loaded;
-use crate::render::RenderDoc;
+use crate::timing::RenderDoc;
 
 /// Renders `frames` GPU frames (plus a warm-up) of `method`.
 #[cfg(feature = "gpu")]
@@ -64,7 +65,7 @@ pub fn time_gpu(
         shadow_rays: 0,
         setup_s,
         hot_bytes,
-        target_features: crate::render::target_features(),
+        target_features: crate::timing::target_features(),
     })
 }
 

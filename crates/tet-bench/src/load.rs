@@ -11,7 +11,8 @@ use tet_build::scene::Scene;
 use tet_core::TetMesh;
 use tet_core::scene::{Camera, PointLight};
 
-use crate::cli::BuildFlags;
+use crate::camera::{ViewError, apply_view, framing_camera};
+use crate::cli::{BuildFlags, ViewArgs};
 
 /// File extension of mesh files written by `tet-bench build`.
 pub const MESH_EXTENSION: &str = "tmesh";
@@ -24,7 +25,8 @@ pub struct Loaded {
     pub mesh: TetMesh,
     /// The scene it was built from (absent for mesh files).
     pub scene: Option<Scene>,
-    /// Camera (the scene's, or one framing the mesh).
+    /// Camera (the scene's, or one framing it from outside; `--eye` and
+    /// the other view flags replace parts of it).
     pub camera: Camera,
     /// Point lights (the scene's, or one at the camera).
     pub lights: Vec<PointLight>,
@@ -73,12 +75,21 @@ pub struct CleaningSummary {
     pub unused_vertices: usize,
 }
 
+impl Loaded {
+    /// Replaces the parts of the camera given in `view` (`--eye`,
+    /// `--target`, `--up`, `--fov`), checked; the lights stay where they are.
+    pub fn set_view(&mut self, view: &ViewArgs) -> Result<(), ViewError> {
+        self.camera = apply_view(self.camera, view)?;
+        Ok(())
+    }
+}
+
 /// Loads a mesh file, or loads and builds a scene.
 pub fn load(spec: &str, flags: &BuildFlags, quiet: bool) -> Result<Loaded> {
     let path = Path::new(spec);
     if path.extension().is_some_and(|e| e == MESH_EXTENSION) {
         // The camera and lights stored with the mesh (`tet-bench build`
-        // writes the scene's), else a camera framing the mesh.
+        // writes the scene's), else a camera framing the mesh from outside.
         let (mesh, stored) = tet_core::format::load_with_scene(path)?;
         let camera = stored.camera.unwrap_or_else(|| framing_camera(&mesh));
         let lights = if stored.lights.is_empty() {
@@ -109,7 +120,7 @@ pub fn from_scene(scene: Scene, flags: &BuildFlags, quiet: bool) -> Result<Loade
 }
 
 /// A scene with its already built mesh (camera and lights from the scene,
-/// or framing the mesh).
+/// or a camera framing the scene from outside and a light at the camera).
 pub fn with_mesh(scene: Scene, mesh: TetMesh, build: Option<BuildSummary>) -> Loaded {
     let camera = scene.camera.unwrap_or_else(|| framing_camera(&mesh));
     let lights = if scene.lights.is_empty() {
@@ -129,6 +140,7 @@ pub fn with_mesh(scene: Scene, mesh: TetMesh, build: Option<BuildSummary>) -> Lo
 
 /// Relative margin of the tight enclosing box (of the scene's largest
 /// extent): thin, so that few tets lie between the box and the scene.
+#[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
 pub const TIGHT_BOX_MARGIN: f32 = 0.002;
 
 /// The enclosing box. By default it holds the scene only, grown by
@@ -261,24 +273,7 @@ pub fn build_scene_in(
     )
 }
 
-/// A camera for a mesh without a scene: just inside the +z side of the
-/// mesh's bounding box (inside the enclosing box a build adds), looking at
-/// the centre, so that walks can start in the tet containing it.
-pub fn framing_camera(mesh: &TetMesh) -> Camera {
-    let (min, max) = mesh.point_bounds();
-    if !min.is_finite() {
-        return Camera::default();
-    }
-    let center = (min + max) * 0.5;
-    let position = Vec3::new(center.x, center.y, max.z - 0.02 * (max.z - min.z));
-    Camera {
-        position,
-        target: center,
-        up: Vec3::Y,
-        vfov_deg: 60.0,
-    }
-}
-
+/// A white point light of intensity 1 at `position`.
 fn light_at(position: Vec3) -> PointLight {
     PointLight {
         position,

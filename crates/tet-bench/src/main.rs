@@ -1,69 +1,79 @@
 //! `tet-bench`: the user-facing command-line tool and benchmark harness.
 //! See the README for every subcommand and the `--json` schema.
+//!
+//! The modules lie in layers; each uses only the layers below it:
+//!
+//! 1. commands — [`commands`] (`build`, `info`, `render`, `accuracy`) and
+//!    [`tables`] (one module per paper table, the driver, and the report
+//!    writers: Markdown, CSV, JSON, SVG figures);
+//! 2. measurement, returning plain serialisable data — [`timing`], [`gpu`],
+//!    [`layouts`], [`accuracy`], [`extremes`], [`exitface`], [`outofcore`];
+//! 3. plumbing — [`load`] (scenes and mesh files), [`camera`] (the default
+//!    view and the view flags), [`methods`] with the tracers that are not
+//!    in `tet-trace-cpu` ([`bvh`], [`brute`], `embree`), [`plots`] (SVG
+//!    drawing), [`output`] (stdout and error text) and [`cli`] (the
+//!    arguments).
+#![deny(missing_docs)]
+// A binary exports nothing, so `missing_docs` checks only the crate root;
+// clippy's lint holds every module, item and field to the same rule.
+#![deny(clippy::missing_docs_in_private_items)]
+#![deny(clippy::print_stdout)]
 
 mod accuracy;
 mod brute;
-mod build;
 mod bvh;
+mod camera;
 mod cli;
+mod commands;
 #[cfg(feature = "embree")]
 mod embree;
 mod exitface;
 mod extremes;
 mod gpu;
-mod info;
+mod layouts;
 mod load;
 mod methods;
 mod outofcore;
+mod output;
 mod plots;
-mod render;
 mod tables;
+mod timing;
 
 use std::process::ExitCode;
 
 use clap::Parser;
 use cli::{Cli, Command};
 
+/// Parses the arguments, runs the subcommand, and maps its result to the
+/// exit code.
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::TetgenWorker => return tetgen_worker(),
-        Command::Build(a) => build::run(a, cli.json),
-        Command::Info(a) => info::run(a, cli.json),
-        Command::Render(a) => render::run(a, cli.json),
-        Command::Accuracy(a) => accuracy::run(a, cli.json),
+        Command::Build(a) => commands::build::run(a, cli.json),
+        Command::Info(a) => commands::info::run(a, cli.json),
+        Command::Render(a) => commands::render::run(a, cli.json),
+        Command::Accuracy(a) => commands::accuracy::run(a, cli.json),
         Command::Tables(a) => tables::run(a, cli.json),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader has gone (`… | head`): stop quietly, as Unix tools do.
+        Err(e) if output::is_stdout_closed(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", error_chain(&e));
+            eprintln!("error: {}", output::error_chain(&e));
             ExitCode::FAILURE
         }
     }
 }
 
-/// The error and its causes on one line; a cause whose text the message
-/// already contains (many of our errors quote their source) is not repeated.
-fn error_chain(e: &anyhow::Error) -> String {
-    let mut text = String::new();
-    for cause in e.chain() {
-        let c = cause.to_string();
-        if !text.contains(&c) {
-            if !text.is_empty() {
-                text.push_str(": ");
-            }
-            text.push_str(&c);
-        }
-    }
-    text
-}
-
+/// `tet-bench tetgen-worker`: one TetGen request on stdin/stdout.
 #[cfg(feature = "tetgen")]
 fn tetgen_worker() -> ExitCode {
     ExitCode::from(tet_build::tetgen::worker::serve_stdio().clamp(0, 255) as u8)
 }
 
+/// Without TetGen there is no worker.
 #[cfg(not(feature = "tetgen"))]
 fn tetgen_worker() -> ExitCode {
     eprintln!("error: built without the `tetgen` feature");

@@ -1,12 +1,7 @@
-//! SVG figures of `tet-bench tables` (plotters, SVG backend only: no
-//! system font libraries; text is left to the SVG viewer).
-//!
-//! * `speed_vs_accuracy.svg` — Mrays/s (render) against failures per 1024²
-//!   rays (accuracy), one circle per method and scene: seed 001's trade
-//!   between speed and robustness in one picture;
-//! * `figure8_sorted_vs_unsorted.svg` — seed 000 Figure 8: tet20 Mrays/s on
-//!   the Hilbert-sorted and the unsorted (TetGen order) mesh, per scene;
-//! * `mrays_per_method.svg` — Mrays/s per method, grouped by scene.
+//! SVG drawing for the figures of `tet-bench tables` (plotters, SVG
+//! backend only: no system font libraries; text is left to the SVG
+//! viewer): scatter plots ([`scatter_svg`]) and grouped bars ([`bars_svg`])
+//! of plain points; which figures a run draws is [`crate::tables`]' business.
 //!
 //! Every data point is exactly one mark (`<circle>` in scatter plots,
 //! `<rect>` in bar charts besides the white background); legends are
@@ -17,9 +12,6 @@ use std::fmt::Display;
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-
-use crate::cli::Method;
-use crate::tables::TablesDoc;
 
 /// Plot size in pixels.
 const SIZE: (u32, u32) = (960, 640);
@@ -46,10 +38,12 @@ pub struct BarGroup {
     pub bars: Vec<(String, f64)>,
 }
 
+/// A plotters error as ours.
 fn err(e: impl Display) -> anyhow::Error {
     anyhow!("cannot draw the plot: {e}")
 }
 
+/// The `i`-th series colour (a ten-colour cycle).
 fn colour(i: usize) -> RGBColor {
     const C: [RGBColor; 10] = [
         RGBColor(31, 119, 180),
@@ -77,6 +71,7 @@ fn series_of<'a>(names: impl Iterator<Item = &'a str>) -> Vec<String> {
     out
 }
 
+/// The top of an axis that holds `max`, with room above it.
 fn upper(max: f64) -> f64 {
     if max.is_finite() && max > 0.0 {
         max * 1.15
@@ -214,83 +209,6 @@ pub fn bars_svg(title: &str, y_desc: &str, groups: &[BarGroup]) -> Result<String
         root.present().map_err(err)?;
     }
     Ok(svg)
-}
-
-/// The figures of a `tables` run: `(file name, SVG)`.
-pub fn figures(doc: &TablesDoc) -> Result<Vec<(&'static str, String)>> {
-    let mut out = Vec::new();
-    // Speed vs accuracy.
-    let mut points = Vec::new();
-    for sc in &doc.scenes {
-        let Some(a) = &sc.accuracy else { continue };
-        for x in &a.methods {
-            let Some(r) = sc.renders.iter().find(|r| r.tracer == x.method) else {
-                continue;
-            };
-            points.push(Point {
-                series: r.method.name().to_string(),
-                label: format!("{} ({})", r.method.name(), r.scene),
-                x: x.failures_per_1024_squared,
-                y: r.mrays_per_s,
-            });
-        }
-    }
-    out.push((
-        "speed_vs_accuracy.svg",
-        scatter_svg(
-            "Speed vs accuracy (seed 001 Table 4 against render speed)",
-            "failures per 1024² rays (f32, against the f64 reference)",
-            "Mrays/s (primary rays)",
-            &points,
-        )?,
-    ));
-    // Figure 8.
-    let groups: Vec<BarGroup> = doc
-        .scenes
-        .iter()
-        .filter_map(|sc| {
-            let sorted = sc.renders.iter().find(|r| r.method == Method::Tet20)?;
-            let unsorted = sc.unsorted_tet20.as_ref()?;
-            Some(BarGroup {
-                name: sorted.scene.clone(),
-                bars: vec![
-                    ("tet20, Hilbert-sorted".into(), sorted.mrays_per_s),
-                    ("tet20, unsorted".into(), unsorted.mrays_per_s),
-                ],
-            })
-        })
-        .collect();
-    out.push((
-        "figure8_sorted_vs_unsorted.svg",
-        bars_svg(
-            "Hilbert-sorted vs unsorted mesh (seed 000 Figure 8)",
-            "Mrays/s",
-            &groups,
-        )?,
-    ));
-    // Mrays/s per method per scene.
-    let groups: Vec<BarGroup> = doc
-        .scenes
-        .iter()
-        .filter(|sc| !sc.renders.is_empty())
-        .map(|sc| BarGroup {
-            name: sc.renders[0].scene.clone(),
-            bars: sc
-                .renders
-                .iter()
-                .map(|r| (r.method.name().to_string(), r.mrays_per_s))
-                .collect(),
-        })
-        .collect();
-    out.push((
-        "mrays_per_method.svg",
-        bars_svg(
-            "Render speed per method (seed 000 Table 1)",
-            "Mrays/s",
-            &groups,
-        )?,
-    ));
-    Ok(out)
 }
 
 #[cfg(test)]

@@ -539,3 +539,205 @@ fn mesh_files_carry_the_scene_camera_and_lights() {
     assert_eq!(a["hits"], b["hits"]);
     assert_eq!(a["tets_per_ray"], b["tets_per_ray"]);
 }
+
+/// A closed unit cube centred on (0.5, 0.5, 0.5), outward-facing triangles.
+fn cube_obj(dir: &std::path::Path) -> std::path::PathBuf {
+    let path = dir.join("cube.obj");
+    std::fs::write(
+        &path,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+         f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\n\
+         f 4 8 7\nf 4 7 3\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n",
+    )
+    .unwrap();
+    path
+}
+
+/// `render --json` at a small size, with extra arguments.
+fn render_json(scene: &str, method: &str, extra: &[&str]) -> Value {
+    let mut args = vec![
+        "render", scene, "--method", method, "--width", "48", "--height", "36", "--frames", "1",
+    ];
+    args.extend_from_slice(extra);
+    json(&args)
+}
+
+/// A scene without a camera (an OBJ, and the mesh file built from it) is
+/// seen from outside: the default camera frames the whole closed cube, so
+/// its hits cover a good part of the image but not all of it, and they
+/// are the hits of the f64 brute-force reference.
+#[test]
+fn scenes_without_a_camera_are_framed_from_outside() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = cube_obj(dir.path());
+    let obj = obj.to_str().unwrap();
+    let file = dir.path().join("cube.tmesh");
+    let file = file.to_str().unwrap();
+    json(&["build", obj, "-o", file]);
+    let rays = 48 * 36;
+    for scene in [obj, file] {
+        let walk = render_json(scene, "tet20", &[]);
+        assert_eq!(walk["rays"], rays);
+        assert_eq!(walk["failures"], 0, "{walk}");
+        let hits = walk["hits"].as_u64().unwrap();
+        // The cube's front face alone covers more than a tenth of the image.
+        assert!(
+            hits > rays / 10 && hits < rays,
+            "{scene}: {hits} of {rays} rays hit"
+        );
+        let reference = render_json(scene, "brute", &[]);
+        assert_eq!(walk["hits"], reference["hits"], "{scene}");
+    }
+    // The accuracy command checks every camera ray against the reference.
+    let a = json(&[
+        "accuracy",
+        file,
+        "--methods",
+        "tet20,tet80",
+        "--rays",
+        "0",
+        "--image",
+        "32",
+    ]);
+    let case = &a["cases"][0];
+    assert_eq!(case["rays"], 32 * 32);
+    for m in case["methods"].as_array().unwrap() {
+        assert_eq!(m["failures"], 0, "{m}");
+        assert_eq!(
+            m["agree"].as_u64().unwrap() + m["ambiguous"].as_u64().unwrap(),
+            32 * 32,
+            "{m}"
+        );
+    }
+}
+
+/// `--eye`, `--target`, `--up`, `--fov` replace the camera: looking away
+/// from the cube sees nothing, looking at it from another side sees it,
+/// and impossible views are refused with a clear message.
+#[test]
+fn view_flags_move_the_camera_and_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = cube_obj(dir.path());
+    let file = dir.path().join("cube.tmesh");
+    let file = file.to_str().unwrap();
+    json(&["build", obj.to_str().unwrap(), "-o", file]);
+
+    let away = render_json(
+        file,
+        "tet20",
+        &["--eye", "0.5,0.5,4", "--target", "0.5,0.5,8"],
+    );
+    assert_eq!(away["hits"], 0, "{away}");
+    assert_eq!(away["failures"], 0, "{away}");
+    // From below (-y), up along +z, a narrow field of view that the cube fills.
+    let below = [
+        "--eye",
+        "0.5,-3,0.5",
+        "--target",
+        "0.5,0.5,0.5",
+        "--up",
+        "0,0,1",
+        "--fov",
+        "10",
+    ];
+    let at = render_json(file, "tet20", &below);
+    assert_eq!(at["failures"], 0, "{at}");
+    assert_eq!(
+        at["hits"],
+        48 * 36,
+        "a 10° view of the cube from 3.5 away is all cube"
+    );
+    let reference = render_json(file, "brute", &below);
+    assert_eq!(at["hits"], reference["hits"]);
+    // The same view through `accuracy`: every camera ray agrees.
+    let mut args = vec![
+        "accuracy",
+        file,
+        "--methods",
+        "tet20",
+        "--rays",
+        "0",
+        "--image",
+        "16",
+    ];
+    args.extend_from_slice(&below);
+    let a = json(&args);
+    assert_eq!(a["cases"][0]["methods"][0]["failures"], 0, "{a}");
+
+    for (flags, words) in [
+        (vec!["--eye", "1,2,3", "--target", "1,2,3"], "same point"),
+        (vec!["--up", "0,0,1"], "parallel to the line of sight"),
+        (vec!["--fov", "180"], "between 0 and 180"),
+        (vec!["--fov", "0"], "between 0 and 180"),
+        (vec!["--eye", "1,2"], "three numbers"),
+        (vec!["--target", "1,inf,0"], "not finite"),
+    ] {
+        for command in ["render", "accuracy"] {
+            let mut args = vec![command, file];
+            args.extend_from_slice(&flags);
+            let out = bench(&args);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert!(!out.status.success(), "{args:?} succeeded");
+            assert!(stderr.contains(words), "{args:?}: {stderr}");
+            assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        }
+    }
+}
+
+/// A reader that stops reading (`tet-bench … | head -2`) ends the program
+/// quietly and successfully, as Unix tools do: no panic, no backtrace, no
+/// error message, for every command that writes to stdout.
+#[test]
+fn a_closed_stdout_ends_every_command_quietly() {
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    let obj = cube_obj(dir.path());
+    let obj = obj.to_str().unwrap();
+    let file = dir.path().join("cube.tmesh");
+    let file = file.to_str().unwrap();
+    json(&["build", obj, "-o", file]);
+    let again = dir.path().join("again.tmesh");
+    let tables = dir.path().join("tables");
+    let small = ["--width", "16", "--height", "12", "--frames", "1"];
+    let mut commands: Vec<Vec<&str>> = vec![
+        vec!["info", file],
+        vec!["info", file, "--json"],
+        vec!["build", obj, "-o", again.to_str().unwrap()],
+        vec!["render", file, "--json"],
+        vec!["render", file],
+        vec!["accuracy", file, "--rays", "100", "--image", "8"],
+        vec!["accuracy", file, "--rays", "100", "--image", "8", "--json"],
+    ];
+    commands[3].extend_from_slice(&small);
+    commands[4].extend_from_slice(&small);
+    let mut t = vec![
+        "tables",
+        "--quick",
+        "--scene",
+        file,
+        "--out",
+        tables.to_str().unwrap(),
+    ];
+    t.extend_from_slice(&small);
+    commands.push(t);
+    for args in commands {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_tet-bench"))
+            .args(&args)
+            .env("RUST_BACKTRACE", "1")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("tet-bench runs");
+        // Close the read end before the program writes its first line.
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !stderr.contains("panicked")
+                && !stderr.contains("Broken pipe")
+                && !stderr.contains("error"),
+            "{args:?}: {stderr}"
+        );
+        assert!(out.status.success(), "{args:?}: {:?} {stderr}", out.status);
+    }
+}

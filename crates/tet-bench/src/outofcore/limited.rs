@@ -21,7 +21,9 @@ use tet_build::tetgen::TetgenOptions;
 use tet_core::TetMesh;
 use tet_core::scene::SceneInfo;
 
-use super::{Limited, MemoryReport, Planner, Written, mib, predict};
+use super::predict::predict;
+use super::types::{Limited, MemoryReport, Written, mib};
+use crate::cli::Planner;
 use crate::load::{BuildSummary, CleaningSummary};
 
 /// The split chosen.
@@ -34,15 +36,23 @@ enum Split {
 
 /// The plan of an out-of-core build.
 struct Plan {
+    /// When planning began (the build's clock).
     start: Instant,
+    /// Predicted peak of the in-core TetGen run, bytes.
     predicted: u64,
+    /// How the scene is split.
     split: Split,
     /// TetGen workers at once.
     parallel: usize,
+    /// Options of every part's build.
     options: SeamOptions,
+    /// Seconds spent cleaning the scene.
     clean_s: f64,
+    /// Scene triangles after cleaning.
     scene_triangles: usize,
+    /// Scene vertices after cleaning.
     scene_vertices: usize,
+    /// What cleaning changed.
     cleaning: CleaningSummary,
 }
 
@@ -50,13 +60,17 @@ struct Plan {
 struct Shape {
     /// `(axis, value)` of every plane, a tree's in preorder.
     cuts: Vec<(usize, f32)>,
+    /// `tree` or `slabs`.
     planner: &'static str,
+    /// Depth of the split.
     depth: usize,
 }
 
 /// How the parts were merged, for the report.
 struct Merged<'a> {
+    /// `memory` or `stream`.
     mode: &'static str,
+    /// The streaming merge's summary (streaming only).
     stream: Option<&'a StreamSummary>,
 }
 
@@ -195,6 +209,7 @@ impl Limited<'_> {
         Ok((mesh, build, report))
     }
 
+    /// The spinner's message while the parts are built.
     fn progress(&self, plan: &Plan) -> String {
         let what = match &plan.split {
             Split::Tree(_) => "a split tree".to_string(),

@@ -1,5 +1,5 @@
-//! The traversal speed of a built mesh (issue 8, item 5: the trade between
-//! memory, build time and render time): `build --tet20` traces the mesh
+//! The traversal speed of a built mesh (the trade between memory, build
+//! time and render time of a build under a memory limit): `build --tet20` traces the mesh
 //! file it wrote with tet20, so an out-of-core build and an in-core build
 //! of the same scene report comparable Mrays/s.
 
@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use tet_trace_cpu::render::RenderOptions;
 
 use crate::cli::{BuildFlags, Method};
-use crate::render::{RenderDoc, pool, time_method};
+use crate::timing::{RenderDoc, pool, time_method};
 
 /// Image width of the measurement.
 pub const WIDTH: u32 = 640;

@@ -1,4 +1,6 @@
-//! `tet-bench info`: counts, regions and exact bytes per layout.
+//! What a mesh holds: counts, regions and exact bytes per layout, before
+//! and after pruning what no ray can reach (the `info` document, also the
+//! construction and memory tables of `tables`).
 
 use anyhow::Result;
 use serde::Serialize;
@@ -6,8 +8,7 @@ use tet_core::TetMesh;
 use tet_core::memory::MemoryReport;
 use tet_core::regions::{compute_regions, locate_brute, locate_seeds_brute, prune_unreachable};
 
-use crate::cli::InfoArgs;
-use crate::load::{BuildSummary, Loaded, load};
+use crate::load::{BuildSummary, Loaded};
 
 /// Bytes of one layout (JSON `layouts[]`).
 #[derive(Clone, Debug, Serialize)]
@@ -168,60 +169,4 @@ pub fn info(loaded: &Loaded, prune: bool) -> Result<Info> {
         build: loaded.build.clone(),
         pruned,
     })
-}
-
-fn mb(b: usize) -> f64 {
-    b as f64 / 1e6
-}
-
-/// `tet-bench info`.
-pub fn run(args: &InfoArgs, json: bool) -> Result<()> {
-    let loaded = load(&args.scene, &args.build, json)?;
-    let info = info(&loaded, args.prune)?;
-    if json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
-        return Ok(());
-    }
-    println!("{}", info.name);
-    println!(
-        "  triangles {}  points {}  tets {}  constrained faces {}  components {}",
-        info.triangles, info.points, info.tets, info.constrained_faces, info.components
-    );
-    println!(
-        "  regions {} (largest {} tets, smallest {}, {} single-tet)",
-        info.regions.count, info.regions.largest, info.regions.smallest, info.regions.singletons
-    );
-    if let Some(b) = &info.build {
-        crate::build::print_build(b);
-    }
-    print_layouts(&info.layouts);
-    if let Some(p) = &info.pruned {
-        println!(
-            "  pruned to the camera's and lights' regions: removed {} of {} regions, {} tets, {} points, {} constrained faces",
-            p.regions_removed,
-            p.regions_kept + p.regions_removed,
-            p.tets_removed,
-            p.points_removed,
-            p.constrained_removed
-        );
-        print_layouts(&p.layouts);
-    }
-    Ok(())
-}
-
-fn print_layouts(layouts: &[LayoutBytes]) {
-    println!(
-        "  {:<11} {:>10} {:>10} {:>10} {:>10}",
-        "layout", "hot MB", "cold MB", "total MB", "B/tet hot"
-    );
-    for l in layouts {
-        println!(
-            "  {:<11} {:>10.3} {:>10.3} {:>10.3} {:>10.1}",
-            l.name,
-            mb(l.hot_bytes),
-            mb(l.cold_bytes),
-            mb(l.total_bytes),
-            l.hot_bytes_per_tet
-        );
-    }
 }

@@ -1,4 +1,6 @@
-//! `tet-bench build`: build a scene's mesh and write it to a mesh file.
+//! `tet-bench build`: build a scene's mesh (in core, or in parts under
+//! `--memory-limit`) and write it to a mesh file; `--predict-memory`
+//! predicts TetGen's peak memory instead.
 
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
@@ -8,10 +10,12 @@ use std::path::Path;
 use tet_core::TetMesh;
 use tet_core::scene::SceneInfo;
 
-use crate::cli::BuildArgs;
+use super::text::print_build;
+use crate::cli::{BuildArgs, MergeMode};
 use crate::load::{BuildSummary, MESH_EXTENSION, load};
-use crate::outofcore::{Limited, MemoryReport, MergeMode, predict, print_memory};
-use crate::render::RenderDoc;
+use crate::outofcore::{Limited, MemoryReport, predict, tet20_speed};
+use crate::output::{outln, print_json};
+use crate::timing::RenderDoc;
 
 /// The `build` document.
 #[derive(Debug, Serialize)]
@@ -68,33 +72,6 @@ fn save(
         memory,
         tet20: None,
     })
-}
-
-/// Prints a construction report.
-pub fn print_build(b: &BuildSummary) {
-    println!(
-        "  build: TetGen `{}`; {} scene triangles, {} Steiner points",
-        b.switches, b.scene_triangles, b.steiner_points
-    );
-    println!(
-        "  times: clean {:.3} s, TetGen {:.3} s, assemble+validate {:.3} s, reorder {:.3} s, total {:.3} s; TetGen peak {}",
-        b.clean_s,
-        b.tetgen_s,
-        b.assemble_s,
-        b.reorder_s,
-        b.total_s,
-        b.worker_peak_kib
-            .map_or("n/a".into(), |k| format!("{:.1} MB", k as f64 / 1024.0))
-    );
-    let c = &b.cleaning;
-    println!(
-        "  cleaning: {} vertices merged, {} repeated-vertex, {} zero-area, {} duplicate triangles dropped, {} unused vertices removed",
-        c.merged_vertices,
-        c.repeated_vertex_triangles,
-        c.zero_area_triangles,
-        c.duplicate_triangles,
-        c.unused_vertices
-    );
 }
 
 /// `tet-bench build`.
@@ -176,30 +153,40 @@ pub fn run(args: &BuildArgs, json: bool) -> Result<()> {
     };
     let doc = BuildDoc {
         tet20: if args.tet20 {
-            Some(crate::outofcore::tet20_speed(output, &args.build, json)?)
+            Some(tet20_speed(output, &args.build, json)?)
         } else {
             None
         },
         ..doc
     };
     if json {
-        println!("{}", serde_json::to_string_pretty(&doc)?);
+        print_json(&doc)?;
     } else {
-        println!(
+        outln!(
             "{}: {} points, {} tets, {} constrained faces -> {} ({} bytes)",
-            doc.name, doc.points, doc.tets, doc.constrained_faces, doc.output, doc.file_bytes
-        );
+            doc.name,
+            doc.points,
+            doc.tets,
+            doc.constrained_faces,
+            doc.output,
+            doc.file_bytes
+        )?;
         if let Some(b) = &doc.build {
-            print_build(b);
+            print_build(b)?;
         }
         if let Some(m) = &doc.memory {
-            print_memory(m);
+            print_memory(m)?;
         }
         if let Some(t) = &doc.tet20 {
-            println!(
+            outln!(
                 "  tet20 on the written mesh: {:.2} Mrays/s ({}x{}, best of {} frames, {} threads, {} failures)",
-                t.mrays_per_s, t.width, t.height, t.frames, t.threads, t.failures
-            );
+                t.mrays_per_s,
+                t.width,
+                t.height,
+                t.frames,
+                t.threads,
+                t.failures
+            )?;
         }
     }
     Ok(())
@@ -217,9 +204,9 @@ fn run_predict(args: &BuildArgs, json: bool) -> Result<()> {
         .with_context(|| format!("cannot load scene `{}`", args.scene))?;
     let p = predict(&scene, args.build.no_box)?;
     if json {
-        println!("{}", serde_json::to_string_pretty(&p)?);
+        print_json(&p)?;
     } else {
-        println!(
+        outln!(
             "{}: TetGen input {} points + {} triangles; predicted peak memory {:.1} MiB ({} bytes) = {:.3} × ({:.2} MB + {:.0} B × {})",
             p.name,
             p.points,
@@ -230,7 +217,64 @@ fn run_predict(args: &BuildArgs, json: bool) -> Result<()> {
             p.model.base_bytes / 1e6,
             p.model.bytes_per_element,
             p.points + p.triangles
-        );
+        )?;
+    }
+    Ok(())
+}
+
+/// Prints a memory report.
+fn print_memory(m: &MemoryReport) -> Result<()> {
+    let mib = |bytes: u64| bytes as f64 / (1024.0 * 1024.0);
+    let mb = mib;
+    if !m.out_of_core {
+        outln!(
+            "  memory: predicted in-core peak {:.1} MiB fits the limit {:.1} MiB: built in core (measured peak {})",
+            mb(m.predicted_in_core_bytes),
+            mb(m.limit_bytes),
+            m.max_part_peak_kib
+                .map_or("n/a".into(), |k| format!("{:.1} MiB", k as f64 / 1024.0))
+        )?;
+        return Ok(());
+    }
+    outln!(
+        "  memory: predicted in-core peak {:.1} MiB > limit {:.1} MiB: {} parts along {} ({} at a time), {} scene triangles cut, {:.2} s",
+        mb(m.predicted_in_core_bytes),
+        mb(m.limit_bytes),
+        m.parts,
+        ["x", "y", "z"][m.axis.unwrap_or(0).min(2)],
+        m.parallel_parts,
+        m.triangles_cut,
+        m.total_s
+    )?;
+    for k in 0..m.parts {
+        outln!(
+            "    part {k}: {} points, {} triangles -> {} tets; peak predicted {:.1} MiB, measured {}",
+            m.part_points.get(k).copied().unwrap_or(0),
+            m.part_triangles.get(k).copied().unwrap_or(0),
+            m.part_tets.get(k).copied().unwrap_or(0),
+            mb(m.part_predicted_bytes.get(k).copied().unwrap_or(0)),
+            m.part_peak_kib
+                .get(k)
+                .copied()
+                .flatten()
+                .map_or("n/a".into(), |k| format!("{:.1} MiB", k as f64 / 1024.0))
+        )?;
+    }
+    let process = m
+        .process_peak_kib
+        .map_or("n/a".into(), |k| format!("{:.1} MiB", k as f64 / 1024.0));
+    match (
+        m.merge_s,
+        m.merge_max_resident_bytes,
+        m.merge_all_parts_bytes,
+    ) {
+        (Some(s), Some(held), Some(all)) => outln!(
+            "  merge: streamed through {:.1} MiB of part files in {s:.2} s, holding at most {:.1} MiB (all parts: {:.1} MiB); this process's peak {process}",
+            mb(m.part_file_bytes.unwrap_or(0)),
+            mb(held),
+            mb(all)
+        )?,
+        _ => outln!("  merge: {}; this process's peak {process}", m.merge)?,
     }
     Ok(())
 }

@@ -1,4 +1,6 @@
-//! `tet-bench render`: frames with one method, best and median timings.
+//! Timing one method on one scene: frames rendered on a thread pool, the
+//! best and the median reported as a [`RenderDoc`] (the `render --json`
+//! document and the rows of every speed table).
 
 use std::time::Instant;
 
@@ -7,8 +9,10 @@ use serde::Serialize;
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::render::{Frame, FrameStats, RenderOptions, render, render_into};
 
-use crate::cli::{Method, RenderArgs};
-use crate::load::{Loaded, load, require_tets};
+use crate::bvh::BvhTracer;
+use crate::cli::Method;
+use crate::layouts::layout_bytes;
+use crate::load::Loaded;
 use crate::methods::tracer;
 
 /// Timings of one method on one scene (JSON document of `render`, and rows
@@ -102,7 +106,7 @@ pub fn time_method(
     let setup = Instant::now();
     let t: Box<dyn Tracer + '_> = tracer(method, false, &loaded.mesh)?;
     let setup_s = setup.elapsed().as_secs_f64();
-    let hot_bytes = crate::info::layout_bytes(&loaded.mesh)
+    let hot_bytes = layout_bytes(&loaded.mesh)
         .1
         .iter()
         .find(|l| l.name == method.name())
@@ -119,7 +123,7 @@ pub fn time_method(
     if method == Method::Obvhs {
         // Nodes visited: one untimed frame through the counting traversal
         // (same BVH, same hits); its frame (heat map = nodes) is returned.
-        let counting = crate::bvh::BvhTracer::new(&loaded.mesh).counting();
+        let counting = BvhTracer::new(&loaded.mesh).counting();
         let counted = pool
             .install(|| render(&counting, &loaded.camera, &loaded.lights, opts))
             .context("render failed")?;
@@ -162,55 +166,4 @@ pub fn time_method(
         target_features: target_features(),
     };
     Ok((doc, frame))
-}
-
-/// `tet-bench render`.
-pub fn run(args: &RenderArgs, json: bool) -> Result<()> {
-    let loaded = load(&args.scene, &args.build, json)?;
-    require_tets(&loaded)?;
-    let opts = RenderOptions {
-        width: args.width,
-        height: args.height,
-        shadows: args.shadows,
-        ..RenderOptions::default()
-    };
-    let doc = if args.method.is_gpu() {
-        if args.output.is_some() || args.heatmap.is_some() || args.shadows {
-            bail!("GPU methods report timings only: use a CPU method for images and shadows");
-        }
-        crate::gpu::time_gpu(&loaded, args.method, args.width, args.height, args.frames)?
-    } else {
-        let pool = pool(args.threads)?;
-        let (doc, frame) = time_method(&loaded, args.method, &opts, args.frames, &pool)?;
-        if let Some(path) = &args.output {
-            frame.save_png(path)?;
-        }
-        if let Some(path) = &args.heatmap {
-            frame.save_heatmap(path, None)?;
-        }
-        doc
-    };
-    if json {
-        println!("{}", serde_json::to_string_pretty(&doc)?);
-    } else {
-        let visited = match doc.nodes_per_ray {
-            Some(n) => format!("{n:.1} BVH nodes/ray"),
-            None => format!("{:.1} tets/ray", doc.tets_per_ray),
-        };
-        println!(
-            "{} {} ({}) {}x{} {} threads: best {:.1} ms, median {:.1} ms, {:.2} Mrays/s, {visited}, {} hits, {} failures",
-            doc.scene,
-            doc.method.name(),
-            doc.tracer,
-            doc.width,
-            doc.height,
-            doc.threads,
-            doc.best_ms,
-            doc.median_ms,
-            doc.mrays_per_s,
-            doc.hits,
-            doc.failures
-        );
-    }
-    Ok(())
 }

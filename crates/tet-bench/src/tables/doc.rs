@@ -1,0 +1,179 @@
+//! The plain data of a `tables` run ([`TablesDoc`], written as
+//! `tables.json` and printed by `tables --json`): what every table
+//! measured, per scene and for the whole run. Field names are a scripted
+//! interface: add, never rename or remove.
+
+use serde::Serialize;
+
+use crate::accuracy::CaseAccuracy;
+use crate::cli::BuildFlags;
+use crate::exitface::ExitFaceTable;
+use crate::layouts::Info;
+use crate::load::BuildSummary;
+use crate::outofcore::MemoryReport;
+use crate::timing::RenderDoc;
+
+/// True for the scene the papers' Torus Knots numbers belong to: the
+/// procedural `torus-knots` or a scenes.json's "Torus Knots".
+pub fn is_torus_knots(spec: &str) -> bool {
+    spec == "torus-knots" || spec.ends_with("#Torus Knots")
+}
+
+/// The machine and settings every table states.
+#[derive(Clone, Debug, Serialize)]
+pub struct Setup {
+    /// Logical CPUs.
+    pub cpus: usize,
+    /// Worker threads used.
+    pub threads: usize,
+    /// Image size.
+    pub width: u32,
+    /// Image size.
+    pub height: u32,
+    /// Timed frames per method (best is reported).
+    pub frames: u32,
+    /// Compile-time CPU features (`target-cpu=native` shows here).
+    pub target_features: Vec<&'static str>,
+    /// `--quick`.
+    pub quick: bool,
+    /// OS and architecture.
+    pub platform: String,
+}
+
+/// Everything measured on one scene.
+#[derive(Clone, Debug, Serialize)]
+pub struct SceneResult {
+    /// Scene spec as given.
+    pub spec: String,
+    /// Info (counts, bytes per layout, build report).
+    pub info: Option<Info>,
+    /// BVH build time, s.
+    pub bvh_build_s: Option<f64>,
+    /// One row per method.
+    pub renders: Vec<RenderDoc>,
+    /// tet20 on the unsorted (TetGen order) mesh, for Figure 8.
+    pub unsorted_tet20: Option<RenderDoc>,
+    /// tet20 on the mesh built with `--wide-box` (the enclosing box holds
+    /// the camera, which primary rays start from), against the default tight
+    /// box (rays enter through the boundary).
+    pub wide_box_tet20: Option<RenderDoc>,
+    /// Accuracy against the f64 reference.
+    pub accuracy: Option<CaseAccuracy>,
+    /// GPU methods (seed 000 Table 3), when built with `--features gpu` and
+    /// an adapter is present.
+    pub gpu_renders: Vec<RenderDoc>,
+    /// Why there are no GPU rows, if there are none.
+    pub gpu_note: Option<String>,
+    /// The build trade (full mode only): the same scene built with the
+    /// quality bound `-q5`, and tet20 on it.
+    pub quality5: Option<QualityTrade>,
+    /// Out-of-core builds under ½ and ⅓ of the in-core peak (full mode,
+    /// first scene of each geometry only).
+    pub out_of_core: Vec<OutOfCoreRow>,
+    /// Other scenes of the run with the same geometry: the mesh was built
+    /// once for all of them (box around all their cameras and lights).
+    pub shares_mesh_with: Vec<String>,
+    /// True when this scene's mesh came from that shared build.
+    pub mesh_reused: bool,
+    /// Why the scene failed, if it did.
+    pub error: Option<String>,
+}
+
+/// One out-of-core build of a scene.
+#[derive(Clone, Debug, Serialize)]
+pub struct OutOfCoreRow {
+    /// Fraction of the in-core peak used as the limit (0.5, 0.333…).
+    pub fraction: f64,
+    /// The in-core build's measured TetGen peak, KiB (the limit is a
+    /// fraction of it; of the prediction when not measured).
+    pub in_core_peak_kib: Option<u64>,
+    /// The in-core build's total seconds.
+    pub in_core_s: f64,
+    /// The in-core mesh's tets.
+    pub in_core_tets: usize,
+    /// Limit, parts, peaks, time.
+    pub memory: Option<MemoryReport>,
+    /// Tets of the merged mesh.
+    pub tets: usize,
+    /// tet20 on the merged mesh.
+    pub tet20: Option<RenderDoc>,
+    /// Tet quality of the in-core mesh (seed 003 Table 3).
+    pub in_core_quality: Option<Quality>,
+    /// Tet quality of the merged mesh.
+    pub quality: Option<Quality>,
+    /// Why the build failed, if it did.
+    pub error: Option<String>,
+}
+
+/// Tet quality (seed 003 Table 3: aspect ratio = longest edge ÷ smallest
+/// height; also the radius-edge ratio).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Quality {
+    /// Smallest aspect ratio.
+    pub aspect_min: f64,
+    /// Largest aspect ratio.
+    pub aspect_max: f64,
+    /// Mean aspect ratio.
+    pub aspect_mean: f64,
+    /// Smallest radius-edge ratio.
+    pub radius_edge_min: f64,
+    /// Largest radius-edge ratio.
+    pub radius_edge_max: f64,
+    /// Mean radius-edge ratio.
+    pub radius_edge_mean: f64,
+}
+
+/// A quality-refined build and its traversal speed.
+#[derive(Clone, Debug, Serialize)]
+pub struct QualityTrade {
+    /// Tets.
+    pub tets: usize,
+    /// Construction report.
+    pub build: Option<BuildSummary>,
+    /// tet20 on the refined mesh.
+    pub tet20: RenderDoc,
+}
+
+/// The `tables` document (also written as `tables.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct TablesDoc {
+    /// Machine and settings.
+    pub setup: Setup,
+    /// Per scene.
+    pub scenes: Vec<SceneResult>,
+    /// Exit-face search (seed 001 Table 5), single thread.
+    pub exit_face: Option<ExitFaceTable>,
+    /// Speed against accuracy per method and precision on the first scene,
+    /// as given and at the extremes (scaled, translated, slivers).
+    pub speed_accuracy: Option<SpeedAccuracy>,
+    /// Why there is no out-of-core table, if there is none.
+    pub out_of_core_note: Option<String>,
+    /// SVG figures written (paths).
+    pub figures: Vec<String>,
+    /// Wall time of the whole run, s.
+    pub total_s: f64,
+}
+
+/// How every scene of the tables is built: TetGen `-pY` in a box, Hilbert
+/// order, the default time limit.
+pub const TABLE_FLAGS: BuildFlags = BuildFlags {
+    quality: None,
+    max_steiner: None,
+    time_limit: 600.0,
+    no_box: false,
+    wide_box: false,
+    no_sort: false,
+};
+
+/// Speed against accuracy (seed 001 Table 4 beside render speed): every CPU method in f32 and,
+/// where it has one, f64, on the first scene as given and on its extreme
+/// cases ([`crate::extremes`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct SpeedAccuracy {
+    /// The scene's spec.
+    pub scene: String,
+    /// `as-is`, then the extreme cases (JSON as `accuracy`'s `cases[]`).
+    pub cases: Vec<CaseAccuracy>,
+    /// Why it is missing, when the scene could not be loaded.
+    pub error: Option<String>,
+}

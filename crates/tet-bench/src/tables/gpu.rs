@@ -1,0 +1,67 @@
+//! GPU methods (Aman et al., seed 000 Table 3): the tet walks as wgpu
+//! compute shaders, when built with `--features gpu` and an adapter is
+//! present.
+
+use std::fmt::Write as _;
+
+use tet_trace_cpu::render::RenderOptions;
+
+use super::doc::TablesDoc;
+use crate::cli::Method;
+use crate::gpu::time_gpu;
+use crate::load::Loaded;
+use crate::output::error_chain;
+use crate::timing::RenderDoc;
+
+/// The GPU methods' rows, or why there are none.
+pub fn measure(
+    loaded: &Loaded,
+    opts: &RenderOptions,
+    frames: u32,
+) -> (Vec<RenderDoc>, Option<String>) {
+    if !cfg!(feature = "gpu") {
+        return (Vec::new(), Some("built without the `gpu` feature".into()));
+    }
+    let mut rows = Vec::new();
+    for m in [
+        Method::GpuTet20,
+        Method::GpuTet16,
+        Method::GpuTet32,
+        Method::GpuTet80,
+    ] {
+        eprintln!("  {}: rendering with {}", loaded.name, m.name());
+        match time_gpu(loaded, m, opts.width, opts.height, frames) {
+            Ok(doc) => rows.push(doc),
+            Err(e) => return (rows, Some(error_chain(&e))),
+        }
+    }
+    (rows, None)
+}
+
+/// The table.
+pub fn markdown(m: &mut String, doc: &TablesDoc) {
+    let _ = writeln!(m, "\n## GPU (seed 000 Table 3)\n");
+    let _ = writeln!(
+        m,
+        "| scene | method (device) | best ms | Mrays/s | tets/ray | GPU bytes (tets + points) | failures |"
+    );
+    let _ = writeln!(m, "|---|---|---:|---:|---:|---:|---:|");
+    for sc in &doc.scenes {
+        for r in &sc.gpu_renders {
+            let _ = writeln!(
+                m,
+                "| {} | {} | {:.2} | {:.2} | {:.1} | {} | {} |",
+                r.scene,
+                r.tracer,
+                r.best_ms,
+                r.mrays_per_s,
+                r.tets_per_ray,
+                r.hot_bytes,
+                r.failures
+            );
+        }
+        if let Some(note) = &sc.gpu_note {
+            let _ = writeln!(m, "| {} | no GPU rows: {note} | | | | | |", sc.spec);
+        }
+    }
+}

@@ -1,0 +1,216 @@
+//! `tet-bench tables`: the reproduction of the papers' tables, one module
+//! per table, each owning its measurement and its Markdown section:
+//!
+//! * Aman et al. (seed 000) Table 1 — construction time per structure
+//!   ([`construction`]), render time per method per scene
+//!   ([`render_speed`], with the paper's CPU numbers as ratios to the BVH
+//!   measured in the same run, since absolute times are machine-bound);
+//! * seed 000 Table 4 — bytes per layout per scene ([`memory`]);
+//! * seed 000 Table 5 — the Armadillo Zoom camera series, with `--scenes`
+//!   ([`zoom`]);
+//! * seed 000 Figure 8 — Hilbert-sorted vs unsorted mesh, tet20 ([`sorting`]);
+//! * entry through the boundary (tight box) vs camera inside (wide box),
+//!   tet20 ([`entry`]);
+//! * the build trade `-pY` vs `-pYq5`, full mode ([`quality`]);
+//! * seed 000 Table 3 — GPU methods, with `--features gpu` and an adapter
+//!   ([`gpu`]);
+//! * Maria et al. (seed 001) Table 4 — rays with a wrong result per 1024²
+//!   rays per method ([`robustness`]);
+//! * speed vs accuracy — Mrays/s beside the failure rate per method and
+//!   precision, as given and at the extremes ([`speed_accuracy`]);
+//! * seed 001 Table 5 — exit-face search cost per method ([`exit_face`]);
+//! * Erkoç et al. (seed 003) Tables 2–3 — out of core: build time, parts
+//!   and peaks under limits of ½ and ⅓ of the in-core TetGen peak, full
+//!   mode ([`out_of_core`]).
+//!
+//! This module is the driver: it plans the scenes ([`plan`](mod@plan)), measures
+//! each table into a [`doc::TablesDoc`], and hands it to the report
+//! writers: Markdown, CSV and JSON ([`report`]) and SVG ([`figures`]).
+//!
+//! Scenes with the same geometry (the Armadillo Zoom series, Mix / Mix
+//! close: same objects, other cameras) are built once, in an enclosing box
+//! that holds every camera and light of the group, and the mesh is reused.
+
+mod construction;
+mod doc;
+mod entry;
+mod exit_face;
+mod figures;
+mod gpu;
+mod memory;
+mod out_of_core;
+mod plan;
+mod quality;
+mod render_speed;
+mod report;
+mod robustness;
+mod sorting;
+mod speed_accuracy;
+mod zoom;
+
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use tet_trace_cpu::render::RenderOptions;
+
+use crate::cli::TablesArgs;
+use crate::methods::cpu_methods;
+use crate::output::{error_chain, outln, print_json};
+use crate::timing::{pool, target_features};
+use doc::{SceneResult, Setup, TABLE_FLAGS, TablesDoc};
+use plan::{MeshCache, Planned, plan, scene_specs};
+use report::{markdown, write_atomic, write_outputs};
+
+/// Measures every table of one scene.
+fn measure_scene(
+    planned: &Planned,
+    cache: &mut MeshCache,
+    args: &TablesArgs,
+    opts: &RenderOptions,
+    frames: u32,
+    pool: &rayon::ThreadPool,
+) -> Result<SceneResult> {
+    let spec = planned.spec.as_str();
+    let (loaded, mesh_reused) = cache.load(planned, &TABLE_FLAGS, false)?;
+    if mesh_reused {
+        eprintln!(
+            "  {spec}: mesh shared with {}",
+            planned.shares_with.join(", ")
+        );
+    }
+    let (info, bvh_build_s) = construction::measure(&loaded)?;
+    let renders = render_speed::measure(spec, &loaded, opts, frames, pool)?;
+    let accuracy = robustness::measure(spec, &loaded, &cpu_methods(), args.quick)?;
+    let unsorted_tet20 = Some(sorting::measure(planned, cache, opts, frames, pool)?);
+    let wide_box_tet20 = Some(entry::measure(planned, cache, opts, frames, pool)?);
+    let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames);
+    let quality5 = if args.quick {
+        None
+    } else {
+        Some(quality::measure(planned, cache, opts, frames, pool)?)
+    };
+    let out_of_core = if args.quick || !planned.first {
+        Vec::new()
+    } else {
+        out_of_core::measure(&loaded, &TABLE_FLAGS, &planned.extra, opts, frames, pool)
+    };
+    Ok(SceneResult {
+        quality5,
+        out_of_core,
+        shares_mesh_with: planned.shares_with.clone(),
+        mesh_reused,
+        gpu_renders,
+        gpu_note,
+        spec: spec.into(),
+        info: Some(info),
+        bvh_build_s: Some(bvh_build_s),
+        renders,
+        unsorted_tet20,
+        wide_box_tet20,
+        accuracy: Some(accuracy),
+        error: None,
+    })
+}
+
+/// `tet-bench tables`.
+pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
+    let start = Instant::now();
+    let pool = pool(args.threads)?;
+    let (width, height, frames) = if args.quick {
+        (640, 480, 3)
+    } else {
+        (1920, 1440, 5)
+    };
+    let width = args.width.unwrap_or(width).max(1);
+    let height = args.height.unwrap_or(height).max(1);
+    let frames = args.frames.unwrap_or(frames).max(1);
+    let opts = RenderOptions {
+        width,
+        height,
+        ..RenderOptions::default()
+    };
+    let setup = Setup {
+        cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        threads: pool.current_num_threads(),
+        width,
+        height,
+        frames,
+        target_features: target_features(),
+        quick: args.quick,
+        platform: format!("{}-{}", std::env::consts::OS, std::env::consts::ARCH),
+    };
+    let mut scenes = Vec::new();
+    let mut cache = MeshCache::default();
+    for planned in plan(&scene_specs(args)?) {
+        let spec = planned.spec.clone();
+        eprintln!("scene {spec}");
+        let result = measure_scene(&planned, &mut cache, args, &opts, frames, &pool);
+        if planned.last
+            && let Some(key) = planned.key
+        {
+            cache.evict(key);
+        }
+        scenes.push(match result {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("  {spec}: {}", error_chain(&e));
+                SceneResult {
+                    spec: spec.clone(),
+                    info: None,
+                    bvh_build_s: None,
+                    renders: Vec::new(),
+                    unsorted_tet20: None,
+                    wide_box_tet20: None,
+                    accuracy: None,
+                    gpu_renders: Vec::new(),
+                    gpu_note: None,
+                    quality5: None,
+                    out_of_core: Vec::new(),
+                    shares_mesh_with: planned.shares_with.clone(),
+                    mesh_reused: false,
+                    error: Some(error_chain(&e)),
+                }
+            }
+        });
+    }
+    let exit_face = Some(exit_face::measure(args.quick)?);
+    let speed_accuracy = scene_specs(args)?.first().map(|spec| {
+        eprintln!("speed vs accuracy: {spec}, f32 and f64, as given and at the extremes");
+        speed_accuracy::measure(spec, args.quick)
+    });
+    let mut doc = TablesDoc {
+        setup,
+        scenes,
+        exit_face,
+        speed_accuracy,
+        out_of_core_note: args.quick.then(|| {
+            "skipped in --quick mode: each scene is built twice more, in parts (run without --quick)"
+                .to_string()
+        }),
+        figures: Vec::new(),
+        total_s: 0.0,
+    };
+    let plots_dir = args.plots.clone().unwrap_or_else(|| args.out.clone());
+    std::fs::create_dir_all(&plots_dir)
+        .with_context(|| format!("cannot create {}", plots_dir.display()))?;
+    for (name, svg) in figures::figures(&doc)? {
+        let path = plots_dir.join(name);
+        write_atomic(&path, svg.as_bytes())?;
+        doc.figures.push(path.display().to_string());
+    }
+    doc.total_s = start.elapsed().as_secs_f64();
+    let markdown = markdown(&doc);
+    write_outputs(&args.out, &doc, &markdown)?;
+    if json {
+        print_json(&doc)?;
+    } else {
+        outln!("{markdown}")?;
+        eprintln!(
+            "wrote {}/tables.{{md,csv,json}} and {} figures in {}",
+            args.out.display(),
+            doc.figures.len(),
+            plots_dir.display()
+        );
+    }
+    Ok(())
+}

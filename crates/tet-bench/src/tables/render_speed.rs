@@ -1,0 +1,96 @@
+//! Render time per method (Aman et al., seed 000 Table 1, right half):
+//! every CPU method on every scene, with the ratio to the BVH measured in
+//! the same run beside the paper authors' own code's ratio on Torus Knots
+//! (absolute times are machine-bound, ratios travel).
+
+use std::fmt::Write as _;
+
+use anyhow::Result;
+use tet_trace_cpu::render::RenderOptions;
+
+use super::doc::{TablesDoc, is_torus_knots};
+use crate::cli::Method;
+use crate::load::Loaded;
+use crate::methods::cpu_methods;
+use crate::timing::{RenderDoc, time_method};
+
+/// neptun (the authors' C++ code) on a 2-core machine, Torus Knots,
+/// 1920×1440 primary rays, 2 threads, Mrays/s, measured once for this
+/// project: the paper-ratio column divides these by neptun's BVH.
+const NEPTUN_TORUS_KNOTS_MRAYS: [(Method, f64); 7] = [
+    (Method::Tet20, 5.23),
+    (Method::Tet16, 4.84),
+    (Method::Tet32, 2.31),
+    (Method::Tet80, 1.65),
+    (Method::Sctp, 2.79),
+    (Method::Obvhs, 4.92),
+    (Method::Embree, 11.3),
+];
+
+/// neptun's BVH on the same run, Mrays/s (the denominator of its ratios).
+const NEPTUN_BVH_MRAYS: f64 = 4.92;
+
+/// One timed render per CPU method.
+pub fn measure(
+    spec: &str,
+    loaded: &Loaded,
+    opts: &RenderOptions,
+    frames: u32,
+    pool: &rayon::ThreadPool,
+) -> Result<Vec<RenderDoc>> {
+    let mut renders = Vec::new();
+    for m in cpu_methods() {
+        eprintln!("  {spec}: rendering with {}", m.name());
+        renders.push(time_method(loaded, m, opts, frames, pool)?.0);
+    }
+    Ok(renders)
+}
+
+/// The table.
+pub fn markdown(m: &mut String, doc: &TablesDoc) {
+    let _ = writeln!(
+        m,
+        "\n## Render time per method (seed 000 Table 1, right half)\n"
+    );
+    let _ = writeln!(
+        m,
+        "Ratio = method Mrays/s ÷ BVH (obvhs) Mrays/s in the same run. Paper ratio: neptun's CPU numbers on Torus Knots (1920×1440, 2 threads) ÷ its BVH (4.92 Mrays/s).\n"
+    );
+    let _ = writeln!(
+        m,
+        "| scene | method | best ms | median ms | Mrays/s | tets/ray | BVH nodes/ray | ratio to BVH | paper ratio | failures |"
+    );
+    let _ = writeln!(m, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for sc in &doc.scenes {
+        let bvh = sc
+            .renders
+            .iter()
+            .find(|r| r.method == Method::Obvhs)
+            .map_or(f64::NAN, |r| r.mrays_per_s);
+        for r in &sc.renders {
+            let paper = NEPTUN_TORUS_KNOTS_MRAYS
+                .iter()
+                .find(|(pm, _)| *pm == r.method)
+                .filter(|_| is_torus_knots(&sc.spec))
+                .map_or("–".to_string(), |(_, v)| {
+                    format!("{:.2}", v / NEPTUN_BVH_MRAYS)
+                });
+            let (tets, nodes) = match r.nodes_per_ray {
+                Some(n) => ("–".to_string(), format!("{n:.1}")),
+                None => (format!("{:.1}", r.tets_per_ray), "–".to_string()),
+            };
+            let _ = writeln!(
+                m,
+                "| {} | {} | {:.1} | {:.1} | {:.2} | {tets} | {nodes} | {:.2} | {} | {} |",
+                r.scene,
+                r.tracer,
+                r.best_ms,
+                r.median_ms,
+                r.mrays_per_s,
+                r.mrays_per_s / bvh,
+                paper,
+                r.failures
+            );
+        }
+    }
+}

@@ -1,0 +1,75 @@
+//! Robustness (Maria et al., seed 001 Table 4): rays with a wrong result
+//! per 1024² rays per method against the f64 reference, beside each
+//! method's render speed.
+
+use std::fmt::Write as _;
+
+use anyhow::Result;
+
+use super::doc::TablesDoc;
+use crate::accuracy::{CaseAccuracy, run_case};
+use crate::cli::{Method, Precision};
+use crate::load::Loaded;
+
+/// Every CPU method (`methods`) in f32 on the scene's camera image and
+/// random interior rays (256² + 20,000 with `--quick`, else 1024² +
+/// 100,000).
+pub fn measure(
+    spec: &str,
+    loaded: &Loaded,
+    methods: &[Method],
+    quick: bool,
+) -> Result<CaseAccuracy> {
+    let (side, rays) = if quick {
+        (256, 20_000)
+    } else {
+        (1024, 100_000)
+    };
+    eprintln!("  {spec}: accuracy ({side}² camera rays + {rays} random rays)");
+    run_case("as-is", loaded, methods, Precision::F32, side, rays, 1)
+}
+
+/// The table.
+pub fn markdown(m: &mut String, doc: &TablesDoc) {
+    let _ = writeln!(
+        m,
+        "\n## Robustness (seed 001 Table 4) and speed vs accuracy\n"
+    );
+    let _ = writeln!(
+        m,
+        "Failures = wrong triangle + false miss + false hit + step cap + lost + NaN, beyond the grazing tolerance, per 1024² rays, against an f64 reference. Seed 001 reports 0 for its Plücker method in f32.\n"
+    );
+    let _ = writeln!(
+        m,
+        "| scene | method | rays | grazing | wrong | false miss | false hit | cap | lost | failures per 1024² | Mrays/s (render) |"
+    );
+    let _ = writeln!(m, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for sc in &doc.scenes {
+        if let Some(a) = &sc.accuracy {
+            for x in &a.methods {
+                let speed = sc
+                    .renders
+                    .iter()
+                    .find(|r| r.tracer == x.method)
+                    .map_or(f64::NAN, |r| r.mrays_per_s);
+                let _ = writeln!(
+                    m,
+                    "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} |",
+                    sc.info
+                        .as_ref()
+                        .map_or(sc.spec.as_str(), |i| i.name.as_str()),
+                    x.method,
+                    x.rays,
+                    x.ambiguous,
+                    x.wrong_triangle,
+                    x.false_misses,
+                    x.false_hits,
+                    x.step_cap,
+                    x.lost,
+                    x.failures_per_1024_squared,
+                    speed
+                );
+            }
+        }
+    }
+}

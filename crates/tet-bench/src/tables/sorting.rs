@@ -1,0 +1,55 @@
+//! Hilbert-sorted vs unsorted mesh (Aman et al., seed 000 Figure 8):
+//! tet20 on the mesh in TetGen's order against the sorted one.
+
+use std::fmt::Write as _;
+
+use anyhow::Result;
+use tet_trace_cpu::render::RenderOptions;
+
+use super::doc::{TABLE_FLAGS, TablesDoc};
+use super::plan::{MeshCache, Planned};
+use crate::cli::{BuildFlags, Method};
+use crate::timing::{RenderDoc, time_method};
+
+/// tet20 on the scene built without Hilbert sorting.
+pub fn measure(
+    planned: &Planned,
+    cache: &mut MeshCache,
+    opts: &RenderOptions,
+    frames: u32,
+    pool: &rayon::ThreadPool,
+) -> Result<RenderDoc> {
+    eprintln!("  {}: unsorted mesh for Figure 8", planned.spec);
+    let flags = BuildFlags {
+        no_sort: true,
+        ..TABLE_FLAGS
+    };
+    let unsorted = cache.load(planned, &flags, false)?.0;
+    Ok(time_method(&unsorted, Method::Tet20, opts, frames, pool)?.0)
+}
+
+/// The table.
+pub fn markdown(m: &mut String, doc: &TablesDoc) {
+    let _ = writeln!(
+        m,
+        "\n## Hilbert-sorted vs unsorted (seed 000 Figure 8), tet20\n"
+    );
+    let _ = writeln!(
+        m,
+        "| scene | sorted Mrays/s | unsorted Mrays/s | speed-up |"
+    );
+    let _ = writeln!(m, "|---|---:|---:|---:|");
+    for sc in &doc.scenes {
+        let sorted = sc.renders.iter().find(|r| r.method == Method::Tet20);
+        if let (Some(a), Some(b)) = (sorted, &sc.unsorted_tet20) {
+            let _ = writeln!(
+                m,
+                "| {} | {:.2} | {:.2} | {:.2}× |",
+                a.scene,
+                a.mrays_per_s,
+                b.mrays_per_s,
+                a.mrays_per_s / b.mrays_per_s
+            );
+        }
+    }
+}

@@ -1,0 +1,91 @@
+//! Speed against accuracy: every CPU method in f32 and, where it has one,
+//! f64, on the first scene as given and on its extreme cases (scaled,
+//! translated, slivers: [`crate::extremes`]) — Maria et al.'s robustness
+//! (seed 001 Table 4) beside the speed it costs.
+
+use std::fmt::Write as _;
+
+use anyhow::Result;
+
+use super::doc::{SpeedAccuracy, TABLE_FLAGS};
+use crate::accuracy::{CaseAccuracy, all_cases};
+use crate::cli::Precision;
+use crate::load::load;
+use crate::methods::cpu_methods;
+use crate::output::error_chain;
+
+/// Runs the speed-against-accuracy cases on `spec`.
+pub fn measure(spec: &str, quick: bool) -> SpeedAccuracy {
+    let flags = TABLE_FLAGS;
+    let (side, rays) = if quick { (128, 5_000) } else { (512, 50_000) };
+    let run = || -> Result<Vec<CaseAccuracy>> {
+        let loaded = load(spec, &flags, true)?;
+        all_cases(
+            &loaded,
+            &cpu_methods(),
+            Precision::Both,
+            side,
+            rays,
+            7,
+            Some(&flags),
+            true,
+        )
+    };
+    match run() {
+        Ok(cases) => SpeedAccuracy {
+            scene: spec.to_string(),
+            cases,
+            error: None,
+        },
+        Err(e) => SpeedAccuracy {
+            scene: spec.to_string(),
+            cases: Vec::new(),
+            error: Some(error_chain(&e)),
+        },
+    }
+}
+
+/// The table.
+pub fn markdown(m: &mut String, x: &SpeedAccuracy) {
+    let _ = writeln!(
+        m,
+        "\n## Speed vs accuracy: precision and extreme scenes ({})\n",
+        x.scene
+    );
+    let _ = writeln!(
+        m,
+        "Per case, the same camera and random interior rays for every method; failures as above (per 1024² rays); Mrays/s of one pass over these rays (all threads), so speeds compare within a case. Cases: the scene as given, scaled by 1e-4 and 1e4, translated by 1e5, and a sliver-heavy jittered grid.\n"
+    );
+    if let Some(e) = &x.error {
+        let _ = writeln!(m, "Not measured: {e}\n");
+        return;
+    }
+    let _ = writeln!(
+        m,
+        "| case | method | precision | rays | wrong | false miss | false hit | cap | lost + NaN | failures per 1024² | Mrays/s |"
+    );
+    let _ = writeln!(m, "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for c in &x.cases {
+        if let Some(why) = &c.skipped {
+            let _ = writeln!(m, "| {} | skipped: {why} | | | | | | | | | |", c.case);
+            continue;
+        }
+        for r in &c.methods {
+            let _ = writeln!(
+                m,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} |",
+                c.case,
+                r.method,
+                r.precision,
+                r.rays,
+                r.wrong_triangle,
+                r.false_misses,
+                r.false_hits,
+                r.step_cap,
+                r.lost + r.nans,
+                r.failures_per_1024_squared,
+                r.mrays_per_s
+            );
+        }
+    }
+}
