@@ -17,8 +17,8 @@
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use glam::{DVec3, Vec3};
 use glam::Vec3A;
+use glam::{DVec3, Vec3};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;

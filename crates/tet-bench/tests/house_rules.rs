@@ -1,11 +1,54 @@
-//! The modules of `tet-bench` lie in layers that point one way: no module
-//! uses another that uses it back, directly or through a chain (an import
-//! circle). Edges are the module paths the source names (`use crate::…`,
-//! `super::…`, `self::…`, `child::…`, and such paths inline), each taken to
-//! the longest prefix that is a module of the crate; unit tests are left out.
+//! The workspace's structural rules, checked on its own sources so that
+//! they hold after every change:
+//!
+//! * no import circle between the modules of a crate (module `a` names
+//!   `crate::b…` or `super::…b` and `b`, directly or through others, names
+//!   `a`): modules sit in layers that point one way;
+//! * no source file longer than [`MAX_LINES`] lines (its unit tests aside)
+//!   unless its first lines say why (a line starting `//! Long file:`);
+//! * no project issue numbers in user-facing text (README, module docs,
+//!   comments, CLI help): users do not know what they are, so the text names
+//!   the paper and section instead.
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::fs;
 use std::path::{Path, PathBuf};
+
+/// Longest source file, in lines before its `#[cfg(test)] mod tests`.
+const MAX_LINES: usize = 800;
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+fn crate_src_dirs() -> Vec<PathBuf> {
+    let mut dirs: Vec<PathBuf> = fs::read_dir(workspace().join("crates"))
+        .expect("crates/")
+        .flatten()
+        .map(|e| e.path().join("src"))
+        .filter(|p| p.is_dir())
+        .collect();
+    dirs.sort();
+    assert!(
+        dirs.len() >= 5,
+        "expected the workspace's crates, found {dirs:?}"
+    );
+    dirs
+}
 
 type Module = Vec<String>;
 
@@ -143,8 +186,11 @@ fn resolve(cur: &Module, path: &[String], mods: &BTreeMap<Module, PathBuf>) -> O
         .find(|m| mods.contains_key(m))
 }
 
-/// The module graph of the crate in `src`.
-fn graph(src: &Path) -> BTreeMap<Module, BTreeSet<Module>> {
+/// The module graph of the crate in `src`. With `parents: false`, a
+/// module's use of its ancestors (the items a parent `mod.rs` or the crate
+/// root defines or re-exports for its children) is not an edge: only
+/// imports between siblings and cousins are.
+fn graph(src: &Path, parents: bool) -> BTreeMap<Module, BTreeSet<Module>> {
     let mods = modules(src);
     let mut edges = BTreeMap::new();
     for (m, file) in &mods {
@@ -153,6 +199,7 @@ fn graph(src: &Path) -> BTreeMap<Module, BTreeSet<Module>> {
             .iter()
             .filter_map(|p| resolve(m, p, &mods))
             .filter(|t| t != m)
+            .filter(|t| parents || !m.starts_with(t))
             .collect();
         edges.insert(m.clone(), targets);
     }
@@ -198,10 +245,11 @@ fn name(m: &Module) -> String {
     }
 }
 
+/// tet-bench, strictly: not even a module and its parent use each other.
 #[test]
-fn modules_have_no_import_circles() {
+fn tet_bench_modules_lie_in_layers() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let edges = graph(&src);
+    let edges = graph(&src, true);
     // The scan sees the layers: a command uses a measurement module, which
     // uses plumbing, and a table module uses the tables' data.
     let has = |a: &str, b: &str| {
@@ -241,9 +289,93 @@ fn the_scan_finds_circles_through_chains_groups_and_super() {
     for (path, text) in files {
         std::fs::write(src.join(path), text).unwrap();
     }
-    let edges = graph(src);
+    let edges = graph(src, true);
     let found = circles(&edges);
     let names: Vec<Vec<String>> = found.iter().map(|c| c.iter().map(name).collect()).collect();
     assert_eq!(names, [vec!["a".to_string(), "b::x".to_string()]]);
     assert!(edges[&vec!["c".to_string()]].is_empty());
+}
+
+#[test]
+fn no_import_circle_in_any_crate() {
+    let mut found = Vec::new();
+    for src in crate_src_dirs() {
+        for c in circles(&graph(&src, false)) {
+            let names: Vec<String> = c.iter().map(name).collect();
+            found.push(format!("{}: {}", src.display(), names.join(" <-> ")));
+        }
+    }
+    assert!(found.is_empty(), "import circles:\n{}", found.join("\n"));
+}
+
+#[test]
+fn no_source_file_longer_than_the_limit_without_a_reason() {
+    let mut long = Vec::new();
+    for src in crate_src_dirs() {
+        let mut files = Vec::new();
+        rust_files(&src, &mut files);
+        for file in files {
+            let text = fs::read_to_string(&file).expect("readable source");
+            let end = text.find("#[cfg(test)]\nmod tests").unwrap_or(text.len());
+            let lines = text[..end].lines().count();
+            let explained = text
+                .lines()
+                .take(40)
+                .any(|l| l.starts_with("//! Long file:"));
+            if lines > MAX_LINES && !explained {
+                long.push(format!("{} ({lines} lines)", file.display()));
+            }
+        }
+    }
+    assert!(
+        long.is_empty(),
+        "files over {MAX_LINES} lines:\n{}",
+        long.join("\n")
+    );
+}
+
+/// `issue 8`, `Issue 12`, `issue #4`: a project issue number.
+fn issue_number_at(line: &str) -> Option<usize> {
+    let lower = line.to_ascii_lowercase();
+    let mut from = 0;
+    while let Some(i) = lower[from..].find("issue") {
+        let at = from + i;
+        from = at + 5;
+        if lower[..at].ends_with(|c: char| c.is_ascii_alphanumeric()) {
+            continue;
+        }
+        let rest = lower[from..].trim_start_matches([' ', '#']);
+        let skipped = lower.len() - from - rest.len();
+        if skipped > 0 && rest.starts_with(|c: char| c.is_ascii_digit()) {
+            return Some(at);
+        }
+    }
+    None
+}
+
+#[test]
+fn no_issue_numbers_in_user_facing_text() {
+    let root = workspace();
+    let mut files = vec![root.join("README.md"), root.join("fuzz/README.md")];
+    for src in crate_src_dirs() {
+        rust_files(&src, &mut files);
+    }
+    rust_files(&root.join("fuzz/targets_common"), &mut files);
+    let mut hits = Vec::new();
+    for file in files {
+        let text = fs::read_to_string(&file).expect("readable text");
+        for (n, line) in text.lines().enumerate() {
+            if issue_number_at(line).is_some() {
+                hits.push(format!("{}:{}: {}", file.display(), n + 1, line.trim()));
+            }
+        }
+    }
+    assert!(
+        hits.is_empty(),
+        "issue numbers in user text:\n{}",
+        hits.join("\n")
+    );
+    assert!(issue_number_at("the memory model of issue 8").is_some());
+    assert!(issue_number_at("see Issue #12.").is_some());
+    assert!(issue_number_at("no issues here; tissue 3").is_none());
 }
