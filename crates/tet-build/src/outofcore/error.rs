@@ -14,7 +14,7 @@ use tet_core::format::FormatError;
 use tet_core::reorder::PermutationError;
 use thiserror::Error;
 
-/// A failure of [`build_split_once`] and the other out-of-core builders.
+/// A failure of [`build_split_once`](super::seam::build_split_once) and the other out-of-core builders.
 #[derive(Debug, Error)]
 pub enum SeamError {
     /// Cleaning rejected the scene.

@@ -16,7 +16,7 @@ use glam::Vec3;
 use std::collections::HashMap;
 use tet_core::face_key;
 
-/// What [`build_slabs`] (and [`build_split_once`]) did.
+/// What [`build_slabs`](super::seam::build_slabs) (and [`build_split_once`](super::seam::build_split_once)) did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SeamReport {
     /// Scene triangles (after cleaning) strictly crossing at least one plane.
@@ -50,7 +50,7 @@ pub struct SeamReport {
     pub part_predicted_bytes: Vec<u64>,
 }
 
-/// Options of [`build_slabs`].
+/// Options of [`build_slabs`](super::seam::build_slabs).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SeamOptions {
     /// Box around the scene (the whole mesh's boundary).

@@ -1,5 +1,5 @@
 //! The geometry of cuts: an axis-aligned [`SplitPlane`], which side of it a
-//! triangle lies on, exact bits of a point ([`key`]) and the clipping of
+//! triangle lies on, exact bits of a point (`key`) and the clipping of
 //! scene triangles by a plane, with crossing points rounded once to f32 and
 //! lying exactly on the plane (Erkoç et al., seed 003 §3.2 `CLIP`, made
 //! exact).
@@ -157,7 +157,7 @@ pub fn cut_triangle(
 }
 
 /// Vertices off a cut plane by less than this × the box's largest extent
-/// make the plane unusable ([`SeamError::PlaneNearVertex`]): TetGen would
+/// make the plane unusable ([`SeamError::PlaneNearVertex`](super::error::SeamError::PlaneNearVertex)): TetGen would
 /// merge crossing points with them (its duplicate tolerance is relative).
 pub const NEAR_PLANE: f64 = 1e-7;
 

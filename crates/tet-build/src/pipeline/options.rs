@@ -14,7 +14,7 @@ use crate::tetgen::{Isolation, TetgenOptions};
 /// Progress callback, called at the start of every stage.
 pub type ProgressFn = Arc<dyn Fn(&Progress) + Send + Sync>;
 
-/// A stage of [`build`].
+/// A stage of [`build`](super::build).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
     /// Cleaning the scene.
@@ -38,20 +38,20 @@ pub enum Stage {
     Validate,
 }
 
-/// How [`build`] turns TetGen's tets into neighbour links and the
-/// constrained-face table. Both give the same [`TetMesh`].
+/// How [`build`](super::build) turns TetGen's tets into neighbour links and the
+/// constrained-face table. Both give the same [`TetMesh`](tet_core::TetMesh).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Assembly {
     /// Read TetGen's own adjacency (`-nn`): the neighbour of each tet face
     /// and the two tets of each constrained face. Linear time, no sorting.
     #[default]
     TetgenNeighbors,
-    /// [`TetMesh::assemble`]: neighbours found by sorting all face keys
+    /// [`TetMesh::assemble`](tet_core::TetMesh::assemble): neighbours found by sorting all face keys
     /// (the reference; ignores TetGen's adjacency).
     SortFaceKeys,
 }
 
-/// Memory order of the mesh [`build`] returns.
+/// Memory order of the mesh [`build`](super::build) returns.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Reorder {
     /// TetGen's order (points: scene vertices, box corners, Steiner points).
@@ -64,11 +64,11 @@ pub enum Reorder {
     Hilbert,
 }
 
-/// How [`build`] checks the finished mesh. Either way, a mesh that would
-/// fail [`TetMesh::validate`] is never returned.
+/// How [`build`](super::build) checks the finished mesh. Either way, a mesh that would
+/// fail [`TetMesh::validate`](tet_core::TetMesh::validate) is never returned.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Validation {
-    /// Every invariant of [`TetMesh::validate`] except tet orientation (and
+    /// Every invariant of [`TetMesh::validate`](tet_core::TetMesh::validate) except tet orientation (and
     /// the distinct-vertices check it implies), which the rounding stage has
     /// decided exactly on the final f32 coordinates of every tet (a build
     /// with a non-positive tet fails there). Linear time: links, the
@@ -76,12 +76,12 @@ pub enum Validation {
     /// most one linked pair or unlinked face) without a global sort.
     #[default]
     Construction,
-    /// [`TetMesh::validate`], which also re-checks orientation (slower:
+    /// [`TetMesh::validate`](tet_core::TetMesh::validate), which also re-checks orientation (slower:
     /// sorts every face key, single-threaded).
     Full,
 }
 
-/// What [`build`] reports to the progress callback.
+/// What [`build`](super::build) reports to the progress callback.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Progress {
     /// The stage starting now.
@@ -90,7 +90,7 @@ pub struct Progress {
     pub elapsed: Duration,
 }
 
-/// Options of [`build`].
+/// Options of [`build`](super::build).
 #[derive(Clone)]
 pub struct BuildOptions {
     /// TetGen switches (default `-pYc`: surface preserving, no quality refinement).
@@ -167,7 +167,7 @@ pub struct StageTimes {
     pub total: Duration,
 }
 
-/// What [`build`] did.
+/// What [`build`](super::build) did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BuildReport {
     /// Cleaning actions.

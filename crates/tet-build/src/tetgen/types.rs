@@ -114,7 +114,7 @@ impl TetgenOptions {
 }
 
 /// How to run a worker process: a program (and arguments) that calls
-/// [`worker::serve_stdio`], e.g. the `tet-build-worker` binary, or the
+/// [`worker::serve_stdio`](super::worker::serve_stdio), e.g. the `tet-build-worker` binary, or the
 /// bench binary re-executing itself with a hidden subcommand.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WorkerCommand {

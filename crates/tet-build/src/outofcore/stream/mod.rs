@@ -16,18 +16,18 @@
 //! mesh file in part order (leaf order of the tree, depth first, below
 //! before above; slab order for slabs): part `p`'s tets are
 //! `tet_base[p]..`, its new points `point_base[p]..`. Only points on a seam
-//! wall ([`SeamIndex::contains_point`]) can be shared by two parts (two
+//! wall ([`SeamIndex::contains_point`](super::seam_index::SeamIndex::contains_point)) can be shared by two parts (two
 //! leaves' closed boxes meet only within the seam of their lowest common
 //! split), so only those are deduplicated, by their exact bits, through a
 //! map whose size is proportional to the seams' area, not the volume. The
 //! sections are written in file order by passes over the part files
-//! through [`SectionReader`]:
+//! through [`SectionReader`](tet_core::format::SectionReader):
 //!
 //! 1. *points and seam faces*: each part's payload CRC is checked
-//!    ([`SectionReader::verify_payload`]); its points get global ids (seam
+//!    ([`SectionReader::verify_payload`](tet_core::format::SectionReader::verify_payload)); its points get global ids (seam
 //!    points through the map, the rest in order) and the new ones are
 //!    appended; every open face of the part (a boundary face, or a scene
-//!    face with one side) that lies in a seam ([`SeamIndex::contains_face`])
+//!    face with one side) that lies in a seam ([`SeamIndex::contains_face`](super::seam_index::SeamIndex::contains_face))
 //!    is keyed by its sorted global vertex triple. The first part to offer
 //!    a key leaves it open; the second closes it: a seam-only face becomes a
 //!    tet–tet link (both directions kept in a map keyed by (global tet,

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use tet_core::scene::SceneInfo;
 
-/// Where and how [`super::tree::build_tree_to_file`] and
+/// Where and how [`build_tree_to_file`](crate::outofcore::tree::build_tree_to_file) and
 /// [`crate::outofcore::seam::build_slabs_to_file`] write the merged mesh.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StreamOptions {
