@@ -463,4 +463,47 @@ mod tests {
             })
         ));
     }
+
+    #[test]
+    fn one_gather_equals_the_three_permutations() {
+        use crate::synthetic::{GridSpec, SplitMix64, kuhn_grid};
+        let mut rng = SplitMix64(9);
+        let mut shuffled = |n: usize| {
+            let mut v: Vec<u32> = (0..n as u32).collect();
+            for i in (1..n).rev() {
+                v.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
+            }
+            v
+        };
+        for seed in 0..3 {
+            let mut a = kuhn_grid(&GridSpec {
+                cells: [3, 3, 2],
+                constrained_fraction: 0.4,
+                seed,
+                ..GridSpec::default()
+            });
+            let n = a.points.len();
+            a.attributes.normals = Some((0..n).map(|i| Vec3::splat(i as f32)).collect());
+            let r = Reordering {
+                points: shuffled(a.points.len()),
+                tets: shuffled(a.tets.len()),
+                constrained: shuffled(a.constrained.len()),
+            };
+            let mut b = a.clone();
+            apply_point_permutation(&mut a, &r.points).unwrap();
+            apply_tet_permutation(&mut a, &r.tets).unwrap();
+            apply_constrained_permutation(&mut a, &r.constrained).unwrap();
+            apply_reordering(&mut b, &r).unwrap();
+            assert_eq!(a, b);
+            b.validate().unwrap();
+            // A wrong order leaves the mesh untouched.
+            let c = b.clone();
+            let bad = Reordering {
+                points: vec![0; b.points.len()],
+                ..r.clone()
+            };
+            assert!(apply_reordering(&mut b, &bad).is_err());
+            assert_eq!(b, c);
+        }
+    }
 }

@@ -487,3 +487,47 @@ fn check_attributes(m: &TetMesh) -> Result<(), MeshError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::Link;
+    use crate::synthetic::{GridSpec, kuhn_grid};
+
+    #[test]
+    fn construction_checks_agree_with_validate() {
+        let m = kuhn_grid(&GridSpec {
+            cells: [3, 2, 2],
+            constrained_fraction: 0.3,
+            seed: 4,
+            ..GridSpec::default()
+        });
+        m.validate().unwrap();
+        m.validate_construction().unwrap();
+        // A one-sided link.
+        let mut a = m.clone();
+        let t = (0..a.tets.len())
+            .find(|&t| a.neighbors[t].iter().any(|l| l.as_tet().is_some()))
+            .unwrap();
+        let k = (0..4)
+            .find(|&k| a.neighbors[t][k].as_tet().is_some())
+            .unwrap();
+        a.neighbors[t][k] = Link::BOUNDARY;
+        assert!(a.validate().is_err() && a.validate_construction().is_err());
+        // An unlinked copy of a tet: only face manifoldness sees it.
+        let mut b = m.clone();
+        b.tets.push(b.tets[0]);
+        b.neighbors.push([Link::BOUNDARY; 4]);
+        assert!(matches!(
+            b.validate_construction(),
+            Err(crate::MeshError::FaceNotManifold { .. })
+        ));
+        // Orientation is the one check left out.
+        let mut c = m.clone();
+        c.tets[0].swap(0, 1);
+        assert!(matches!(
+            c.validate(),
+            Err(crate::MeshError::NotPositive { tet: 0, .. })
+        ));
+        assert!(c.check_tet_orientation(0).is_err());
+    }
+}
