@@ -2,17 +2,19 @@
 //! and [`StreamError`] (part files and the streaming merge). At the bottom
 //! of the out-of-core modules: everything else may name them.
 
-use super::plane::SplitPlane;
-use crate::bbox::BoxError;
-use crate::clean::CleanError;
-use crate::tetgen::TetgenError;
-use glam::Vec3;
 use std::io;
 use std::path::PathBuf;
+
+use glam::Vec3;
 use tet_core::MeshError;
 use tet_core::format::FormatError;
 use tet_core::reorder::PermutationError;
 use thiserror::Error;
+
+use super::plane::SplitPlane;
+use crate::bbox::BoxError;
+use crate::clean::CleanError;
+use crate::tetgen::TetgenError;
 
 /// A failure of [`build_split_once`](super::seam::build_split_once) and the other out-of-core builders.
 #[derive(Debug, Error)]

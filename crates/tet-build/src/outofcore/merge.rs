@@ -3,19 +3,14 @@
 //! or streamed through part files ([`super::stream::ToFile`]); the
 //! replacement of the paper's `MERGE` (Erkoç et al., seed 003 §3.3).
 
-use super::error::SeamError;
-use super::parts::FacetKind;
-use super::parts::PartMesh;
-use super::parts::PartStats;
-use super::parts::SeamOptions;
-use super::parts::SeamReport;
-use super::parts::run_parts;
-use super::plane::SplitPlane;
-use super::plane::key;
-use glam::Vec3;
 use std::collections::HashMap;
-use tet_core::TetMesh;
-use tet_core::face_key;
+
+use glam::Vec3;
+use tet_core::{TetMesh, face_key};
+
+use super::error::SeamError;
+use super::parts::{FacetKind, PartMesh, PartStats, SeamOptions, SeamReport, run_parts};
+use super::plane::{SplitPlane, key};
 
 /// The parts of a split, ready for TetGen.
 pub(super) struct PartInputs {

@@ -2,19 +2,15 @@
 //! PLC run through TetGen `-pY` (every facet must come back as exactly one
 //! face), several parts at a time, and the [`SeamReport`] of a split build.
 
-use super::error::SeamError;
-use super::plane::SplitPlane;
-use super::plane::key;
-use crate::bbox::BoxSpec;
-use crate::tetgen::Isolation;
-use crate::tetgen::TetgenError;
-use crate::tetgen::TetgenInput;
-use crate::tetgen::TetgenOptions;
-use crate::tetgen::tetrahedralize;
-use glam::DVec3;
-use glam::Vec3;
 use std::collections::HashMap;
+
+use glam::{DVec3, Vec3};
 use tet_core::face_key;
+
+use super::error::SeamError;
+use super::plane::{SplitPlane, key};
+use crate::bbox::BoxSpec;
+use crate::tetgen::{Isolation, TetgenError, TetgenInput, TetgenOptions, tetrahedralize};
 
 /// What [`build_slabs`](super::seam::build_slabs) (and [`build_split_once`](super::seam::build_split_once)) did.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -36,22 +36,17 @@
 //! [`SeamError::RoundingFlattens`] (the in-core pipeline's snapping repair
 //! is not applied here yet).
 
-use super::merge::InMemory;
-use super::merge::Merge;
-use super::merge::PartInputs;
-use super::merge::finish_parts;
+use glam::Vec3;
+use tet_core::TetMesh;
+
+use super::merge::{InMemory, Merge, PartInputs, finish_parts};
 use super::parts::FacetKind;
-use super::plane::SplitPlane;
-use super::plane::fan;
-use super::stream::StreamOptions;
-use super::stream::StreamSummary;
-use super::stream::ToFile;
+use super::plane::{SplitPlane, fan};
+use super::stream::{StreamOptions, StreamSummary, ToFile};
 use crate::bbox::EnclosingBox;
 use crate::clean::clean_scene;
 use crate::procedural::BOX_TRIANGLES;
 use crate::scene::Scene;
-use glam::Vec3;
-use tet_core::TetMesh;
 
 pub use super::error::SeamError;
 pub use super::parts::{SeamOptions, SeamReport};

@@ -3,16 +3,14 @@
 //! edges and vertices as constraints; both parts next to the plane get its
 //! triangles as facets.
 
-use super::error::SeamError;
-use super::plane::SplitPlane;
-use super::plane::key;
-use glam::DVec2;
-use glam::Vec3;
-use spade::ConstrainedDelaunayTriangulation;
-use spade::Point2;
-use spade::Triangulation;
-use spade::handles::FixedVertexHandle;
 use std::collections::HashMap;
+
+use glam::{DVec2, Vec3};
+use spade::handles::FixedVertexHandle;
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+
+use super::error::SeamError;
+use super::plane::{SplitPlane, key};
 
 /// The seam: triangles in the plane, each with the in-plane scene triangle
 /// it lies in (cleaned index), if any.

@@ -26,10 +26,10 @@
 //! by the original triangles' vertices (not the clipped pieces), so the
 //! estimates and cut counts below the root are upper bounds.
 
-use super::memory_model::MemoryModel;
-use super::plane::NEAR_PLANE;
-use super::plane::near_plane_vertex;
 use glam::Vec3;
+
+use super::memory_model::MemoryModel;
+use super::plane::{NEAR_PLANE, near_plane_vertex};
 
 pub use super::plane::{Side, SplitPlane};
 

@@ -1,26 +1,19 @@
 //! The streaming merge of part files into the mesh file
 //! ([`merge_part_files`]); see [`super`] for the passes and working set.
 
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::Vec3;
+use tet_core::format::{OptionalSections, SectionReader, StreamWriter};
+use tet_core::scene::SceneInfo;
+use tet_core::{ConstrainedFace, FACE_VERTICES, FaceSide, Link, NO_TET, face_key};
+
 use super::options::StreamSummary;
 use crate::outofcore::error::StreamError;
-use crate::outofcore::plane::SplitPlane;
-use crate::outofcore::plane::key;
+use crate::outofcore::plane::{SplitPlane, key};
 use crate::outofcore::seam_index::SeamIndex;
-use glam::Vec3;
-use std::collections::HashMap;
-use std::path::Path;
-use std::path::PathBuf;
-use std::time::Instant;
-use tet_core::ConstrainedFace;
-use tet_core::FACE_VERTICES;
-use tet_core::FaceSide;
-use tet_core::Link;
-use tet_core::NO_TET;
-use tet_core::face_key;
-use tet_core::format::OptionalSections;
-use tet_core::format::SectionReader;
-use tet_core::format::StreamWriter;
-use tet_core::scene::SceneInfo;
 
 /// Elements read or written at a time by the passes that need no whole
 /// section.

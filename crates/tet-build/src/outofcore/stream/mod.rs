@@ -63,15 +63,14 @@
 //! own peak is one part (TetGen's output, then its [`TetMesh`]) per worker
 //! thread on top of the planner's inputs.
 
-use self::part_file::PartDir;
-use self::part_file::PartFile;
-use super::error::SeamError;
-use super::merge::Merge;
-use super::merge::MergeContext;
-use super::parts::PartMesh;
-use super::parts::PartStats;
 use std::path::PathBuf;
+
 use tet_core::TetMesh;
+
+use self::part_file::{PartDir, PartFile};
+use super::error::SeamError;
+use super::merge::{Merge, MergeContext};
+use super::parts::{PartMesh, PartStats};
 
 pub use super::error::StreamError;
 pub use merger::merge_part_files;

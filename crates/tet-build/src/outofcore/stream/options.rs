@@ -2,6 +2,7 @@
 //! ([`StreamSummary`]).
 
 use std::path::PathBuf;
+
 use tet_core::scene::SceneInfo;
 
 /// Where and how [`build_tree_to_file`](crate::outofcore::tree::build_tree_to_file) and

@@ -1,11 +1,10 @@
 //! Part files: one finished part on disk, in a directory removed when done.
 
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use crate::outofcore::error::StreamError;
 use crate::outofcore::parts::PartStats;
-use std::path::Path;
-use std::path::PathBuf;
-use std::sync::atomic::AtomicU64;
-use std::sync::atomic::Ordering;
 
 /// One finished part: its file and report fields.
 pub(crate) struct PartFile {

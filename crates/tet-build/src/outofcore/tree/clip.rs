@@ -1,17 +1,14 @@
 //! Clipping in tree order: every scene triangle clipped by the planes of
 //! the tree, crossings registered on their roots (item 1 of [`super`]).
 
-use super::cut_tree::CutTree;
-use super::geometry::Lines;
-use super::geometry::Poly;
-use super::geometry::Registry;
-use super::geometry::Root;
-use super::geometry::Wall;
-use crate::outofcore::error::SeamError;
-use crate::outofcore::plane::NEAR_PLANE;
-use crate::outofcore::plane::SplitPlane;
-use glam::Vec3;
 use std::collections::HashSet;
+
+use glam::Vec3;
+
+use super::cut_tree::CutTree;
+use super::geometry::{Lines, Poly, Registry, Root, Wall};
+use crate::outofcore::error::SeamError;
+use crate::outofcore::plane::{NEAR_PLANE, SplitPlane};
 
 /// A node of the flattened tree.
 pub(super) struct Node {

@@ -1,8 +1,9 @@
 //! [`CutTree`]: the planes of a recursive split.
 
+use glam::Vec3;
+
 use crate::outofcore::plane::SplitPlane;
 use crate::outofcore::split::SplitTree;
-use glam::Vec3;
 
 /// The planes of a recursive split, without the planner's estimates.
 #[derive(Clone, Debug, PartialEq)]

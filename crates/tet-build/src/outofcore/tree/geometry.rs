@@ -2,15 +2,12 @@
 //! axis-parallel lines, and the outlines of clipped pieces: the exact
 //! geometry shared by the clipping and the walls.
 
+use std::collections::{HashMap, HashSet};
+
+use glam::{DVec2, DVec3, Vec3};
+
 use crate::outofcore::error::SeamError;
-use crate::outofcore::plane::SplitPlane;
-use crate::outofcore::plane::crossing_point;
-use crate::outofcore::plane::key;
-use glam::DVec2;
-use glam::DVec3;
-use glam::Vec3;
-use std::collections::HashMap;
-use std::collections::HashSet;
+use crate::outofcore::plane::{SplitPlane, crossing_point, key};
 
 /// A segment's root: the scene edge or cut segment it lies on, endpoints in
 /// canonical (key) order.

@@ -44,29 +44,21 @@
 //! | repair of overlapping vertices/edges   | none: shared roots and walls      |
 //! | `MERGE` by centroid hashing            | exact dedup + `TetMesh::assemble` |
 
+use glam::Vec3;
+use tet_core::TetMesh;
+
 use self::clip::run_clipping;
-use self::geometry::outline;
-use self::geometry::triangulate_outline;
-use self::walls::prepare_walls;
-use self::walls::triangulate_wall;
+use self::geometry::{outline, triangulate_outline};
+use self::walls::{prepare_walls, triangulate_wall};
 use super::error::SeamError;
-use super::merge::InMemory;
-use super::merge::Merge;
-use super::merge::PartInputs;
-use super::merge::finish_parts;
-use super::parts::FacetKind;
-use super::parts::SeamOptions;
-use super::parts::SeamReport;
+use super::merge::{InMemory, Merge, PartInputs, finish_parts};
+use super::parts::{FacetKind, SeamOptions, SeamReport};
 use super::plane::key;
 use super::split::SplitTree;
-use super::stream::StreamOptions;
-use super::stream::StreamSummary;
-use super::stream::ToFile;
+use super::stream::{StreamOptions, StreamSummary, ToFile};
 use crate::bbox::EnclosingBox;
 use crate::clean::clean_scene;
 use crate::scene::Scene;
-use glam::Vec3;
-use tet_core::TetMesh;
 
 pub use cut_tree::CutTree;
 

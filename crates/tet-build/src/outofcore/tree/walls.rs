@@ -1,25 +1,18 @@
 //! Walls: seams and box faces with the traces of the other seams, each
 //! triangulated once (item 2 of [`super`]).
 
-use super::clip::Cut;
-use super::geometry::Lines;
-use super::geometry::Registry;
-use super::geometry::Wall;
-use super::geometry::WallTriangle;
-use super::geometry::free_axis;
-use super::geometry::orient2;
-use super::geometry::outline;
-use super::geometry::subdivide;
-use crate::outofcore::error::SeamError;
-use crate::outofcore::plane::SplitPlane;
-use crate::outofcore::plane::key;
-use crate::outofcore::section::add_seam_constraint;
-use glam::DVec2;
-use glam::Vec3;
-use spade::ConstrainedDelaunayTriangulation;
-use spade::Point2;
-use spade::Triangulation;
 use std::collections::HashMap;
+
+use glam::{DVec2, Vec3};
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+
+use super::clip::Cut;
+use super::geometry::{
+    Lines, Registry, Wall, WallTriangle, free_axis, orient2, outline, subdivide,
+};
+use crate::outofcore::error::SeamError;
+use crate::outofcore::plane::{SplitPlane, key};
+use crate::outofcore::section::add_seam_constraint;
 
 /// The edge of wall `r`'s rectangle lying in wall `w`'s plane and inside
 /// its rectangle, if any.
