@@ -1,4 +1,4 @@
-//! The `obj_and_scene` and `tetgen_files` fuzz targets (issue 7), run on the
+//! The `obj_and_scene` and `tetgen_files` fuzz targets, run on the
 //! stable toolchain: each target's body (`fuzz/targets_common/<target>.rs`,
 //! shared verbatim with the cargo-fuzz binaries through `include!`) over the
 //! checked-in seed corpus `fuzz/seeds/<target>/` and over token-level

@@ -1,4 +1,4 @@
-//! Out-of-core construction (issue 8): memory model and split plan.
+//! Out-of-core construction (Erkoç et al., seed 003): memory model and split plan.
 
 #![cfg(feature = "tetgen")]
 
@@ -331,7 +331,7 @@ fn first_hit(mesh: &TetMesh, o: DVec3, d: DVec3) -> Option<(f64, u32, f64)> {
     best
 }
 
-/// The checks of issue 8 against the in-core mesh: valid, same volume,
+/// The out-of-core checks against the in-core mesh: valid, same volume,
 /// every scene triangle's faces sum to its area, same first hits.
 fn check_against_in_core(scene: &Scene, merged: &TetMesh) {
     merged.validate().unwrap();
@@ -606,7 +606,7 @@ fn tet20_mrays(mesh: &TetMesh, scene: &Scene) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Trade measurement (issue 8 item 5): in-core TetGen vs the out-of-core
+/// Trade measurement (Erkoç et al., seed 003 §4): in-core TetGen vs the out-of-core
 /// builders at 1/2, 1/3 and 1/4 of the in-core measured peak, 2 parts at a
 /// time, on Torus Knots in a Box and on a 125-knot grid: parallel slabs
 /// (`build_with_memory_limit`) and the paper's recursive tree with

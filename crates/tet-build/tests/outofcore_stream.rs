@@ -1,4 +1,4 @@
-//! The streaming merge of part files (issue 8, item 4) against an
+//! The streaming merge of part files against an
 //! independent reference, without TetGen: two Kuhn grids side by side are
 //! the two halves of one Kuhn grid (Kuhn's subdivision is conforming across
 //! cells), so merging their files across the seam x = 2 must give that

@@ -19,13 +19,21 @@
 //! A permutation is given as an *order*: `order[new] = old`. Everything is
 //! deterministic (ties broken by the old index). Vertex slots inside a tet are
 //! never rotated, so orientation and face numbering are unchanged.
+//!
+//! The pieces of [`hilbert_reorder`] are public so that a builder can run
+//! them in parallel and get the very same result: the sort keys
+//! ([`Quantizer::key`] of a point, [`tet_key`], [`constrained_key`]), the
+//! order they give ([`order_by_key`]: `(key, old index)` pairs sorted, so any
+//! correct sort of the same pairs gives the same order) and the renumbering
+//! of one element ([`Renumbering`]), which [`apply_reordering`] gathers
+//! array by array.
 
 use glam::Vec3;
 use thiserror::Error;
 
 use crate::hilbert::Quantizer;
 use crate::link::{Link, LinkKind};
-use crate::mesh::{FaceSide, TetMesh};
+use crate::mesh::{ConstrainedFace, FaceSide, TetMesh};
 use crate::regions::{Regions, compute_regions};
 
 /// The permutations applied by a reordering, each as `order[new] = old`.
@@ -185,8 +193,9 @@ pub fn apply_constrained_permutation(
     Ok(())
 }
 
-/// Sorts `keys` (one per element) and returns the order, ties by index.
-fn order_by_key<K: Ord + Copy>(keys: impl Iterator<Item = K>) -> Vec<u32> {
+/// Sorts `keys` (one per element) and returns the order, ties by index:
+/// the `(key, index)` pairs sorted ascending.
+pub fn order_by_key<K: Ord + Copy>(keys: impl Iterator<Item = K>) -> Vec<u32> {
     let mut v: Vec<(K, u32)> = keys.enumerate().map(|(i, k)| (k, i as u32)).collect();
     v.sort_unstable();
     v.into_iter().map(|(_, i)| i).collect()
@@ -206,11 +215,15 @@ pub fn hilbert_point_order(mesh: &TetMesh, q: &Quantizer) -> Vec<u32> {
     order_by_key(mesh.points.iter().map(|&p| q.key(p)))
 }
 
+/// Hilbert key of tet `t`'s centroid (out-of-range vertices count as the
+/// origin): the sort key of the tet order.
+pub fn tet_key(mesh: &TetMesh, q: &Quantizer, t: usize) -> u64 {
+    q.key(centroid(mesh, t))
+}
+
 /// Hilbert key of each tet's centroid.
 pub fn tet_keys(mesh: &TetMesh, q: &Quantizer) -> Vec<u64> {
-    (0..mesh.tets.len())
-        .map(|t| q.key(centroid(mesh, t)))
-        .collect()
+    (0..mesh.tets.len()).map(|t| tet_key(mesh, q, t)).collect()
 }
 
 /// Tets sorted by the Hilbert key of their centroid.
@@ -221,31 +234,149 @@ pub fn hilbert_tet_order(mesh: &TetMesh, q: &Quantizer) -> Vec<u32> {
 /// Constrained faces sorted by the lowest tet index on their sides (then
 /// that tet's face), so the table follows the tet order.
 pub fn constrained_order_by_tets(mesh: &TetMesh) -> Vec<u32> {
-    order_by_key(mesh.constrained.iter().map(|cf| {
-        [cf.front, cf.back]
-            .into_iter()
-            .filter(|s| s.exists())
-            .map(|s| (s.tet, s.face))
-            .min()
-            .unwrap_or((u32::MAX, 0))
-    }))
+    order_by_key(mesh.constrained.iter().map(|cf| constrained_key(cf, &[])))
 }
 
-/// Applies point, tet and constrained-face orders in turn.
+/// Sort key of a constrained face once tet `t` has become `new_tet[t]`:
+/// its lowest `(new tet, face)` side (`(u32::MAX, 0)` with no side). Tets
+/// beyond `new_tet` keep their index (pass `&[]` for the current order).
+pub fn constrained_key(cf: &ConstrainedFace, new_tet: &[u32]) -> (u32, u32) {
+    [cf.front, cf.back]
+        .into_iter()
+        .filter(|s| s.exists())
+        .map(|s| {
+            (
+                new_tet.get(s.tet as usize).copied().unwrap_or(s.tet),
+                s.face,
+            )
+        })
+        .min()
+        .unwrap_or((u32::MAX, 0))
+}
+
+/// Where every element of a mesh goes under a [`Reordering`]: the inverse
+/// permutations (`new_of_old`), and the renumbering of one tet, one tet's
+/// links and one constrained face. Ids out of range (invalid mesh only) are
+/// handled as [`apply_point_permutation`], [`apply_tet_permutation`] and
+/// [`apply_constrained_permutation`] do, so an invalid mesh stays invalid.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Renumbering {
+    /// New index of each old point.
+    pub points: Vec<u32>,
+    /// New index of each old tet.
+    pub tets: Vec<u32>,
+    /// New index of each old constrained face.
+    pub constrained: Vec<u32>,
+}
+
+impl Renumbering {
+    /// The inverse of `r` for `mesh`; errors when an order is not a
+    /// permutation of the mesh's array.
+    pub fn new(mesh: &TetMesh, r: &Reordering) -> Result<Renumbering, PermutationError> {
+        Ok(Renumbering {
+            points: invert_order("point", &r.points, mesh.points.len())?,
+            tets: invert_order("tet", &r.tets, mesh.tets.len())?,
+            constrained: invert_order("constrained face", &r.constrained, mesh.constrained.len())?,
+        })
+    }
+
+    /// New vertex id (`u32::MAX` for an out-of-range one).
+    pub fn point(&self, v: u32) -> u32 {
+        self.points.get(v as usize).copied().unwrap_or(u32::MAX)
+    }
+
+    /// A tet's vertex ids, renumbered.
+    pub fn tet(&self, tet: [u32; 4]) -> [u32; 4] {
+        tet.map(|v| self.point(v))
+    }
+
+    /// A tet's links, renumbered (out-of-range targets left as they are).
+    pub fn links(&self, links: [Link; 4]) -> [Link; 4] {
+        links.map(|l| match l.kind() {
+            LinkKind::Tet(n) => self.tets.get(n as usize).map_or(l, |&n| Link::tet(n)),
+            LinkKind::Constrained(c) => self
+                .constrained
+                .get(c as usize)
+                .map_or(l, |&c| Link::constrained(c)),
+            LinkKind::Boundary => l,
+        })
+    }
+
+    /// A tet side, renumbered (absent or out-of-range sides unchanged).
+    pub fn side(&self, s: FaceSide) -> FaceSide {
+        match self.tets.get(s.tet as usize) {
+            Some(&tet) => FaceSide { tet, face: s.face },
+            None => s,
+        }
+    }
+
+    /// A constrained face's vertices and sides, renumbered.
+    pub fn constrained_face(&self, cf: ConstrainedFace) -> ConstrainedFace {
+        ConstrainedFace {
+            triangle: cf.triangle,
+            vertices: cf.vertices.map(|v| self.point(v)),
+            front: self.side(cf.front),
+            back: self.side(cf.back),
+        }
+    }
+}
+
+/// Applies all three orders of `r` at once, one gather per array (points,
+/// normals, uvs, tets, links, constrained faces): the same mesh as
+/// [`apply_point_permutation`], [`apply_tet_permutation`] and
+/// [`apply_constrained_permutation`] in turn. The mesh is untouched on error.
+pub fn apply_reordering(mesh: &mut TetMesh, r: &Reordering) -> Result<(), PermutationError> {
+    check_lengths(mesh)?;
+    let map = Renumbering::new(mesh, r)?;
+    mesh.points = gather(&mesh.points, &r.points);
+    if let Some(n) = mesh.attributes.normals.as_mut()
+        && n.len() == r.points.len()
+    {
+        *n = gather(n, &r.points);
+    }
+    if let Some(uv) = mesh.attributes.uvs.as_mut()
+        && uv.len() == r.points.len()
+    {
+        *uv = gather(uv, &r.points);
+    }
+    mesh.tets = r
+        .tets
+        .iter()
+        .map(|&o| map.tet(mesh.tets[o as usize]))
+        .collect();
+    mesh.neighbors = r
+        .tets
+        .iter()
+        .map(|&o| map.links(mesh.neighbors[o as usize]))
+        .collect();
+    mesh.constrained = r
+        .constrained
+        .iter()
+        .map(|&o| map.constrained_face(mesh.constrained[o as usize]))
+        .collect();
+    Ok(())
+}
+
+/// Applies point and tet orders, the constrained faces following the tets
+/// ([`constrained_key`]).
 fn apply_all(
     mesh: &mut TetMesh,
     points: Vec<u32>,
     tets: Vec<u32>,
 ) -> Result<Reordering, PermutationError> {
-    apply_point_permutation(mesh, &points)?;
-    apply_tet_permutation(mesh, &tets)?;
-    let constrained = constrained_order_by_tets(mesh);
-    apply_constrained_permutation(mesh, &constrained)?;
-    Ok(Reordering {
+    let new_tet = invert_order("tet", &tets, mesh.tets.len())?;
+    let constrained = order_by_key(
+        mesh.constrained
+            .iter()
+            .map(|cf| constrained_key(cf, &new_tet)),
+    );
+    let r = Reordering {
         points,
         tets,
         constrained,
-    })
+    };
+    apply_reordering(mesh, &r)?;
+    Ok(r)
 }
 
 /// Reorders points (by position) and tets (by centroid) along a Hilbert curve
@@ -331,5 +462,48 @@ mod tests {
                 ..
             })
         ));
+    }
+
+    #[test]
+    fn one_gather_equals_the_three_permutations() {
+        use crate::synthetic::{GridSpec, SplitMix64, kuhn_grid};
+        let mut rng = SplitMix64(9);
+        let mut shuffled = |n: usize| {
+            let mut v: Vec<u32> = (0..n as u32).collect();
+            for i in (1..n).rev() {
+                v.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
+            }
+            v
+        };
+        for seed in 0..3 {
+            let mut a = kuhn_grid(&GridSpec {
+                cells: [3, 3, 2],
+                constrained_fraction: 0.4,
+                seed,
+                ..GridSpec::default()
+            });
+            let n = a.points.len();
+            a.attributes.normals = Some((0..n).map(|i| Vec3::splat(i as f32)).collect());
+            let r = Reordering {
+                points: shuffled(a.points.len()),
+                tets: shuffled(a.tets.len()),
+                constrained: shuffled(a.constrained.len()),
+            };
+            let mut b = a.clone();
+            apply_point_permutation(&mut a, &r.points).unwrap();
+            apply_tet_permutation(&mut a, &r.tets).unwrap();
+            apply_constrained_permutation(&mut a, &r.constrained).unwrap();
+            apply_reordering(&mut b, &r).unwrap();
+            assert_eq!(a, b);
+            b.validate().unwrap();
+            // A wrong order leaves the mesh untouched.
+            let c = b.clone();
+            let bad = Reordering {
+                points: vec![0; b.points.len()],
+                ..r.clone()
+            };
+            assert!(apply_reordering(&mut b, &bad).is_err());
+            assert_eq!(b, c);
+        }
     }
 }

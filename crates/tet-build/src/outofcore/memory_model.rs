@@ -69,36 +69,18 @@ pub struct MemorySample {
 
 impl MemoryModel {
     /// The constants fitted on this machine (see the module docs for how to
-    /// refit). Measured 2026-11-22, TetGen 1.5 built by `build.rs`, `-pYczQ`,
-    /// worker VmHWM, knot grids in an enclosing box:
-    ///
-    /// | scene (knots, segments×sides) | points | triangles | tets | peak MiB | TetGen s |
-    /// |---|---:|---:|---:|---:|---:|
-    /// | 1, 120×12  |   1,448 |   2,892 |    11,413 |   12.9 |  0.09 |
-    /// | 1, 480×24  |  11,528 |  23,052 |   107,179 |   98.2 |  1.92 |
-    /// | 8, 120×12  |  11,528 |  23,052 |    93,718 |   79.5 |  1.06 |
-    /// | 27, 120×12 |  38,888 |  77,772 |   317,925 |  259.3 |  6.00 |
-    /// | 8, 480×24  |  92,168 | 184,332 |   870,468 |  743.9 | 15.50 |
-    /// | 27, 240×24 | 155,528 | 311,052 | 1,290,914 | 1188.0 | 25.16 |
-    ///
-    /// The whole-scene fit alone was 2.35 MB + 2,565 B × (points +
-    /// triangles) (relative residuals −10 % … +13 %, margin 1.244). Parts
-    /// of a split cost less per element than that: their seam facets are
-    /// a planar triangulation TetGen meshes cheaply (a 14-slab part of
-    /// Torus Knots in a Box measured 40 MB where that fit predicted 72 MB).
-    /// The seam-aware fit ([`MemoryModel::fit_parts`], 2026-11-22, on the
-    /// six scenes above plus 157 parts of slab and tree splits of 8 and 27
-    /// knots and Torus Knots in a Box at 1/2, 1/3 and 1/5 of the whole
-    /// prediction; `measure_part_memory_model` in `tests/outofcore.rs`) is
-    /// 3.39 MB + 2,324 B × (scene points + scene facets) + 408 B × (wall
-    /// points + wall facets), relative residuals −6 % … +23 % (the worst
-    /// are the finely tessellated single knots of the table), margin
-    /// 1.1 × 1.23 = 1.353. [`MemoryModel::predict`] (whole scenes, no
-    /// walls) uses the scene rate for every element. Compare the paper's
-    /// 4.57 kB per input vertex (≈ 1.5 kB per element for closed meshes, on
-    /// a different TetGen build and measurement). Issue 8's figures (249 MB
-    /// for 77k triangles, 1.1 GB for 360k, 9 GB for 2.88M, measured
-    /// differently) are below this fit, i.e. the fit is on the safe side.
+    /// refit): TetGen 1.5 built by `build.rs`, `-pYczQ`, the worker's
+    /// `VmHWM`, on the knot grids of [`measurement_scenes`] in an enclosing
+    /// box and on parts of slab and tree splits of them
+    /// ([`MemoryModel::fit_parts`]; `measure_part_memory_model` in
+    /// `tests/outofcore.rs`). Parts of a split cost less per element than a
+    /// whole scene: their seam facets are a planar triangulation TetGen
+    /// meshes cheaply, hence the separate wall rate. [`MemoryModel::predict`]
+    /// (whole scenes, no walls) uses the scene rate for every element. The
+    /// measurements behind the constants are in the README's results. For
+    /// comparison, the paper's fit is 4.57 kB per input vertex (≈ 1.5 kB per
+    /// element for closed meshes, on a different TetGen build and
+    /// measurement).
     pub const FITTED: MemoryModel = MemoryModel {
         base_bytes: 3_386_656.9,
         bytes_per_element: 2_324.144,

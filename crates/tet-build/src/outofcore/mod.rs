@@ -1,5 +1,5 @@
 //! Out-of-core constrained tetrahedralization under a memory limit
-//! (Erkoç et al., seed 003; issue 8).
+//! (Erkoç et al., seed 003).
 //!
 //! The paper's `TETRA` procedure (§3, Algorithm 1) tetrahedralizes a part
 //! with TetGen when `CALCULATE_EXPECTED_MEMORY` fits the limit, and
@@ -7,43 +7,52 @@
 //! `MERGE`s the two meshes (repairing overlapping vertices/edges along the
 //! cut and hashing centroids to find neighbours, §3.2–3.3). This module:
 //!
+//! Modules, bottom up (each uses only modules above it):
+//!
+//! * [`error`]: [`error::SeamError`] and [`error::StreamError`].
+//! * [`plane`]: the geometry of cuts. An axis-aligned [`plane::SplitPlane`];
+//!   triangles crossing it are clipped with crossing points rounded once to
+//!   f32 and lying exactly on the plane ([`plane::clip_polygon`],
+//!   [`plane::crossing_point`]).
 //! * [`memory_model`]: `CALCULATE_EXPECTED_MEMORY` — TetGen's peak memory
 //!   measured against its input size (worker `VmHWM`), a weighted linear
-//!   fit ([`memory_model::MemoryModel::FITTED`], with the measurements) and
+//!   fit ([`memory_model::MemoryModel::FITTED`]) and
 //!   [`memory_model::predict_peak_memory`] with a safety margin.
-//! * [`split`]: the split planners. [`split::plan_split`] is the paper's
+//! * [`split`]: part planning. [`split::plan_split`] is the paper's
 //!   recursive rule (plane through the mean of the axis of largest
 //!   variance, moved to a nearby plane cutting fewer triangles — the
 //!   paper's future work) as a [`split::SplitTree`] with the triangles cut
 //!   at every node; [`split::plan_slabs`] cuts parallel slabs on the axis
 //!   of largest variance at corner quantiles, as many as needed for every
 //!   slab's prediction to fit (the fallback when no tree fits).
-//! * [`seam`]: exact seams between parallel planes. Triangles crossing a
-//!   plane are clipped with crossing points rounded once to f32 and lying
-//!   exactly on the plane; one `spade` constrained Delaunay triangulation
-//!   of the section (cut segments, in-plane scene edges and vertices as
-//!   constraints) is given to both neighbouring parts as facets; TetGen
-//!   `-pY` keeps every facet. [`seam::build_slabs`] builds `k + 1` slabs
-//!   (parts run concurrently in worker processes with `parallel_parts`),
-//!   [`seam::build_with_memory_limit`] plans and builds under a limit.
+//! * [`seam_index`]: which points and faces lie on a seam (exact), for the
+//!   streamed merge and the seam [`report`].
+//! * `section`: one `spade` constrained Delaunay triangulation of a plane's
+//!   section (cut segments, in-plane scene edges and vertices as
+//!   constraints), given to both neighbouring parts as facets; TetGen `-pY`
+//!   keeps every facet.
+//! * `parts`: each part's TetGen run (parts run concurrently in worker
+//!   processes with `parallel_parts`) and the [`seam::SeamReport`].
+//! * `merge`: what becomes of finished parts. In memory: exact point
+//!   deduplication + [`tet_core::TetMesh::assemble`] (no repair step, no
+//!   hashing of centroids; the caller holds the whole mesh).
+//! * [`stream`]: the streamed merge: each part written to a part file as
+//!   soon as its worker returns, the part files merged into the mesh file a
+//!   part at a time, holding one part plus maps proportional to the seams'
+//!   area ([`stream::merge_part_files`]). Both merges give the same mesh up
+//!   to the order of its elements; the streamed one is Hilbert-sorted part
+//!   by part, parts in leaf order.
+//! * [`seam`]: builds with parallel planes: [`seam::build_slabs`] builds
+//!   `k + 1` slabs, [`seam::build_with_memory_limit`] plans and builds
+//!   under a limit, [`seam::build_slabs_to_file`] streams.
 //! * [`tree`]: the paper's recursive tree with perpendicular planes. Where
 //!   seams meet, every wall is triangulated with the traces of the other
 //!   seams and the crossings registered on shared roots, so both sides of
 //!   every wall receive the very same triangles
 //!   ([`tree::build_tree`], [`tree::build_tree_with_memory_limit`], which
-//!   moves a plane meeting a degenerate configuration and retries).
-//! * Merging, two ways: in memory (exact point deduplication +
-//!   [`tet_core::TetMesh::assemble`]: no repair step, no hashing of
-//!   centroids; the caller holds the whole mesh), or streamed ([`stream`]:
-//!   each part written to a part file as soon as its worker returns, the
-//!   part files merged into the mesh file a part at a time, holding one
-//!   part plus maps proportional to the seams' area;
-//!   [`tree::build_tree_to_file`], [`seam::build_slabs_to_file`],
-//!   [`tree::build_tree_with_memory_limit_to_file`]). Both give the same
-//!   mesh up to the order of its elements; the streamed one is
-//!   Hilbert-sorted part by part, parts in leaf order.
-//! * [`seam_index`]: which points and faces lie on a seam (exact), for the
-//!   streamed merge and the seam [`report`].
+//!   moves a plane meeting a degenerate configuration and retries;
+//!   [`tree::build_tree_to_file`],
+//!   [`tree::build_tree_with_memory_limit_to_file`] stream).
 //! * [`report`]: tet quality at the seams vs elsewhere.
 //!
 //! | paper (seed 003)                       | code                                   |
@@ -74,10 +83,15 @@
 //!   points with the vertex); [`split::plan_slabs`] avoids such planes and
 //!   [`tree::build_tree_with_memory_limit`] moves them.
 
+pub mod error;
 pub mod memory_model;
+mod merge;
+mod parts;
+pub mod plane;
 pub mod report;
 pub mod seam;
 pub mod seam_index;
+mod section;
 pub mod split;
 pub mod stream;
 pub mod tree;

@@ -1,4 +1,4 @@
-//! Quality near the seams (issue 8, item 5; Erkoç et al., seed 003,
+//! Quality near the seams (Erkoç et al., seed 003,
 //! Table 3 compares tet quality of the merged mesh with TetGen's in-core
 //! mesh, and notes it is worse near the cut).
 //!
@@ -13,8 +13,8 @@
 use glam::Vec3;
 use tet_core::{FACE_VERTICES, TetMesh};
 
+use super::plane::SplitPlane;
 use super::seam_index::SeamIndex;
-use super::split::SplitPlane;
 use crate::quality::{QualityReport, Stats, aspect_ratio, radius_edge_ratio};
 
 /// Quality of the tets touching a seam and of the others.

@@ -13,7 +13,7 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
-use super::split::SplitPlane;
+use super::plane::SplitPlane;
 
 /// The seams, indexed by plane.
 #[derive(Clone, Debug, Default)]

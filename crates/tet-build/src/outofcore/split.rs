@@ -29,42 +29,9 @@
 use glam::Vec3;
 
 use super::memory_model::MemoryModel;
+use super::plane::{NEAR_PLANE, near_plane_vertex};
 
-/// An axis-aligned cut plane `x[axis] = value`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SplitPlane {
-    /// 0 = x, 1 = y, 2 = z.
-    pub axis: usize,
-    /// Plane offset (f32, so seam points are exactly on it).
-    pub value: f32,
-}
-
-/// Where a triangle lies relative to a plane (see the module docs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Side {
-    /// All vertices at or below, at least one strictly below.
-    Below,
-    /// All vertices at or above, at least one strictly above.
-    Above,
-    /// Vertices strictly on both sides: the plane cuts it.
-    Cut,
-    /// All three vertices on the plane.
-    InPlane,
-}
-
-impl SplitPlane {
-    /// Classifies a triangle (exact comparisons of f32 coordinates).
-    pub fn classify(&self, tri: [Vec3; 3]) -> Side {
-        let below = tri.iter().any(|p| p[self.axis] < self.value);
-        let above = tri.iter().any(|p| p[self.axis] > self.value);
-        match (below, above) {
-            (true, true) => Side::Cut,
-            (true, false) => Side::Below,
-            (false, true) => Side::Above,
-            (false, false) => Side::InPlane,
-        }
-    }
-}
+pub use super::plane::{Side, SplitPlane};
 
 /// Predicted peak of a part with `points` scene vertices, `triangles`
 /// scene triangles and `seam` triangles cut by the planes bounding it
@@ -214,7 +181,7 @@ pub fn choose_plane(
 
 /// [`choose_plane`], skipping candidate planes that pass within
 /// `tolerance` of a vertex of the part's triangles without passing through
-/// it (the seams refuse those, [`super::seam::NEAR_PLANE`]); when every
+/// it (the seams refuse those, [`NEAR_PLANE`]); when every
 /// candidate is too close, the plain rule's plane is returned.
 pub fn choose_plane_avoiding(
     vertices: &[Vec3],
@@ -303,7 +270,7 @@ pub fn plan_split(
     options: &SplitOptions,
 ) -> SplitTree {
     let part: Vec<u32> = (0..triangles.len() as u32).collect();
-    let tolerance = super::seam::NEAR_PLANE * (bounds.1 - bounds.0).max_element() as f64;
+    let tolerance = NEAR_PLANE * (bounds.1 - bounds.0).max_element() as f64;
     plan_part(vertices, triangles, part, 0, bounds, 0, options, tolerance)
 }
 
@@ -404,7 +371,7 @@ pub struct SlabPlan {
 /// fits `options.limit_bytes`: `k` planes at the `k + 1`-quantiles of the
 /// triangle corners along the axis of largest variance, each moved (within
 /// `±search_steps · search_step ·` extent) to the candidate cutting the
-/// fewest triangles and lying no closer than [`super::seam::NEAR_PLANE`] ×
+/// fewest triangles and lying no closer than [`NEAR_PLANE`] ×
 /// the box extent to a vertex off it (when that crowds planes into one gap
 /// and the slabs do not fit, the plain quantiles are tried too); `k` grows
 /// (0, 1, 2, 3, 4, 6, 9, …) until all slabs fit. Slab
@@ -436,7 +403,7 @@ pub fn plan_slabs(
         .collect();
     coords.sort_by(f32::total_cmp);
     let extent = (hi[axis] - lo[axis]) as f64;
-    let tolerance = super::seam::NEAR_PLANE * (hi - lo).max_element() as f64;
+    let tolerance = NEAR_PLANE * (hi - lo).max_element() as f64;
     let max_planes = (1usize << options.max_depth.min(10)) - 1;
     let cuts = |value: f32| {
         let plane = SplitPlane { axis, value };
@@ -465,7 +432,7 @@ pub fn plan_slabs(
                         continue;
                     }
                     let plane = SplitPlane { axis, value };
-                    if super::seam::near_plane_vertex(vertices, plane, tolerance).is_some() {
+                    if near_plane_vertex(vertices, plane, tolerance).is_some() {
                         continue;
                     }
                     let c = cuts(value);

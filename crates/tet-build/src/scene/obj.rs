@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 
-use super::SceneError;
+use super::error::SceneError;
 
 /// A mesh in its local frame, with separate index triples per attribute (as
 /// in OBJ: a position can carry different normals on different faces).

@@ -18,9 +18,10 @@ use glam::DVec3;
 use serde_json::Value;
 use tet_core::scene::PointLight;
 
+use super::error::SceneError;
+use super::model::{ObjectPlacement, Scene};
 use super::obj::{MeshData, load_obj};
 use super::transform::{Transform, orbit_camera};
-use super::{ObjectPlacement, Scene, SceneError};
 
 /// Parsed `scenes.json`, kept as a JSON value with its path for messages.
 #[derive(Clone, Debug)]

@@ -1,6 +1,6 @@
 //! Raw bindings to our C ABI shim (`cpp/tet_shim.{h,cpp}`), compiled together
 //! with TetGen by `build.rs`. Only [`super`] calls these; everything unsafe
-//! about TetGen stays in this file and in `super::run_in_process`.
+//! about TetGen stays in this file and in `super::in_process`.
 
 use std::ffi::{c_char, c_void};
 

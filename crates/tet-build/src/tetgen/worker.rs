@@ -42,10 +42,10 @@ use std::io::{self, BufReader, BufWriter, Read, Write};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use super::{
-    TetgenError, TetgenInput, TetgenOptions, TetgenOutput, WorkerCommand, check_input,
-    run_in_process,
-};
+use super::check::check_input;
+use super::error::TetgenError;
+use super::in_process::run_in_process;
+use super::types::{TetgenInput, TetgenOptions, TetgenOutput, WorkerCommand};
 
 const REQUEST_MAGIC: &[u8; 8] = b"TETREQ01";
 const REPLY_MAGIC: &[u8; 8] = b"TETRES02";

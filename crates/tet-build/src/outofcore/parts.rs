@@ -1,0 +1,305 @@
+//! The parts of a split and their TetGen runs: [`SeamOptions`], each part's
+//! PLC run through TetGen `-pY` (every facet must come back as exactly one
+//! face), several parts at a time, and the [`SeamReport`] of a split build.
+
+use std::collections::HashMap;
+
+use glam::{DVec3, Vec3};
+use tet_core::face_key;
+
+use super::error::SeamError;
+use super::plane::{SplitPlane, key};
+use crate::bbox::BoxSpec;
+use crate::tetgen::{Isolation, TetgenError, TetgenInput, TetgenOptions, tetrahedralize};
+
+/// What [`build_slabs`](super::seam::build_slabs) (and [`build_split_once`](super::seam::build_split_once)) did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SeamReport {
+    /// Scene triangles (after cleaning) strictly crossing at least one plane.
+    pub triangles_cut: usize,
+    /// Scene triangles lying in one of the planes.
+    pub triangles_in_plane: usize,
+    /// Vertices of each seam triangulation (including its 4 section corners).
+    pub seam_vertices: Vec<usize>,
+    /// Triangles of each seam triangulation.
+    pub seam_triangles: Vec<usize>,
+    /// Each seam: its plane and its rectangle (lower and upper corner; the
+    /// plane's coordinate is the same in both), in the order of
+    /// `seam_vertices`. Used by [`super::report::seam_quality`].
+    pub seams: Vec<(SplitPlane, Vec3, Vec3)>,
+    /// Input points of each part's PLC (part `k` lies between planes `k − 1` and `k`).
+    pub part_points: Vec<usize>,
+    /// Facets of each part's PLC.
+    pub part_triangles: Vec<usize>,
+    /// Points of each part's PLC used by no scene facet (wall corners,
+    /// trace points): the part of `part_points` the memory model counts
+    /// at the wall rate.
+    pub part_wall_points: Vec<usize>,
+    /// Facets of each part's PLC that are seam-only or box faces.
+    pub part_wall_triangles: Vec<usize>,
+    /// Tets of each part.
+    pub part_tets: Vec<usize>,
+    /// Peak memory of each part's worker (KiB), when isolated.
+    pub part_peak_kib: Vec<Option<u64>>,
+    /// Predicted peak memory of each part's TetGen run from its real input
+    /// ([`super::memory_model::predict_part_peak_memory`], bytes, with margin).
+    pub part_predicted_bytes: Vec<u64>,
+}
+
+/// Options of [`build_slabs`](super::seam::build_slabs).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SeamOptions {
+    /// Box around the scene (the whole mesh's boundary).
+    pub enclosing_box: BoxSpec,
+    /// TetGen switches (`-Y` is required and forced on).
+    pub tetgen: TetgenOptions,
+    /// Where TetGen runs.
+    pub isolation: Isolation,
+    /// Run the parts concurrently (one thread each, at most this many at a
+    /// time; 0 or 1 = one after the other). Only worth it with
+    /// [`Isolation::Worker`]: in-process TetGen runs are serialized.
+    pub parallel_parts: usize,
+}
+
+/// A facet of a part's PLC and what it becomes in the merged mesh.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum FacetKind {
+    /// A scene-triangle piece (cleaned index).
+    Scene(u32),
+    /// A seam-only face.
+    Seam,
+}
+
+/// What one part's TetGen run took and gave (the per-part report fields).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PartStats {
+    pub(super) input_points: usize,
+    pub(super) input_triangles: usize,
+    /// Points used by no scene facet (seam and box corners, trace points).
+    pub(super) wall_points: usize,
+    /// Facets that are not scene pieces (seam-only and box faces).
+    pub(super) wall_triangles: usize,
+    pub(super) tets: usize,
+    pub(super) peak_kib: Option<u64>,
+}
+
+/// One part after TetGen: f32 points, positive tets, constrained faces.
+pub(super) struct PartMesh {
+    pub(super) points: Vec<Vec3>,
+    pub(super) tets: Vec<[u32; 4]>,
+    /// (vertices, cleaned source) in the part's point indices.
+    pub(super) constrained: Vec<([u32; 3], u32)>,
+    pub(super) stats: PartStats,
+}
+
+pub(super) fn run_part(
+    part: usize,
+    facets: &[([Vec3; 3], FacetKind)],
+    box_faces: &[[Vec3; 3]],
+    options: &SeamOptions,
+) -> Result<PartMesh, SeamError> {
+    let mut index: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut points: Vec<Vec3> = Vec::new();
+    let mut id = |p: Vec3| {
+        *index.entry(key(p)).or_insert_with(|| {
+            points.push(p);
+            points.len() as u32 - 1
+        })
+    };
+    let mut triangles = Vec::new();
+    let mut markers = Vec::new();
+    for (i, (t, _)) in facets.iter().enumerate() {
+        triangles.push(t.map(&mut id));
+        markers.push(i as i32 + 1);
+    }
+    for t in box_faces {
+        triangles.push(t.map(&mut id));
+        markers.push(0);
+    }
+    let mut on_scene = vec![false; points.len()];
+    for ((_, k), t) in facets.iter().zip(&triangles) {
+        if matches!(k, FacetKind::Scene(_)) {
+            for &v in t {
+                on_scene[v as usize] = true;
+            }
+        }
+    }
+    let wall_points = on_scene.iter().filter(|&&s| !s).count();
+    let wall_triangles = facets
+        .iter()
+        .filter(|(_, k)| matches!(k, FacetKind::Seam))
+        .count()
+        + box_faces.len();
+    let input = TetgenInput {
+        points: points.iter().map(|p| p.as_dvec3().to_array()).collect(),
+        triangles,
+        markers,
+    };
+    let mut topts = options.tetgen.clone();
+    topts.preserve_surface = true;
+    let out = match tetrahedralize(&input, &topts, &options.isolation) {
+        Ok(out) => out,
+        Err(TetgenError::SelfIntersection) => {
+            return Err(self_intersection(part, facets, &points, &input.triangles));
+        }
+        Err(source) => return Err(SeamError::Tetgen { part, source }),
+    };
+    if let Some(i) = (0..input.points.len()).find(|&i| out.points.get(i) != Some(&input.points[i]))
+    {
+        return Err(SeamError::InputPointChanged { part, point: i });
+    }
+    // Every facet must be exactly one face with its own vertices.
+    let mut count = vec![0usize; facets.len()];
+    let mut same = vec![false; facets.len()];
+    for (face, &m) in out.faces.iter().zip(&out.face_markers) {
+        if m <= 0 || m as usize > facets.len() {
+            continue;
+        }
+        let f = m as usize - 1;
+        count[f] += 1;
+        same[f] = face_key(*face) == face_key(input.triangles[f]);
+    }
+    if let Some(f) = (0..facets.len()).find(|&f| count[f] != 1 || !same[f]) {
+        return Err(SeamError::FacetNotPreserved {
+            part,
+            facet: f,
+            faces: count[f],
+        });
+    }
+    let p32: Vec<Vec3> = out
+        .points
+        .iter()
+        .map(|p| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32))
+        .collect();
+    let mut tets = Vec::with_capacity(out.tets.len());
+    let mut bad = 0;
+    for &t in &out.tets {
+        let [a, b, c, d] = t.map(|v| DVec3::from_array(out.points[v as usize]));
+        let o = tet_core::predicates::orient3d(a, b, c, d);
+        let t = if o < 0.0 { [t[1], t[0], t[2], t[3]] } else { t };
+        let [a, b, c, d] = t.map(|v| p32[v as usize]);
+        if o == 0.0 || tet_core::predicates::orient3d_f32(a, b, c, d) <= 0.0 {
+            bad += 1;
+        }
+        tets.push(t);
+    }
+    if bad > 0 {
+        return Err(SeamError::RoundingFlattens { part, count: bad });
+    }
+    let constrained = facets
+        .iter()
+        .zip(&input.triangles)
+        .filter_map(|((_, k), &t)| match k {
+            FacetKind::Scene(s) => Some((t, *s)),
+            FacetKind::Seam => None,
+        })
+        .collect();
+    Ok(PartMesh {
+        stats: PartStats {
+            input_points: input.points.len(),
+            input_triangles: input.triangles.len(),
+            wall_points,
+            wall_triangles,
+            tets: tets.len(),
+            peak_kib: out.worker_peak_kib,
+        },
+        points: p32,
+        tets,
+        constrained,
+    })
+}
+
+/// Names the first intersecting pair of a part's PLC (TetGen only says
+/// that there is one).
+pub(super) fn self_intersection(
+    part: usize,
+    facets: &[([Vec3; 3], FacetKind)],
+    points: &[Vec3],
+    triangles: &[[u32; 3]],
+) -> SeamError {
+    let r = crate::intersect::find_self_intersections(points, triangles);
+    let what = |i: u32| {
+        let t = triangles[i as usize].map(|v| points[v as usize]);
+        let s = match facets.get(i as usize) {
+            Some((_, FacetKind::Scene(s))) => Some(*s),
+            _ => None,
+        };
+        (t, s)
+    };
+    match r.pairs.first() {
+        Some(p) => SeamError::PartSelfIntersects {
+            part,
+            first: what(p.first),
+            second: what(p.second),
+            kind: p.kind,
+            pairs: r.pairs.len(),
+        },
+        None => SeamError::Tetgen {
+            part,
+            source: TetgenError::SelfIntersection,
+        },
+    }
+}
+
+/// Runs TetGen on every part, at most `options.parallel_parts` at a time:
+/// that many threads take the next part from a queue as soon as their
+/// previous one finishes (largest input first, so a big part does not
+/// start last), which keeps both threads busy when parts differ in size.
+/// Each part is handed to `finish` on its thread as soon as its TetGen
+/// run returns. Results are in part order; the first error (in part order)
+/// is returned.
+pub(super) fn run_parts<T: Send>(
+    parts: &[Vec<([Vec3; 3], FacetKind)>],
+    faces: &[Vec<[Vec3; 3]>],
+    options: &SeamOptions,
+    finish: &(dyn Fn(usize, PartMesh) -> Result<T, SeamError> + Sync),
+) -> Result<Vec<T>, SeamError> {
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    let width = options.parallel_parts.max(1).min(parts.len().max(1));
+    let mut order: Vec<usize> = (0..parts.len()).collect();
+    order.sort_by_key(|&k| std::cmp::Reverse(parts[k].len() + faces[k].len()));
+    let results: Vec<Mutex<Option<Result<T, SeamError>>>> =
+        (0..parts.len()).map(|_| Mutex::new(None)).collect();
+    let next = AtomicUsize::new(0);
+    let failed = AtomicBool::new(false);
+    let work = || {
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            if i >= order.len() || failed.load(Ordering::Relaxed) {
+                break;
+            }
+            let k = order[i];
+            let r = run_part(k, &parts[k], &faces[k], options).and_then(|m| finish(k, m));
+            if r.is_err() {
+                failed.store(true, Ordering::Relaxed);
+            }
+            *results[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
+        }
+    };
+    if width == 1 {
+        work();
+    } else {
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..width).map(|_| scope.spawn(work)).collect();
+            for h in handles {
+                h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+            }
+        });
+    }
+    let mut out = Vec::with_capacity(parts.len());
+    let mut first_error = None;
+    for r in results {
+        match r.into_inner().unwrap_or_else(|e| e.into_inner()) {
+            Some(Ok(m)) => out.push(m),
+            Some(Err(e)) => {
+                first_error.get_or_insert(e);
+            }
+            None => {}
+        }
+    }
+    match first_error {
+        Some(e) => Err(e),
+        None => Ok(out),
+    }
+}

@@ -1,0 +1,332 @@
+//! The paper's recursive split with exact seams: perpendicular planes
+//! (Erkoç et al., seed 003, Algorithm 1 `TETRA`/`CLIP`/`MERGE`, §3.2–3.3).
+//!
+//! A [`CutTree`] splits the enclosing box recursively; every leaf box is one
+//! TetGen run (`-pY`). Where seams meet, both sides must see the same
+//! triangles, so the whole cut is built as one conforming complex before
+//! any part runs:
+//!
+//! 1. **Clipping in tree order.** Every scene triangle is a convex polygon
+//!    whose edges each lie on a *root* segment: a scene edge, or the cut
+//!    segment of a polygon by a plane. The crossing of an edge with a plane
+//!    is always computed from its root's endpoints
+//!    ([`super::seam::crossing_point`], f64, rounded once to f32, exact on
+//!    the plane), so the two sides of a seam, and the neighbours sharing a
+//!    scene edge, compute bit-identical points whatever the clip order. Each
+//!    crossing point is *registered* on its root with its exact parameter
+//!    `t` along the root. Scene triangles lying in a plane are part of that
+//!    plane's seam and are also clipped further down both sides (only to
+//!    register their edges' crossings).
+//! 2. **Walls.** Every split node's plane section of its box (a *seam*) and
+//!    the six faces of the enclosing box are *walls*. A wall's constraints
+//!    are: its boundary, the *traces* of all other seams whose rectangle has
+//!    an edge on the wall (the deeper planes on either side), the cut
+//!    segments and in-plane scene edges and vertices. Traces and boundaries
+//!    lie on axis-parallel lines where two coordinates are exact plane
+//!    values, so the points on them are found *exactly* (every point with
+//!    those two coordinates); traces crossing each other get their exact
+//!    crossing point. Every other segment is subdivided at the points
+//!    registered on its root between its endpoints (ordered by `t`). One
+//!    planar CDT (`spade`) per wall.
+//! 3. **Parts.** A leaf's PLC is its scene pieces (outlines subdivided as
+//!    above, triangulated by ear clipping in the triangle's dominant
+//!    projection) plus, for each of its six faces, the triangles of the wall
+//!    it lies on that lie inside the face. Adjacent leaves therefore receive
+//!    the very same triangles on shared faces, and subdivide shared edges
+//!    identically; TetGen `-pY` keeps every facet (checked), and the merge
+//!    is exact: in memory (dedup + `assemble`, [`build_tree`]) or streamed
+//!    through part files ([`build_tree_to_file`], [`super::stream`]).
+//!
+//! | paper (seed 003)                       | code                              |
+//! |----------------------------------------|-----------------------------------|
+//! | recursion of `TETRA`                   | [`CutTree`], [`build_tree`]       |
+//! | `CLIP` (clip triangles by the plane)   | tree-order clipping (item 1)      |
+//! | repair of overlapping vertices/edges   | none: shared roots and walls      |
+//! | `MERGE` by centroid hashing            | exact dedup + `TetMesh::assemble` |
+
+use glam::Vec3;
+use tet_core::TetMesh;
+
+use self::clip::run_clipping;
+use self::geometry::{outline, triangulate_outline};
+use self::walls::{prepare_walls, triangulate_wall};
+use super::error::SeamError;
+use super::merge::{InMemory, Merge, PartInputs, finish_parts};
+use super::parts::{FacetKind, SeamOptions, SeamReport};
+use super::plane::key;
+use super::split::SplitTree;
+use super::stream::{StreamOptions, StreamSummary, ToFile};
+use crate::bbox::EnclosingBox;
+use crate::clean::clean_scene;
+use crate::scene::Scene;
+
+pub use cut_tree::CutTree;
+
+mod clip;
+mod cut_tree;
+mod geometry;
+mod walls;
+
+/// Builds the mesh of `scene` in its enclosing box split by `tree` (see
+/// the module docs): every leaf is one TetGen run (concurrently with
+/// `options.parallel_parts`), merged exactly. The result passes
+/// [`TetMesh::validate`]; constrained faces carry the *input* scene
+/// triangle ids. The report's seam fields list the split nodes' seams in
+/// depth-first order (below before above); part fields list the leaves in
+/// the same order.
+pub fn build_tree(
+    scene: &Scene,
+    tree: &CutTree,
+    options: &SeamOptions,
+) -> Result<(TetMesh, SeamReport), SeamError> {
+    build_tree_with(scene, tree, options, &InMemory)
+}
+
+/// [`build_tree`] with the parts written to part files as they finish and
+/// streamed into the mesh file `stream.output` ([`super::stream`]): the
+/// caller never holds the whole mesh. The parts follow each other in the
+/// file in leaf order (depth first, below before above), each
+/// Hilbert-sorted on its own with `stream.sort_parts`.
+pub fn build_tree_to_file(
+    scene: &Scene,
+    tree: &CutTree,
+    options: &SeamOptions,
+    stream: &StreamOptions,
+) -> Result<(StreamSummary, SeamReport), SeamError> {
+    build_tree_with(scene, tree, options, &ToFile::new(stream)?)
+}
+
+/// [`build_tree`] with the parts finished and merged by `merge`.
+fn build_tree_with<M: Merge>(
+    scene: &Scene,
+    tree: &CutTree,
+    options: &SeamOptions,
+    merge: &M,
+) -> Result<(M::Output, SeamReport), SeamError> {
+    let (cleaned, cm) = clean_scene(scene)?;
+    if cleaned.triangles.is_empty() {
+        return Err(SeamError::EmptyScene);
+    }
+    let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
+    let mut cut = run_clipping(&cleaned.vertices, &cleaned.triangles, tree, b.min, b.max)?;
+    prepare_walls(&mut cut, b.min, b.max);
+    let mut report = SeamReport {
+        triangles_cut: cut.triangles_cut.len(),
+        triangles_in_plane: cut.triangles_in_plane.len(),
+        ..SeamReport::default()
+    };
+    let triangulated: Vec<Result<_, SeamError>> = {
+        let (walls, reg, lines) = (&cut.walls, &cut.registry, &cut.lines);
+        use rayon::prelude::*;
+        walls
+            .par_iter()
+            .map(|w| triangulate_wall(w, reg, lines))
+            .collect()
+    };
+    for (w, t) in cut.walls.iter_mut().zip(triangulated) {
+        w.triangles = t?;
+        if w.seam {
+            let mut vs: Vec<[u32; 3]> = w.triangles.iter().flat_map(|(t, _)| t.map(key)).collect();
+            vs.sort_unstable();
+            vs.dedup();
+            report.seam_vertices.push(vs.len());
+            report.seams.push((w.plane, w.lo, w.hi));
+            report.seam_triangles.push(w.triangles.len());
+        }
+    }
+    // Leaves in depth-first order (below first).
+    let mut leaves = Vec::new();
+    let mut stack = vec![0usize];
+    while let Some(id) = stack.pop() {
+        match cut.nodes[id].split {
+            None => leaves.push(id),
+            Some((_, _, below, above)) => {
+                stack.push(above);
+                stack.push(below);
+            }
+        }
+    }
+    let mut parts: Vec<Vec<([Vec3; 3], FacetKind)>> = Vec::with_capacity(leaves.len());
+    for &id in &leaves {
+        let node = &cut.nodes[id];
+        let mut facets = Vec::new();
+        for poly in &cut.pieces[id] {
+            let l = outline(&cut.registry, &cut.lines, poly)?;
+            let t = cleaned.triangles[poly.source as usize].map(|v| cleaned.vertices[v as usize]);
+            let normal = (t[1] - t[0]).as_dvec3().cross((t[2] - t[0]).as_dvec3());
+            for tri in triangulate_outline(&l, normal, poly.source)? {
+                facets.push((tri, FacetKind::Scene(poly.source)));
+            }
+        }
+        for axis in 0..3 {
+            for value in [node.lo[axis], node.hi[axis]] {
+                let (mut flo, mut fhi) = (node.lo, node.hi);
+                flo[axis] = value;
+                fhi[axis] = value;
+                let wall = cut
+                    .walls
+                    .iter()
+                    .find(|w| {
+                        w.plane.axis == axis
+                            && w.plane.value == value
+                            && (0..3).all(|a| w.lo[a] <= flo[a] && fhi[a] <= w.hi[a])
+                    })
+                    .expect("every leaf face lies on a seam or on the enclosing box");
+                for (t, s) in &wall.triangles {
+                    let inside = t
+                        .iter()
+                        .all(|p| (0..3).all(|a| p[a] >= flo[a] && p[a] <= fhi[a]));
+                    if inside {
+                        facets.push((*t, s.map_or(FacetKind::Seam, FacetKind::Scene)));
+                    }
+                }
+            }
+        }
+        parts.push(facets);
+    }
+    // The clipping (pieces, walls, registries) and the cleaned scene are
+    // not needed while the parts run: every part's PLC is in `parts`.
+    drop(cut);
+    drop(cleaned);
+    let inputs = PartInputs {
+        faces: vec![Vec::new(); parts.len()],
+        parts,
+        triangle_source: cm.triangle_source,
+        triangle_count: scene.triangles.len() as u32,
+    };
+    finish_parts(inputs, report, options, merge)
+}
+
+/// The plan [`build_tree_with_memory_limit`] built.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TreePlan {
+    /// The planner's tree (estimates per leaf, triangles cut per node),
+    /// with the planes as planned.
+    pub plan: SplitTree,
+    /// The planes as built (after any moves).
+    pub cuts: CutTree,
+    /// How many plane moves the build needed.
+    pub plane_moves: usize,
+}
+
+/// How many times [`build_tree_with_memory_limit`] moves a plane that met
+/// a degenerate configuration before giving up.
+pub const MAX_PLANE_MOVES: usize = 8;
+
+/// The paper's `TETRA` under a memory limit: plans the recursive split of
+/// `scene` ([`super::split::plan_split`], planes avoiding vertices within
+/// TetGen's tolerance) so that every leaf's *predicted* TetGen peak fits
+/// `split.limit_bytes`, then builds it ([`build_tree`]). A plane that
+/// meets a degenerate configuration only the build can see (a point made
+/// by an earlier cut within tolerance of it, [`SeamError::PlaneNearPoint`]
+/// or [`SeamError::DegenerateCut`]) is moved by 1/4096 of the box's
+/// extent and the build retried, at most [`MAX_PLANE_MOVES`] times.
+pub fn build_tree_with_memory_limit(
+    scene: &Scene,
+    split: &super::split::SplitOptions,
+    options: &SeamOptions,
+) -> Result<(TetMesh, SeamReport, TreePlan), SeamError> {
+    build_tree_with_memory_limit_with(scene, split, options, &InMemory)
+}
+
+/// [`build_tree_with_memory_limit`] streaming the parts into the mesh file
+/// `stream.output` ([`build_tree_to_file`]).
+pub fn build_tree_with_memory_limit_to_file(
+    scene: &Scene,
+    split: &super::split::SplitOptions,
+    options: &SeamOptions,
+    stream: &StreamOptions,
+) -> Result<(StreamSummary, SeamReport, TreePlan), SeamError> {
+    build_tree_with_memory_limit_with(scene, split, options, &ToFile::new(stream)?)
+}
+
+/// [`build_tree_with_memory_limit`] with the parts merged by `merge`.
+fn build_tree_with_memory_limit_with<M: Merge>(
+    scene: &Scene,
+    split: &super::split::SplitOptions,
+    options: &SeamOptions,
+    merge: &M,
+) -> Result<(M::Output, SeamReport, TreePlan), SeamError> {
+    let (cleaned, _) = clean_scene(scene)?;
+    if cleaned.triangles.is_empty() {
+        return Err(SeamError::EmptyScene);
+    }
+    let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
+    let plan =
+        super::split::plan_split(&cleaned.vertices, &cleaned.triangles, (b.min, b.max), split);
+    if plan.max_predicted_bytes() > split.limit_bytes {
+        return Err(SeamError::LimitTooSmall {
+            limit_bytes: split.limit_bytes,
+        });
+    }
+    let mut tree = CutTree::from_split_tree(&plan);
+    drop(cleaned);
+    let mut moves = 0;
+    loop {
+        match build_tree_with(scene, &tree, options, merge) {
+            Ok((mesh, report)) => {
+                return Ok((
+                    mesh,
+                    report,
+                    TreePlan {
+                        plan,
+                        cuts: tree,
+                        plane_moves: moves,
+                    },
+                ));
+            }
+            Err(
+                e @ (SeamError::PlaneNearPoint { plane, .. }
+                | SeamError::DegenerateCut { plane, .. }),
+            ) => {
+                let step = (b.max - b.min).max_element() / 4096.0;
+                if moves >= MAX_PLANE_MOVES || !tree.nudge(plane, step, b.min, b.max) {
+                    return Err(e);
+                }
+                moves += 1;
+            }
+            Err(e) => return Err(e),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A piece nearly parallel to a wall (z = 0) whose chain A–D–C on the
+    /// wall is not exactly straight: the ear at B would leave the sliver
+    /// (A, C, D) lying in the wall, overlapping the wall's triangles.
+    #[test]
+    fn ear_clipping_leaves_no_sliver_in_a_wall() {
+        let a = Vec3::new(0.0, 0.0, 0.0);
+        let b = Vec3::new(0.9, -1.0, -0.01);
+        let c = Vec3::new(2.0, 1.0, 0.0);
+        let d = Vec3::new(1.0, 0.500_001, 0.0);
+        let outline = [b, c, d, a];
+        let normal = (c - a).as_dvec3().cross((b - a).as_dvec3()) * -1.0;
+        assert!(normal.z > 0.0);
+        let tris = triangulate_outline(&outline, normal, 0).unwrap();
+        assert_eq!(tris.len(), 2);
+        for t in &tris {
+            assert!(!t.iter().all(|p| p.z == 0.0), "{t:?} lies in the wall");
+        }
+        // The triangles tile the outline (projected areas add up).
+        let area = |p: &[Vec3]| {
+            let n = p.len();
+            (0..n)
+                .map(|i| {
+                    let (u, v) = (p[i].as_dvec3(), p[(i + 1) % n].as_dvec3());
+                    u.x * v.y - v.x * u.y
+                })
+                .sum::<f64>()
+                / 2.0
+        };
+        let sum: f64 = tris.iter().map(|t| area(t)).sum();
+        assert!(
+            (sum - area(&outline)).abs() < 1e-12,
+            "{sum} vs {}",
+            area(&outline)
+        );
+    }
+}
