@@ -9,11 +9,12 @@ use tet_core::TetMesh;
 use tet_core::layout::{LayoutError, LayoutMesh, LayoutRecord};
 use tet_core::link::Link;
 
-use crate::entry::{BoundaryEntry, EntryHint};
-use crate::lockstep::{ExitRule, RecordWords};
+use crate::batch::BatchWalk;
 use crate::ray::{Ray, TraceOutcome};
+pub use crate::walk::LANES;
 use crate::walk::{
-    Projection, Start, Starts, Topology, prefetch_index, step_cap, trace, trace_interleaved,
+    BoundaryEntry, EntryHint, ExitRule, Projection, RecordWords, Start, Starts, Topology,
+    prefetch_index, step_cap, trace, trace_interleaved, trace_until,
 };
 
 /// A ray-traversal method over one mesh.
@@ -69,7 +70,7 @@ pub trait Tracer: Sync {
             // Traced from its origin; `Start::Tet` is ignored.
             return Ok(Start::Tet(0));
         }
-        entry.start_with::<crate::DuffF32>(self.mesh(), ray, hint)
+        entry.start_with::<crate::walk::DuffF32>(self.mesh(), ray, hint)
     }
 
     /// False for a tracer that does not walk the tets (a BVH, a brute
@@ -91,9 +92,6 @@ pub trait Tracer: Sync {
         self.trace(ray, start)
     }
 }
-
-/// Walks interleaved per thread by [`WalkTracer::trace_batch`].
-pub const LANES: usize = 8;
 
 /// A projected-walk kernel: layout `L` (a [`Topology`]) walked with
 /// projection `P`. The kernel modules ([`crate::tet20`], ...) name the
@@ -134,7 +132,7 @@ impl<'m, L: Topology, P: Projection> WalkTracer<'m, L, P> {
     }
 }
 
-impl<L: Topology, P: Projection> Tracer for WalkTracer<'_, L, P> {
+impl<L: Topology, P: BatchWalk> Tracer for WalkTracer<'_, L, P> {
     fn name(&self) -> String {
         format!("{}/{}", self.name, P::NAME)
     }
@@ -170,7 +168,14 @@ impl<L: Topology, P: Projection> Tracer for WalkTracer<'_, L, P> {
         )
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
-        crate::secondary::ShadowTracer::trace_until(self, ray, start, stop)
+        trace_until::<P, L>(
+            self.mesh,
+            &self.layout,
+            ray,
+            start,
+            stop,
+            step_cap(self.mesh),
+        )
     }
     fn start_outside(
         &self,
@@ -188,7 +193,7 @@ impl<L: Topology, P: Projection> Tracer for WalkTracer<'_, L, P> {
 /// [`crate::lockstep`] are tested and measured against.
 pub struct Interleaved<'a, 'm, L, P>(pub &'a WalkTracer<'m, L, P>);
 
-impl<L: Topology, P: Projection> Tracer for Interleaved<'_, '_, L, P> {
+impl<L: Topology, P: BatchWalk> Tracer for Interleaved<'_, '_, L, P> {
     fn name(&self) -> String {
         format!("{}/interleaved", self.0.name())
     }

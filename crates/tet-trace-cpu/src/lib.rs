@@ -8,15 +8,38 @@
 //! * [`mod@locate`]: exact point location (seed 000 §4.2);
 //! * [`entry`]: rays from a viewpoint outside the mesh enter through its boundary;
 //! * [`walk`]: the watertight traversal engine and its projections;
+//! * [`lockstep`]: the SIMD lockstep batch walks, and [`batch`]: which
+//!   batch walk each projection takes;
 //! * [`scaled`]: the scaled basis of Eq. 1–3, specialised per direction case;
 //! * kernels, one per method: [`sctp`], [`tet32`], [`tet20`], [`tet16`], [`tet80`];
 //! * [`mod@reference`]: f64 brute-force closest hit and ray generators for tests;
 //! * [`render`]: pinhole renderer, Lambert shading, PNG, heat maps, stats;
 //! * [`secondary`]: shadow, reflection and refraction rays (seed 000 §6).
+//!
+//! # Example
+//!
+//! A mesh (here a procedural grid with a closed box of constrained faces
+//! inside), the Tet20 kernel, and one ray from inside the mesh:
+//!
+//! ```
+//! use glam::Vec3;
+//! use tet_core::synthetic::{GridSpec, kuhn_grid};
+//! use tet_trace_cpu::{DuffF32, Ray, Start, TraceOutcome, Tracer, locate, tet20::Tet20Tracer};
+//!
+//! let shell = Some(([1; 3], [3; 3]));
+//! let mesh = kuhn_grid(&GridSpec { cells: [4; 3], shell, ..Default::default() });
+//! let tracer = Tet20Tracer::<DuffF32>::new(&mesh).unwrap();
+//! let origin = Vec3::new(0.5, 0.5, 0.5); // outside the box, inside the mesh
+//! let start = Start::Tet(locate(&mesh, origin, 0).unwrap());
+//! let ray = Ray::new(origin, Vec3::splat(2.0) - origin); // toward the box centre
+//! let TraceOutcome::Hit(hit) = tracer.trace(&ray, start) else { panic!("no hit") };
+//! assert!(hit.t > 0.0 && hit.tets_visited > 0);
+//! ```
 
 #![deny(missing_docs)]
 
 pub mod area_light;
+pub mod batch;
 pub mod entry;
 pub mod kernel;
 pub mod locate;
@@ -26,7 +49,6 @@ pub mod reference;
 pub mod render;
 pub mod scaled;
 pub mod sctp;
-mod sctp_lockstep;
 pub mod secondary;
 pub mod tet16;
 pub mod tet20;
@@ -34,6 +56,7 @@ pub mod tet32;
 pub mod tet80;
 pub mod walk;
 
+pub use batch::BatchWalk;
 pub use entry::{Viewpoint, ViewpointError};
 pub use kernel::{Tracer, WalkTracer};
 pub use locate::{LocateError, locate};

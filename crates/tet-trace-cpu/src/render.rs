@@ -323,7 +323,7 @@ pub fn render_scene_with<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
 /// [`render`] into `frame`, whose buffers are reused when they already
 /// have the image's size: a sequence of frames (a benchmark, an animation)
 /// then spends its time tracing and shading, not having the system zero
-/// fresh pages for every frame (10 % of a 1920×1440 Torus Knots frame).
+/// fresh pages for every frame.
 pub fn render_into<T: Tracer + ?Sized>(
     tracer: &T,
     camera: &Camera,

@@ -22,15 +22,14 @@
 //! suffer from this (see the robustness census in `tests/robustness.rs`).
 //!
 //! Batches (a tile of primary rays) walk 16 rays in AVX-512 lockstep where
-//! the CPU has AVX-512F (`crate::sctp_lockstep`, the same decisions bit
-//! for bit), else the scalar interleaved walk: Torus Knots, 1920×1440, 2
-//! threads, 2.05 → 8.13 Mrays/s (neptun's ScTP: 2.79).
+//! the CPU has AVX-512F ([`crate::lockstep`], the same decisions bit for
+//! bit), several times faster than the scalar interleaved walk that serves
+//! them elsewhere.
 
 use tet_core::layout::{Baseline32, Baseline32Mesh};
 
 use crate::kernel::{WalkRecord, WalkTracer, slot_exit_link};
-use crate::lockstep::ExitRule;
-use crate::walk::TripleF32;
+use crate::walk::{ExitRule, TripleF32};
 
 impl WalkRecord for Baseline32 {
     const KERNEL: &'static str = "sctp";

@@ -70,7 +70,8 @@ use tet_core::{Link, NO_TET, TetMesh};
 use crate::kernel::{Tracer, WalkTracer};
 use crate::locate::{LocateError, locate, star};
 use crate::ray::{Hit, Ray, TraceOutcome};
-use crate::walk::{DuffF32, Projection, Start, Topology, step_cap, trace};
+use crate::walk::{DuffF32, Projection, Start, Topology, step_cap, trace_until};
+pub use crate::walk::{StopAt, stops_at};
 
 /// Unit geometric normal of a hit's face (from the source triangle winding).
 pub fn face_normal(mesh: &TetMesh, face: u32) -> Vec3 {
@@ -229,49 +230,6 @@ impl LightTarget {
     }
 }
 
-/// True when `tet` is in the sorted set `stop` (a linear scan for the usual
-/// one or two tets, binary search beyond).
-#[inline(always)]
-pub fn stops_at(stop: &[u32], tet: u32) -> bool {
-    if stop.len() <= 8 {
-        stop.contains(&tet)
-    } else {
-        stop.binary_search(&tet).is_ok()
-    }
-}
-
-/// A [`Topology`] that ends the walk when it enters a tet of `stop`: the exit
-/// link of such a tet reads as the mesh boundary, so the walk reports a
-/// [`TraceOutcome::Miss`] there (for a shadow ray: unoccluded). Everything
-/// else is forwarded to `inner` unchanged (same decisions, same
-/// watertightness).
-#[derive(Clone, Copy, Debug)]
-pub struct StopAt<'a, T> {
-    /// The layout walked.
-    pub inner: &'a T,
-    /// Sorted tets at which the walk stops.
-    pub stop: &'a [u32],
-}
-
-impl<T: Topology> Topology for StopAt<'_, T> {
-    #[inline(always)]
-    fn vx(&self, tet: u32) -> u32 {
-        self.inner.vx(tet)
-    }
-    #[inline(always)]
-    fn exit_link(&self, tet: u32, face: [u32; 3], d: u32, exiting: u32, entry_raw: u32) -> u32 {
-        if stops_at(self.stop, tet) {
-            Link::BOUNDARY.0
-        } else {
-            self.inner.exit_link(tet, face, d, exiting, entry_raw)
-        }
-    }
-    #[inline(always)]
-    fn prefetch(&self, tet: u32) {
-        self.inner.prefetch(tet)
-    }
-}
-
 /// The canonical mesh as a [`Topology`] (`tets` + `neighbors`, neighbour `k`
 /// opposite vertex `k`): lets any tracer's shadow rays walk without a
 /// layout. An out-of-range tet reads as the boundary, never a panic.
@@ -350,49 +308,24 @@ impl<'m> MeshWalker<'m> {
     }
 }
 
-/// True when a walk starting at `start` already starts in a stop tet.
-fn starts_in(start: Start, stop: &[u32]) -> bool {
-    match start {
-        Start::Tet(t) => stops_at(stop, t),
-        Start::Face { tet, .. } | Start::Entry { tet, .. } => stops_at(stop, tet),
-    }
-}
-
-fn stopped_at_start() -> TraceOutcome {
-    TraceOutcome::Miss { tets_visited: 1 }
-}
-
 impl ShadowTracer for MeshWalker<'_> {
     fn mesh(&self) -> &TetMesh {
         self.mesh
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
-        if ray.is_valid() && starts_in(start, stop) {
-            return stopped_at_start();
-        }
-        let topo = StopAt {
-            inner: &MeshTopology(self.mesh),
-            stop,
-        };
-        trace::<DuffF32, _>(self.mesh, &topo, ray, start, self.cap)
+        let topo = MeshTopology(self.mesh);
+        trace_until::<DuffF32, _>(self.mesh, &topo, ray, start, stop, self.cap)
     }
 }
 
 /// Every projected-walk kernel walks its shadow rays on its own layout.
 impl<L: Topology, P: Projection> ShadowTracer for WalkTracer<'_, L, P> {
     fn mesh(&self) -> &TetMesh {
-        Tracer::mesh(self)
+        self.mesh
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
-        if ray.is_valid() && starts_in(start, stop) {
-            return stopped_at_start();
-        }
-        let mesh = Tracer::mesh(self);
-        let topo = StopAt {
-            inner: self.layout(),
-            stop,
-        };
-        trace::<P, _>(mesh, &topo, ray, start, step_cap(mesh))
+        let mesh = self.mesh;
+        trace_until::<P, _>(mesh, self.layout(), ray, start, stop, step_cap(mesh))
     }
 }
 

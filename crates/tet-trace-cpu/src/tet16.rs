@@ -12,8 +12,7 @@
 use tet_core::layout::{Tet16, Tet16Mesh, rank_of};
 
 use crate::kernel::{WalkRecord, WalkTracer};
-use crate::lockstep::ExitRule;
-use crate::walk::{DuffF32, DuffF64};
+use crate::walk::{DuffF32, DuffF64, ExitRule};
 
 impl WalkRecord for Tet16 {
     const KERNEL: &'static str = "tet16";

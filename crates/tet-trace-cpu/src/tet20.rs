@@ -20,8 +20,7 @@
 use tet_core::layout::{Tet20, Tet20Mesh, rank_of};
 
 use crate::kernel::{WalkRecord, WalkTracer};
-use crate::lockstep::ExitRule;
-use crate::walk::{DuffF32, DuffF64};
+use crate::walk::{DuffF32, DuffF64, ExitRule};
 
 impl WalkRecord for Tet20 {
     const KERNEL: &'static str = "tet20";

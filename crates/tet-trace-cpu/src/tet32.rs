@@ -10,8 +10,7 @@
 use tet_core::layout::{Tet32, Tet32Mesh};
 
 use crate::kernel::{WalkRecord, WalkTracer, slot_exit_link};
-use crate::lockstep::ExitRule;
-use crate::walk::{DuffF32, DuffF64};
+use crate::walk::{DuffF32, DuffF64, ExitRule};
 
 impl WalkRecord for Tet32 {
     const KERNEL: &'static str = "tet32";

@@ -2,7 +2,9 @@
 //! when available, and an optional artificial cap on buffer sizes (tests and
 //! what-if runs for smaller GPUs).
 
-use crate::GpuError;
+use std::sync::OnceLock;
+
+use crate::error::GpuError;
 
 /// Environment variable that, when set to a non-empty value other than `0`,
 /// tells the test helpers to treat "no adapter" as a failure instead of a
@@ -47,24 +49,14 @@ impl GpuContext {
 
     /// Opens the first Vulkan adapter wgpu offers (high-performance
     /// preference), requesting its highest limits and, when supported, the
-    /// timestamp-query feature.
+    /// timestamp-query feature. The instance and adapter are found once per
+    /// process and shared by every context (each context has its own
+    /// device and queue).
     pub fn with_options(opts: &GpuOptions) -> Result<GpuContext, GpuError> {
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        // Only the Vulkan backend is compiled in (lavapipe in CI).
-        desc.backends = wgpu::Backends::VULKAN;
-        let instance = wgpu::Instance::new(desc);
-        let request = |fallback: bool| {
-            pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-                power_preference: wgpu::PowerPreference::HighPerformance,
-                force_fallback_adapter: fallback,
-                compatible_surface: None,
-                ..Default::default()
-            }))
-        };
-        let adapter = match request(opts.force_fallback_adapter) {
+        let adapter = match shared_adapter(opts.force_fallback_adapter) {
             Ok(a) => a,
             Err(first) if !opts.force_fallback_adapter => {
-                request(true).map_err(|e| GpuError::NoAdapter {
+                shared_adapter(true).map_err(|e| GpuError::NoAdapter {
                     reason: format!("{first}; fallback adapter: {e}"),
                 })?
             }
@@ -158,4 +150,45 @@ impl GpuContext {
         }
         Ok(())
     }
+}
+
+/// The process's wgpu instance and its two adapters (default and fallback),
+/// each looked up on first use. Every adapter enumeration makes the Vulkan
+/// loader's implicit layers probe the window systems: Mesa's device-select
+/// layer connects to Wayland, and libwayland prints `error: XDG_RUNTIME_DIR
+/// is invalid or not set in the environment.` where there is no Wayland
+/// session (a headless machine, CI) although nothing failed. Enumerating
+/// once per process keeps that to one line however many contexts a run
+/// opens.
+struct Shared {
+    instance: wgpu::Instance,
+    adapters: [OnceLock<Result<wgpu::Adapter, wgpu::RequestAdapterError>>; 2],
+}
+
+/// The adapter wgpu offers with `fallback` (see [`Shared`]).
+fn shared_adapter(fallback: bool) -> Result<wgpu::Adapter, wgpu::RequestAdapterError> {
+    static SHARED: OnceLock<Shared> = OnceLock::new();
+    let shared = SHARED.get_or_init(|| {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        // Only the Vulkan backend is compiled in (lavapipe in CI).
+        desc.backends = wgpu::Backends::VULKAN;
+        Shared {
+            instance: wgpu::Instance::new(desc),
+            adapters: [OnceLock::new(), OnceLock::new()],
+        }
+    });
+    shared.adapters[fallback as usize]
+        .get_or_init(|| {
+            pollster::block_on(
+                shared
+                    .instance
+                    .request_adapter(&wgpu::RequestAdapterOptions {
+                        power_preference: wgpu::PowerPreference::HighPerformance,
+                        force_fallback_adapter: fallback,
+                        compatible_surface: None,
+                        ..Default::default()
+                    }),
+            )
+        })
+        .clone()
 }

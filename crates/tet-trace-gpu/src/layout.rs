@@ -9,7 +9,7 @@ use tet_core::{FACE_VERTICES, TetMesh};
 use tet_trace_cpu::tet80::EXIT;
 use tet_trace_cpu::walk::EXIT_SLOT;
 
-use crate::GpuError;
+use crate::error::GpuError;
 
 /// WGSL source of the layout-independent walk.
 const WALK: &str = include_str!("walk.wgsl");

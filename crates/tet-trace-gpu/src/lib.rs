@@ -19,7 +19,7 @@
 //! ## The kernels: a port of the CPU walk (seed 000, Algorithms 1–7)
 //!
 //! `src/walk.wgsl` is a statement-by-statement port of
-//! `tet_trace_cpu::walk::step` with the `DuffF32` projection (see that
+//! `tet_trace_cpu::walk::step::advance` with the `DuffF32` projection (see that
 //! module's docs for the watertightness argument); each layout appends its
 //! `layout_vx` / `layout_exit` functions (ports of the CPU `Topology`
 //! implementations: Tet32 Algorithm 3 compares the exit vertex with the three
@@ -115,10 +115,15 @@
 //! ## Testing without a GPU
 //!
 //! `tests/walk.rs` runs on lavapipe (`apt-get install -y
-//! --no-install-recommends mesa-vulkan-drivers`; set `XDG_RUNTIME_DIR`, e.g.
-//! to `/tmp`, to silence Mesa's window-system probe). Without an adapter the
+//! --no-install-recommends mesa-vulkan-drivers`). Without an adapter the
 //! tests print a skip message, unless [`REQUIRE_ADAPTER_ENV`]
-//! (`TET_GPU_REQUIRED=1`) is set, which makes that a failure (CI).
+//! (`TET_GPU_REQUIRED=1`) is set, which makes that a failure (CI). The
+//! wgpu instance and adapter are looked up once per process and shared by
+//! every [`GpuContext`]: on a machine without a Wayland session, Mesa's
+//! window-system probe prints `error: XDG_RUNTIME_DIR is invalid or not set
+//! in the environment.` at each lookup although nothing failed, so it
+//! appears at most once per process (setting `XDG_RUNTIME_DIR`, e.g. to
+//! `/tmp`, silences it).
 //!
 //! ## Timing
 //!
@@ -129,81 +134,16 @@
 #![deny(missing_docs)]
 
 mod context;
+mod dispatch;
+mod error;
 mod layout;
+mod records;
+mod starts;
+mod stats;
 mod tracer;
 
 pub use context::{GpuContext, GpuOptions, REQUIRE_ADAPTER_ENV};
+pub use error::GpuError;
 pub use layout::GpuLayout;
-pub use tracer::{DispatchStats, GpuFrame, GpuMemory, GpuTracer};
-
-use thiserror::Error;
-
-/// Everything that can go wrong on the GPU path; each variant names what
-/// failed.
-#[derive(Debug, Error)]
-pub enum GpuError {
-    /// No adapter (GPU or software) could be obtained.
-    #[error("no wgpu adapter available: {reason}")]
-    NoAdapter {
-        /// What wgpu reported.
-        reason: String,
-    },
-    /// The adapter refused to create a device.
-    #[error("could not create a wgpu device on {adapter}: {reason}")]
-    Device {
-        /// Adapter name.
-        adapter: String,
-        /// What wgpu reported.
-        reason: String,
-    },
-    /// A buffer exceeds one of the device limits.
-    #[error(
-        "{buffer}: {bytes} bytes exceed the device limit {limit} = {value} bytes \
-         (tet records are split over at most 4 bindings, other arrays not at all)"
-    )]
-    TooLarge {
-        /// Which buffer ("tet20 records", "points", ...).
-        buffer: &'static str,
-        /// Its size in bytes.
-        bytes: u64,
-        /// Name of the wgpu limit (`max_storage_buffer_binding_size`, ...).
-        limit: &'static str,
-        /// The limit's value.
-        value: u64,
-    },
-    /// The mesh could not be encoded in the layout.
-    #[error(transparent)]
-    Layout(#[from] tet_core::layout::LayoutError),
-    /// More elements than the kernel's 32-bit indices can address.
-    #[error("{what}: {count} exceeds the GPU kernel's limit of {limit}")]
-    TooMany {
-        /// What was counted.
-        what: &'static str,
-        /// How many there are.
-        count: usize,
-        /// The largest supported count.
-        limit: usize,
-    },
-    /// `rays` and `starts` of a batch differ in length.
-    #[error("batch has {rays} rays but {starts} starts")]
-    LengthMismatch {
-        /// Number of rays.
-        rays: usize,
-        /// Number of starts.
-        starts: usize,
-    },
-    /// Invalid camera set-up (start tet out of range, empty image, ...).
-    #[error("camera: {detail}")]
-    Camera {
-        /// What is wrong.
-        detail: String,
-    },
-    /// wgpu reported a validation or out-of-memory error.
-    #[error("wgpu error during {during}: {message}")]
-    Wgpu {
-        /// The operation.
-        during: &'static str,
-        /// wgpu's message.
-        message: String,
-    },
-}
+pub use stats::{DispatchStats, GpuFrame, GpuMemory};
+pub use tracer::GpuTracer;

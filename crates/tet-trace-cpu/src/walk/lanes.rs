@@ -1,0 +1,178 @@
+//! Batches of rays on one thread: their starts ([`Starts`]), the [`Feed`]
+//! every batch walk draws its lanes from, and the scalar interleaved walk
+//! ([`trace_interleaved`]).
+
+use tet_core::TetMesh;
+
+use super::entry::{BoundaryEntry, EntryHint};
+use super::projection::Projection;
+use super::start::{Lane, Start, begin, begin_with};
+use super::step::{advance, finish_step};
+use super::stop::Advance;
+use super::topology::Topology;
+use crate::ray::{Failure, Ray, TraceOutcome};
+
+/// The starts of a batch of rays: one for all (primary rays from a viewpoint
+/// inside the mesh), one per ray, or each ray's entry into the mesh from
+/// outside.
+#[derive(Clone, Copy, Debug)]
+pub enum Starts<'a> {
+    /// Every ray starts from this.
+    Same(Start),
+    /// Ray `i` starts from element `i` (same length as the rays).
+    Each(&'a [Start]),
+    /// Every ray's origin lies outside the mesh: each enters through the
+    /// boundary face its line crosses, decided with the walk's own
+    /// projection ([`BoundaryEntry::start_with`]).
+    Outside(&'a BoundaryEntry),
+}
+
+/// Walks interleaved per thread by the scalar batch walk
+/// ([`trace_interleaved`]) of the kernels.
+pub const LANES: usize = 8;
+
+/// A batch being traced: its rays and starts, the next ray to start, and
+/// where the outcomes go. Every batch walk (the interleaved walk here, the
+/// SIMD lockstep walks) draws its lanes from one and stores outcomes in it.
+pub(crate) struct Feed<'a> {
+    pub(crate) mesh: &'a TetMesh,
+    pub(crate) rays: &'a [Ray],
+    start: Starts<'a>,
+    /// The next ray not started yet.
+    next: usize,
+    /// The boundary face the last ray from outside entered through (tested
+    /// first for the next, see [`crate::entry`]).
+    hint: EntryHint,
+    pub(crate) out: &'a mut [TraceOutcome],
+}
+
+impl<'a> Feed<'a> {
+    /// A feed of ray `i` from `start` into `out[i]`, over the shorter of
+    /// `rays` and `out`.
+    #[inline(always)]
+    pub(crate) fn new(
+        mesh: &'a TetMesh,
+        rays: &'a [Ray],
+        start: Starts<'a>,
+        out: &'a mut [TraceOutcome],
+    ) -> Feed<'a> {
+        let n = rays.len().min(out.len());
+        Feed {
+            mesh,
+            rays: &rays[..n],
+            start,
+            next: 0,
+            hint: EntryHint::default(),
+            out: &mut out[..n],
+        }
+    }
+
+    /// Starts the next queued ray that does not end before its walk (those
+    /// are written to `out` directly): its index and lane.
+    #[inline(always)]
+    pub(crate) fn next_lane<P: Projection>(&mut self) -> Option<(usize, Lane<P>)> {
+        let mesh = self.mesh;
+        while self.next < self.rays.len() {
+            let i = self.next;
+            self.next += 1;
+            let ray = &self.rays[i];
+            let lane = match self.start {
+                Starts::Same(s) => begin::<P>(mesh, ray, s),
+                Starts::Each(s) => begin::<P>(mesh, ray, s[i]),
+                Starts::Outside(entry) => begin_outside::<P>(mesh, ray, entry, &mut self.hint),
+            };
+            match lane {
+                Ok(l) => return Some((i, l)),
+                Err(o) => self.out[i] = o,
+            }
+        }
+        None
+    }
+}
+
+/// Traces many rays (ray `i` from `start` of ray `i`) with `K` walks interleaved on one thread:
+/// each round advances every lane by one tet, so the CPU overlaps the
+/// dependent load → project → decide → load chains of independent rays
+/// (memory-level parallelism without SIMD). Each step prefetches the record
+/// of the lane's next tet, which that lane reads a round later.
+/// Results are identical to [`trace`](super::step::trace) ray by ray (same
+/// `advance` and `finish_step`). `out.len()` must equal `rays.len()`.
+pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
+    mesh: &TetMesh,
+    topo: &T,
+    rays: &[Ray],
+    start: Starts<'_>,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    let mut feed = Feed::new(mesh, rays, start, out);
+    let points = &mesh.points[..];
+    // Lanes in flight, each with its ray index; a finished lane is replaced
+    // in place by the next ray, or removed when none is left.
+    let mut lanes: Vec<(usize, Lane<P>)> = Vec::with_capacity(K);
+    while lanes.len() < K {
+        match feed.next_lane() {
+            Some(l) => lanes.push(l),
+            None => break,
+        }
+    }
+    while !lanes.is_empty() {
+        let mut j = 0;
+        while j < lanes.len() {
+            let adv = advance(points, topo, &mut lanes[j].1, cap);
+            if adv == Advance::Go || lane_event(&mut feed, &mut lanes, j, adv) {
+                j += 1;
+            }
+        }
+    }
+}
+
+/// The out-of-line part of [`trace_interleaved`]'s round: lane `j` stopped
+/// with `adv`; finish its step, and when its walk ended, store the outcome
+/// and refill or remove the lane. True when `lanes[j]` is (still) a live
+/// lane that already took its step this round.
+#[cold]
+#[inline(never)]
+fn lane_event<P: Projection>(
+    feed: &mut Feed<'_>,
+    lanes: &mut Vec<(usize, Lane<P>)>,
+    j: usize,
+    adv: Advance,
+) -> bool {
+    let (i, lane) = &mut lanes[j];
+    let i = *i;
+    let Some(o) = finish_step(feed.mesh, &feed.rays[i], lane, adv) else {
+        return true;
+    };
+    feed.out[i] = o;
+    match feed.next_lane() {
+        Some(l) => {
+            lanes[j] = l;
+            true
+        }
+        None => {
+            lanes.swap_remove(j);
+            false
+        }
+    }
+}
+
+/// [`begin`] for a ray from outside the mesh: its entry is decided with the
+/// projection the walk then uses (set up once).
+#[inline(always)]
+fn begin_outside<P: Projection>(
+    mesh: &TetMesh,
+    ray: &Ray,
+    entry: &BoundaryEntry,
+    hint: &mut EntryHint,
+) -> Result<Lane<P>, TraceOutcome> {
+    if !ray.is_valid() {
+        return Err(TraceOutcome::Failed {
+            failure: Failure::InvalidRay,
+            tets_visited: 0,
+        });
+    }
+    let proj = P::setup(ray);
+    let start = entry.start_projected(mesh, ray, &proj, hint)?;
+    begin_with(mesh, ray, proj, start)
+}

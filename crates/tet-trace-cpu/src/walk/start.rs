@@ -1,0 +1,297 @@
+//! Start-up of a walk: where it starts ([`Start`]), the start tet's exit
+//! face (the counter-clockwise face around the origin, with its fallbacks),
+//! or the entry face when the walk enters a tet through a constrained face
+//! or the mesh boundary; everything before the hot loop.
+
+use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
+
+use super::projection::Projection;
+use super::stop::{Resolved, resolve_constrained};
+use crate::locate::star;
+use crate::ray::{Failure, Ray, TraceOutcome};
+
+/// Where a walk starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Start {
+    /// In a tet containing the ray origin (closed: the origin may be on its
+    /// boundary); see [`crate::locate::locate`].
+    Tet(u32),
+    /// Just past constrained face `face`, inside tet `tet` (one of its two
+    /// sides); the origin lies on the face. Used by secondary rays: the face
+    /// itself is never reported again.
+    Face {
+        /// Index into [`TetMesh::constrained`].
+        face: u32,
+        /// The side to walk into.
+        tet: u32,
+    },
+    /// Entering the mesh from outside: the ray's origin lies outside the
+    /// mesh and its line enters `tet` through that tet's boundary face
+    /// `face` (0..=3, opposite vertex slot `face`, linked to
+    /// [`Link::BOUNDARY`]), ahead of the origin. Nothing lies outside the
+    /// mesh, so the walk starts there; see [`crate::entry`], which finds it
+    /// (and resolves a constrained face on the boundary itself).
+    Entry {
+        /// The tet entered.
+        tet: u32,
+        /// Its face on the mesh boundary (0..=3).
+        face: u8,
+    },
+}
+
+impl Start {
+    /// The constrained face the ray starts on ([`Start::Face`]), which a
+    /// tracer without tets must skip.
+    pub fn on_face(&self) -> Option<u32> {
+        match *self {
+            Start::Face { face, .. } => Some(face),
+            Start::Tet(_) | Start::Entry { .. } => None,
+        }
+    }
+}
+
+/// The walk state just after choosing an exit face.
+pub(crate) struct State<P: Projection> {
+    pub(crate) tet: u32,
+    pub(crate) ids: [u32; 3],
+    pub(crate) p: P::Face,
+    pub(crate) link: u32,
+    pub(crate) visited: u32,
+}
+
+/// Exit face of a tet containing the origin: the outward face whose
+/// projection winds counter-clockwise around the origin.
+fn start_in_tet<P: Projection>(mesh: &TetMesh, proj: &P, tet: u32) -> Option<State<P>> {
+    let v = mesh.tets[tet as usize];
+    let p = v.map(|i| proj.project(mesh.points[i as usize]));
+    let state = |k: usize| {
+        let [a, b, c] = FACE_VERTICES[k];
+        State {
+            tet,
+            ids: [v[a], v[b], v[c]],
+            p: P::face([p[a], p[b], p[c]]),
+            link: mesh.neighbors[tet as usize][k].0,
+            visited: 1,
+        }
+    };
+    for (k, s) in FACE_VERTICES.iter().enumerate() {
+        let [a, b, c] = *s;
+        if proj.left(p[a], v[a], p[b], v[b])
+            && proj.left(p[b], v[b], p[c], v[c])
+            && proj.left(p[c], v[c], p[a], v[a])
+        {
+            return Some(state(k));
+        }
+    }
+    None
+}
+
+/// Last resort when rounding left no tet around the origin with a
+/// counter-clockwise exit face: the face of `tet` whose smallest f64 edge
+/// function `d · (qa × qb)` is largest (the face the line leaves through, up
+/// to rounding).
+fn start_fallback<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) -> State<P> {
+    let v = mesh.tets[tet as usize];
+    let o = ray.origin.as_dvec3();
+    let d = ray.direction.as_dvec3();
+    let q = v.map(|i| mesh.points[i as usize].as_dvec3() - o);
+    let score = |k: usize| {
+        let [a, b, c] = FACE_VERTICES[k];
+        let e = |x: usize, y: usize| d.dot(q[x].cross(q[y]));
+        e(a, b).min(e(b, c)).min(e(c, a))
+    };
+    let k = (0..4)
+        .max_by(|&x, &y| score(x).total_cmp(&score(y)))
+        .unwrap_or(0);
+    let [a, b, c] = FACE_VERTICES[k];
+    let ids = [v[a], v[b], v[c]];
+    State {
+        tet,
+        ids,
+        p: P::face(ids.map(|i| proj.project(mesh.points[i as usize]))),
+        link: mesh.neighbors[tet as usize][k].0,
+        visited: 1,
+    }
+}
+
+/// The tet around the ray origin and the face through which the ray line
+/// leaves it (the `start_in_tet` search of [`trace`](crate::walk::trace), with its fallback to the
+/// other tets around an origin on a face, edge or vertex).
+pub fn start_exit_face<P: Projection>(mesh: &TetMesh, ray: &Ray, tet: u32) -> Option<(u32, usize)> {
+    let proj = P::setup(ray);
+    let found = |t: u32| {
+        start_in_tet(mesh, &proj, t).map(|s| {
+            let k = (0..4)
+                .find(|&k| {
+                    mesh.neighbors[t as usize][k].0 == s.link && {
+                        let f = mesh.face_vertices(t, k);
+                        f.contains(&s.ids[0]) && f.contains(&s.ids[1]) && f.contains(&s.ids[2])
+                    }
+                })
+                .unwrap_or(0);
+            (t, k)
+        })
+    };
+    found(tet)
+        .or_else(|| {
+            star(mesh, ray.origin, tet, 256)
+                .into_iter()
+                .skip(1)
+                .find_map(found)
+        })
+        .or_else(|| {
+            let s = start_fallback(mesh, &proj, ray, tet);
+            let k = (0..4).find(|&k| {
+                mesh.neighbors[tet as usize][k].0 == s.link && {
+                    let f = mesh.face_vertices(tet, k);
+                    s.ids.iter().all(|i| f.contains(i))
+                }
+            })?;
+            Some((tet, k))
+        })
+}
+
+/// One ray in flight: its projection, walk state, the tet it enters next
+/// and the raw link it enters through.
+pub(crate) struct Lane<P: Projection> {
+    pub(crate) proj: P,
+    pub(crate) st: State<P>,
+    pub(crate) next: u32,
+    pub(crate) entry_raw: u32,
+}
+
+/// Everything before the hot loop: ray checks, projection set-up, the start
+/// tet's exit face (or the restart on a constrained face) and its link.
+/// `Err` when the walk already ended (invalid ray, hit or miss in the start
+/// tet).
+pub(crate) fn begin<P: Projection>(
+    mesh: &TetMesh,
+    ray: &Ray,
+    start: Start,
+) -> Result<Lane<P>, TraceOutcome> {
+    if !ray.is_valid() {
+        return Err(TraceOutcome::Failed {
+            failure: Failure::InvalidRay,
+            tets_visited: 0,
+        });
+    }
+    begin_with(mesh, ray, P::setup(ray), start)
+}
+
+/// [`begin`] of a valid ray whose projection `proj` is set up.
+#[inline(always)]
+pub(crate) fn begin_with<P: Projection>(
+    mesh: &TetMesh,
+    ray: &Ray,
+    proj: P,
+    start: Start,
+) -> Result<Lane<P>, TraceOutcome> {
+    let st: State<P> = match start {
+        Start::Tet(t) => {
+            if t as usize >= mesh.tets.len() {
+                return Err(TraceOutcome::Failed {
+                    failure: Failure::Lost,
+                    tets_visited: 0,
+                });
+            }
+            match start_in_tet(mesh, &proj, t) {
+                Some(s) => s,
+                None => {
+                    // The origin is on the start tet's boundary and the ray
+                    // leaves it at once: try the other tets around the origin.
+                    let found = star(mesh, ray.origin, t, 256)
+                        .into_iter()
+                        .skip(1)
+                        .find_map(|c| start_in_tet(mesh, &proj, c));
+                    found.unwrap_or_else(|| start_fallback(mesh, &proj, ray, t))
+                }
+            }
+        }
+        Start::Face { .. } | Start::Entry { .. } => {
+            // Entering `tet` through face `k`: past a constrained face, or
+            // through the mesh boundary from outside.
+            let through = match start {
+                Start::Face { face, tet } => mesh
+                    .constrained
+                    .get(face as usize)
+                    .and_then(|cf| cf.side_of(tet))
+                    .map(|side| (tet, side.face as usize, Link::constrained(face))),
+                Start::Entry { tet, face } => {
+                    mesh.is_boundary_face(tet, face)
+                        .then_some((tet, face as usize, Link::BOUNDARY))
+                }
+                Start::Tet(_) => None,
+            };
+            return through
+                .map(|(tet, k, behind)| enter_through(mesh, proj, tet, k, behind))
+                .ok_or(TraceOutcome::Failed {
+                    failure: Failure::Lost,
+                    tets_visited: 0,
+                });
+        }
+    };
+    // Resolve the start tet's exit link.
+    let link = Link(st.link);
+    if let Some(n) = link.as_tet() {
+        let entry_raw = st.tet;
+        return Ok(Lane {
+            proj,
+            st,
+            next: n,
+            entry_raw,
+        });
+    }
+    match resolve_face(mesh, ray, &st, link) {
+        Resolved::Done(out) => Err(out),
+        Resolved::Cross(n) => {
+            let entry_raw = st.link;
+            Ok(Lane {
+                proj,
+                st,
+                next: n,
+                entry_raw,
+            })
+        }
+    }
+}
+
+/// A lane about to enter `tet` through its face `face` (slot index), whose
+/// raw link on the far side is `behind` (the constrained face crossed, or
+/// the boundary): the entry face in counter-clockwise (= inward) order.
+#[inline(always)]
+fn enter_through<P: Projection>(
+    mesh: &TetMesh,
+    proj: P,
+    tet: u32,
+    face: usize,
+    behind: Link,
+) -> Lane<P> {
+    let v = mesh.tets[tet as usize];
+    let [a, b, c] = FACE_VERTICES[face & 3];
+    let ids = [v[a], v[c], v[b]];
+    let st = State {
+        tet: NO_TET,
+        p: P::face(ids.map(|i| proj.project(mesh.points[i as usize]))),
+        ids,
+        link: behind.0,
+        visited: 0,
+    };
+    Lane {
+        proj,
+        st,
+        next: tet,
+        entry_raw: behind.0,
+    }
+}
+
+/// A non-tet link was reached: boundary (miss), or a constrained face (hit,
+/// miss beyond `t_max`, or crossing when before `t_min`).
+#[inline(never)]
+fn resolve_face<P: Projection>(mesh: &TetMesh, ray: &Ray, st: &State<P>, link: Link) -> Resolved {
+    match link.as_constrained() {
+        Some(c) => resolve_constrained(mesh, ray, c, st.ids, st.tet, st.visited),
+        None => Resolved::Done(TraceOutcome::Miss {
+            tets_visited: st.visited,
+        }),
+    }
+}
