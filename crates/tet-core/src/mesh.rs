@@ -354,11 +354,6 @@ impl TetMesh {
             attributes: Attributes::default(),
         })
     }
-
-    /// Checks every invariant; the error names the first offending element.
-    pub fn validate(&self) -> Result<(), MeshError> {
-        crate::validate::validate(self)
-    }
 }
 
 #[cfg(test)]

@@ -124,6 +124,11 @@ fn check_constrained_table(m: &TetMesh) -> Result<(), MeshError> {
 }
 
 impl TetMesh {
+    /// Checks every invariant; the error names the first offending element.
+    pub fn validate(&self) -> Result<(), MeshError> {
+        validate(self)
+    }
+
     /// Checks the array sizes: fewer tets and constrained faces than
     /// [`MAX_TETS`], point ids that fit a `u32`, one link row per tet.
     pub fn check_sizes(&self) -> Result<(), MeshError> {
