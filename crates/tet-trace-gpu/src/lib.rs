@@ -18,9 +18,10 @@
 //!
 //! ## The kernels: a port of the CPU walk (seed 000, Algorithms 1–7)
 //!
-//! `src/walk.wgsl` is a statement-by-statement port of
-//! `tet_trace_cpu::walk::step::advance` with the `DuffF32` projection (see that
-//! module's docs for the watertightness argument); each layout appends its
+//! `src/walk.wgsl` is a statement-by-statement port of the CPU walk's step
+//! (`advance` in `tet-trace-cpu/src/walk/step.rs`) with the `DuffF32`
+//! projection (see [`tet_trace_cpu::walk`] for the watertightness
+//! argument); each layout appends its
 //! `layout_vx` / `layout_exit` functions (ports of the CPU `Topology`
 //! implementations: Tet32 Algorithm 3 compares the exit vertex with the three
 //! stored ids, Tet20 Algorithm 5 indexes the rank-ordered links, Tet16

@@ -313,7 +313,7 @@ fn step<const RULE: u8>(v: &mut V8, g: &Geo<'_>, cap: u32) -> Option<Cold> {
     })
 }
 
-/// Prefetch the next tets' records (measured: see the module docs).
+/// Prefetch the next tets' records (see "Tuning" in [`crate::lockstep`]).
 const PREFETCH: bool = false;
 
 /// The scalar tie rule for the lanes with a zero determinant (`tie`).
@@ -384,5 +384,5 @@ pub(super) fn run_gather<const RULE: u8>(
     }
 }
 
-/// Packs of 8 lanes in flight per thread (measured: see the module docs).
+/// Packs of 8 lanes in flight per thread (see "Tuning" in [`crate::lockstep`]).
 const GROUPS: usize = 2;

@@ -402,5 +402,5 @@ pub(super) fn run_gather<const RULE: u8>(
     }
 }
 
-/// Packs of 16 lanes in flight per thread (1: 13 % slower, Torus Knots)
+/// Packs of 16 lanes in flight per thread (see "Tuning" in [`crate::lockstep`]).
 const GROUPS: usize = 2;
