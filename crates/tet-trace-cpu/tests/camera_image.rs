@@ -17,35 +17,10 @@ use tet_trace_cpu::walk::Topology;
 use tet_trace_cpu::{BatchWalk, Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint};
 
 mod common;
-use common::grid;
+use common::{bits, grid};
 
 const WIDTH: u32 = 64;
 const HEIGHT: u32 = 48;
-
-/// Every bit of an outcome (f32 fields as bits).
-fn bits(o: &TraceOutcome) -> (u8, [u32; 9]) {
-    match *o {
-        TraceOutcome::Hit(h) => (
-            0,
-            [
-                h.triangle,
-                h.face,
-                h.t.to_bits(),
-                h.barycentrics[0].to_bits(),
-                h.barycentrics[1].to_bits(),
-                h.barycentrics[2].to_bits(),
-                h.tet,
-                h.far_tet,
-                h.tets_visited,
-            ],
-        ),
-        TraceOutcome::Miss { tets_visited } => (1, [tets_visited, 0, 0, 0, 0, 0, 0, 0, 0]),
-        TraceOutcome::Failed {
-            failure,
-            tets_visited,
-        } => (2, [tets_visited, failure as u32, 0, 0, 0, 0, 0, 0, 0]),
-    }
-}
 
 /// The primary rays of a `WIDTH × HEIGHT` image, row by row.
 fn image_rays(camera: &Camera) -> Vec<Ray> {

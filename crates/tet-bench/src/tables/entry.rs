@@ -6,10 +6,11 @@ use std::fmt::Write as _;
 use anyhow::Result;
 use tet_trace_cpu::render::RenderOptions;
 
-use super::doc::{TABLE_FLAGS, TablesDoc};
+use super::doc::TablesDoc;
 use super::plan::{MeshCache, Planned};
+use super::variant::tet20_on_variant;
 use crate::cli::{BuildFlags, Method};
-use crate::timing::{RenderDoc, time_method};
+use crate::timing::RenderDoc;
 
 /// tet20 on the scene built with `--wide-box` (the camera inside the mesh).
 pub fn measure(
@@ -19,13 +20,17 @@ pub fn measure(
     frames: u32,
     pool: &rayon::ThreadPool,
 ) -> Result<RenderDoc> {
-    eprintln!("  {}: wide-box mesh (camera inside)", planned.spec);
-    let flags = BuildFlags {
+    let variant = |flags| BuildFlags {
         wide_box: true,
-        ..TABLE_FLAGS
+        ..flags
     };
-    let wide = cache.load(planned, &flags, false)?.0;
-    Ok(time_method(&wide, Method::Tet20, opts, frames, pool)?.0)
+    tet20_on_variant(
+        planned,
+        cache,
+        variant,
+        "wide-box mesh (camera inside)",
+        (opts, frames, pool),
+    )
 }
 
 /// The table.

@@ -46,6 +46,7 @@ mod report;
 mod robustness;
 mod sorting;
 mod speed_accuracy;
+mod variant;
 mod zoom;
 
 use std::time::Instant;

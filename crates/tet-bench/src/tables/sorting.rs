@@ -6,10 +6,11 @@ use std::fmt::Write as _;
 use anyhow::Result;
 use tet_trace_cpu::render::RenderOptions;
 
-use super::doc::{TABLE_FLAGS, TablesDoc};
+use super::doc::TablesDoc;
 use super::plan::{MeshCache, Planned};
+use super::variant::tet20_on_variant;
 use crate::cli::{BuildFlags, Method};
-use crate::timing::{RenderDoc, time_method};
+use crate::timing::RenderDoc;
 
 /// tet20 on the scene built without Hilbert sorting.
 pub fn measure(
@@ -19,13 +20,17 @@ pub fn measure(
     frames: u32,
     pool: &rayon::ThreadPool,
 ) -> Result<RenderDoc> {
-    eprintln!("  {}: unsorted mesh for Figure 8", planned.spec);
-    let flags = BuildFlags {
+    let variant = |flags| BuildFlags {
         no_sort: true,
-        ..TABLE_FLAGS
+        ..flags
     };
-    let unsorted = cache.load(planned, &flags, false)?.0;
-    Ok(time_method(&unsorted, Method::Tet20, opts, frames, pool)?.0)
+    tet20_on_variant(
+        planned,
+        cache,
+        variant,
+        "unsorted mesh for Figure 8",
+        (opts, frames, pool),
+    )
 }
 
 /// The table.

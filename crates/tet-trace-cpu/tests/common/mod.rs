@@ -72,3 +72,28 @@ pub fn assert_outcomes_match(
         }
     }
 }
+
+/// Every bit of an outcome (f32 fields as bits, so `-0.0 ≠ 0.0`).
+pub fn bits(o: &TraceOutcome) -> (u8, [u32; 9]) {
+    match *o {
+        TraceOutcome::Hit(h) => (
+            0,
+            [
+                h.triangle,
+                h.face,
+                h.t.to_bits(),
+                h.barycentrics[0].to_bits(),
+                h.barycentrics[1].to_bits(),
+                h.barycentrics[2].to_bits(),
+                h.tet,
+                h.far_tet,
+                h.tets_visited,
+            ],
+        ),
+        TraceOutcome::Miss { tets_visited } => (1, [tets_visited, 0, 0, 0, 0, 0, 0, 0, 0]),
+        TraceOutcome::Failed {
+            failure,
+            tets_visited,
+        } => (2, [tets_visited, failure as u32, 0, 0, 0, 0, 0, 0, 0]),
+    }
+}
