@@ -96,7 +96,7 @@ pub enum FormatError {
         /// What is wrong.
         detail: String,
     },
-    /// A [`StreamWriter`] was asked to write a section out of table order,
+    /// A [`StreamWriter`](super::StreamWriter) was asked to write a section out of table order,
     /// or one the file does not have.
     #[error("{path}: cannot write section {section}: {detail}", path = .path.display())]
     SectionOrder {
@@ -107,7 +107,7 @@ pub enum FormatError {
         /// Why not.
         detail: String,
     },
-    /// A [`SectionReader`] was asked for elements the section does not
+    /// A [`SectionReader`](super::SectionReader) was asked for elements the section does not
     /// have (or for a section the file does not have: `count` 0).
     #[error("{path}: elements {start}..{end} of section {section} requested, it has {count}", path = .path.display())]
     SectionRange {

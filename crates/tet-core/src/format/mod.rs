@@ -1,4 +1,4 @@
-//! On-disk format of a built [`TetMesh`] (every compact layout is derived
+//! On-disk format of a built [`TetMesh`](crate::TetMesh) (every compact layout is derived
 //! from it at load time).
 //!
 //! # Layout, byte by byte (version 1)
@@ -13,7 +13,7 @@
 //! | 8   | 4 | `version`           | `1` ([`VERSION`]) |
 //! | 12  | 4 | `flags`             | bit 0: normals present, bit 1: uvs, bit 2: materials, bit 3: scene block; other bits 0 |
 //! | 16  | 8 | `file_length`       | total file size in bytes, header included |
-//! | 24  | 4 | `triangle_count`    | [`TetMesh::triangle_count`] |
+//! | 24  | 4 | `triangle_count`    | [`TetMesh::triangle_count`](crate::TetMesh::triangle_count) |
 //! | 28  | 4 | `reserved`          | 0 |
 //! | 32  | 8 | `point_count`       | number of points (≤ 2³²−1) |
 //! | 40  | 8 | `tet_count`         | number of tets (< 2³¹−1) |
@@ -34,7 +34,7 @@
 //! | uvs         | `[f32; 2]`                                           | 8  | `point_count` (if flag bit 1) |
 //! | materials   | `u32`                                                | 4  | `triangle_count` (if flag bit 2) |
 //!
-//! The **scene block** (flag bit 3; see [`SceneInfo`]) has no table entry:
+//! The **scene block** (flag bit 3; see [`SceneInfo`](crate::scene::SceneInfo)) has no table entry:
 //! it starts at the first 8-byte boundary after the last present section and
 //! runs to `file_length`, as 48-byte records of twelve 4-byte words — word 0
 //! the kind, words 1–11 `f32`s, unused words 0:
@@ -67,7 +67,7 @@
 //! `memcpy` per section, no intermediate buffer, no per-element parsing —
 //! a little-endian host needs no conversion; a big-endian one swaps each
 //! 4-byte word in place), the payload CRC compared, and
-//! [`TetMesh::validate`] run. Errors are [`FormatError`]s naming the file and
+//! [`TetMesh::validate`](crate::TetMesh::validate) run. Errors are [`FormatError`]s naming the file and
 //! the field or section at fault.
 //!
 //! [`save`] writes to a temporary file in the target's directory, syncs it
@@ -90,7 +90,7 @@
 //!   without reading the rest; [`SectionReader::verify_payload`] checks the
 //!   payload CRC in one streaming pass of bounded memory. Element *values*
 //!   (vertex ids, links) are not checked: a caller indexing with them checks
-//!   them ([`load`] runs [`TetMesh::validate`] on the whole mesh instead).
+//!   them ([`load`] runs [`TetMesh::validate`](crate::TetMesh::validate) on the whole mesh instead).
 
 //!
 //! # Modules
