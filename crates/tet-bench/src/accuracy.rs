@@ -9,7 +9,10 @@
 //! A ray that **leaks** slipped through a closed surface: the reference hit
 //! lies within `tol` of an edge of its triangle, every edge it lies that
 //! close to is shared by at least two constrained faces (and every vertex
-//! it lies that close to has only such edges around it), and the method
+//! it lies that close to has only such edges around it), the ray crosses
+//! the surface there rather than touching its outline (moved sideways by
+//! `2·tol` in any of eight directions it still passes through a face around
+//! the hit triangle's vertices), and the method
 //! misses or hits something more than `2·tol` farther along than the
 //! reference hit. Leaks are failures, the worst a renderer can make: light
 //! passes through a watertight surface.
@@ -65,8 +68,9 @@ struct RefHit {
     /// The hit point lies within `tol` of an edge of its face.
     near_edge: bool,
     /// Every edge and vertex of the face that the hit point lies within
-    /// `tol` of is closed (see [`EdgeSharing`]): the ray crosses a
-    /// watertight part of the surface. Meaningful with `near_edge`.
+    /// `tol` of is closed (see [`EdgeSharing`]), and the ray crosses the
+    /// surface there ([`Reference::crosses`]): a watertight part of the
+    /// surface is crossed. Meaningful with `near_edge`.
     closed: bool,
     /// Another face is hit within `tol` along the ray.
     second_close: bool,
@@ -106,6 +110,8 @@ struct EdgeSharing {
     faces: HashMap<(u32, u32), u32>,
     /// Vertices with an open edge.
     open_vertices: std::collections::HashSet<u32>,
+    /// Faces around each vertex.
+    vertex_faces: HashMap<u32, Vec<u32>>,
 }
 
 /// The edge `a`–`b` as a key of [`EdgeSharing::faces`].
@@ -117,10 +123,12 @@ impl EdgeSharing {
     /// Counts the faces around every edge of `mesh.constrained`.
     fn new(mesh: &TetMesh) -> Self {
         let mut faces: HashMap<(u32, u32), u32> = HashMap::new();
-        for cf in &mesh.constrained {
+        let mut vertex_faces: HashMap<u32, Vec<u32>> = HashMap::new();
+        for (f, cf) in mesh.constrained.iter().enumerate() {
             let v = cf.vertices;
             for k in 0..3 {
                 *faces.entry(edge_key(v[k], v[(k + 1) % 3])).or_default() += 1;
+                vertex_faces.entry(v[k]).or_default().push(f as u32);
             }
         }
         let open_vertices = faces
@@ -131,6 +139,7 @@ impl EdgeSharing {
         EdgeSharing {
             faces,
             open_vertices,
+            vertex_faces,
         }
     }
 
@@ -156,6 +165,20 @@ impl EdgeSharing {
             edge_ok && vertex_ok
         })
     }
+}
+
+/// True when the line `o + s·d` passes through triangle `v` (closed), in
+/// f64 (the test of `tet_trace_cpu::reference::ray_triangle`).
+fn line_hits(o: DVec3, d: DVec3, v: [DVec3; 3]) -> bool {
+    let q = v.map(|p| p - o);
+    let w = [
+        d.dot(q[1].cross(q[2])),
+        d.dot(q[2].cross(q[0])),
+        d.dot(q[0].cross(q[1])),
+    ];
+    let inside =
+        (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0) || (w[0] <= 0.0 && w[1] <= 0.0 && w[2] <= 0.0);
+    inside && w[0] + w[1] + w[2] != 0.0
 }
 
 /// Distance from `p` to segment `ab` (as `tet_trace_cpu::reference::edge_distance`
@@ -268,9 +291,36 @@ impl<'m> Reference<'m> {
             t,
             tol_t,
             near_edge,
-            closed: near_edge && self.sharing.grazed_closed(cf.vertices, v, p, self.tol),
+            closed: near_edge
+                && self.sharing.grazed_closed(cf.vertices, v, p, self.tol)
+                && self.crosses(ray, cf.vertices),
             second_close: second - t < tol_t,
             near_origin: t < tol_t,
+        })
+    }
+
+    /// True when the ray crosses the surface around face `vertices` rather
+    /// than touching it: the ray moved sideways by `2·tol` in each of eight
+    /// directions still passes through a face around one of those vertices.
+    /// A ray that grazes the outline of a closed surface (both faces of the
+    /// edge on one side of it) fails this, and stays grazing.
+    fn crosses(&self, ray: &Ray, vertices: [u32; 3]) -> bool {
+        let o = ray.origin.as_dvec3();
+        let d = ray.direction.as_dvec3();
+        let (u, w) = d.normalize().any_orthonormal_pair();
+        let ring: Vec<[DVec3; 3]> = vertices
+            .iter()
+            .flat_map(|v| self.sharing.vertex_faces.get(v).into_iter().flatten())
+            .map(|&f| {
+                self.mesh.constrained[f as usize]
+                    .vertices
+                    .map(|k| self.mesh.points[k as usize].as_dvec3())
+            })
+            .collect();
+        (0..8).all(|k| {
+            let a = k as f64 * std::f64::consts::FRAC_PI_4;
+            let shifted = o + (u * a.cos() + w * a.sin()) * (2.0 * self.tol);
+            ring.iter().any(|&v| line_hits(shifted, d, v))
         })
     }
 
@@ -773,6 +823,45 @@ mod tests {
                 assert_eq!((m.leaks, m.ambiguous, m.failures), (0, n, 0), "{m:?}");
             }
         }
+    }
+
+    #[test]
+    fn a_miss_along_the_outline_of_a_closed_surface_is_grazing() {
+        // Rays from outside that touch an edge and a corner of the box and
+        // go on outside it: both faces of the edge lie on one side of them.
+        let mesh = closed_box();
+        let reference = Reference::new(&mesh);
+        let edge = Vec3::new(1.0, 1.0, 2.5);
+        let corner = Vec3::new(1.0, 1.0, 1.0);
+        let set = RaySet {
+            rays: vec![
+                (
+                    Ray::new(Vec3::new(0.0, 1.5, 2.5), edge - Vec3::new(0.0, 1.5, 2.5)),
+                    Some(Start::Tet(0)),
+                ),
+                (
+                    Ray::new(Vec3::new(0.0, 2.0, 2.0), corner - Vec3::new(0.0, 2.0, 2.0)),
+                    Some(Start::Tet(0)),
+                ),
+            ],
+            view: None,
+        };
+        let exp = expected(&reference, &set);
+        assert!(
+            exp.iter().all(|e| e.is_some_and(|e| e.near_edge)),
+            "{exp:?}"
+        );
+        let m = check(&AlwaysMiss(&mesh), "f32", &reference, &exp, &set);
+        assert_eq!((m.leaks, m.ambiguous, m.failures), (0, 2, 0), "{m:?}");
+        // The same points entered across the edge and the corner leak.
+        let set = aimed(Vec3::new(0.0, 0.5, 2.5), &[edge]);
+        let set = RaySet {
+            rays: [set.rays, aimed(Vec3::new(0.0, 0.2, 0.1), &[corner]).rays].concat(),
+            view: None,
+        };
+        let exp = expected(&reference, &set);
+        let m = check(&AlwaysMiss(&mesh), "f32", &reference, &exp, &set);
+        assert_eq!((m.leaks, m.ambiguous, m.failures), (2, 0, 2), "{m:?}");
     }
 
     #[test]
