@@ -11,10 +11,9 @@
 //! close to is shared by at least two constrained faces (and every vertex
 //! it lies that close to has only such edges around it), the ray crosses
 //! the surface there rather than touching its outline (moved sideways by
-//! `2·tol` in any of eight directions it still passes through a face around
-//! the hit triangle's vertices), and the method
-//! misses or hits something more than `2·tol` farther along than the
-//! reference hit. Leaks are failures, the worst a renderer can make: light
+//! `2·tol` in each of eight directions it still passes through a face
+//! around the hit triangle's vertices), and the method misses or hits
+//! something more than `2·tol` farther along than the reference hit. Leaks are failures, the worst a renderer can make: light
 //! passes through a watertight surface.
 //!
 //! Otherwise a ray counts as **ambiguous** (grazing), not wrong, when the
