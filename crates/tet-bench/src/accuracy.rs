@@ -6,14 +6,26 @@
 //! come from a BVH over triangle boxes padded by the tolerance (so the f32
 //! box test cannot drop a triangle the ray passes within tolerance of).
 //!
-//! A ray counts as **ambiguous** (grazing), not wrong, when the reference hit
-//! point lies within `tol` of an edge of its triangle, a second triangle is
-//! hit within `tol` along the ray, the hit lies within `tol` of the ray
-//! origin, or the method's own hit point lies within
+//! A ray that **leaks** slipped through a closed surface: the reference hit
+//! lies within `tol` of an edge of its triangle, every edge it lies that
+//! close to is shared by at least two constrained faces (and every vertex
+//! it lies that close to has only such edges around it), the ray crosses
+//! the surface there rather than touching its outline (moved sideways by
+//! `2·tol` in each of eight directions it still passes through a face
+//! around the hit triangle's vertices), and the method misses or hits
+//! something more than `2·tol` farther along than the reference hit. Leaks are failures, the worst a renderer can make: light
+//! passes through a watertight surface.
+//!
+//! Otherwise a ray counts as **ambiguous** (grazing), not wrong, when the
+//! reference hit point lies within `tol` of an edge of its triangle, a
+//! second triangle is hit within `tol` along the ray, the hit lies within
+//! `tol` of the ray origin, or the method's own hit point lies within
 //! `tol` of an edge of the triangle it reports; `tol = max(1e-5 · diagonal, 4e-7 · max |coordinate|)`
 //! (the second term is a few f32 ulps of the coordinates, which dominates
-//! for scenes far from the origin).
+//! for scenes far from the origin). A reference hit within `tol` of the ray
+//! origin is never a leak: the method may rightly place it behind the origin.
 
+use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
@@ -30,7 +42,7 @@ use tet_core::TetMesh;
 use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::Viewpoint;
 use tet_trace_cpu::kernel::Tracer;
-use tet_trace_cpu::ray::{Failure, Ray, TraceOutcome};
+use tet_trace_cpu::ray::{Failure, Hit, Ray, TraceOutcome};
 use tet_trace_cpu::reference::{Aim, edge_distance, random_ray, ray_triangle};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Start;
@@ -48,8 +60,137 @@ struct RefHit {
     face: u32,
     /// Its scene triangle.
     triangle: u32,
-    /// Closest hit point within `tol` of an edge, or another hit within `tol`.
-    ambiguous: bool,
+    /// Ray parameter of the hit.
+    t: f64,
+    /// The tolerance in units of the ray parameter (`tol / |direction|`).
+    tol_t: f64,
+    /// The hit point lies within `tol` of an edge of its face.
+    near_edge: bool,
+    /// Every edge and vertex of the face that the hit point lies within
+    /// `tol` of is closed (see [`EdgeSharing`]), and the ray crosses the
+    /// surface there ([`Reference::crosses`]): a watertight part of the
+    /// surface is crossed. Meaningful with `near_edge`.
+    closed: bool,
+    /// Another face is hit within `tol` along the ray.
+    second_close: bool,
+    /// The hit lies within `tol` of the ray origin.
+    near_origin: bool,
+}
+
+impl RefHit {
+    /// Grazing by the reference alone: near an edge, a second hit within
+    /// `tol`, or near the ray origin.
+    fn ambiguous(&self) -> bool {
+        self.near_edge || self.second_close || self.near_origin
+    }
+
+    /// True when `outcome` slipped through the closed surface this hit
+    /// grazes: it misses, or hits more than `2·tol` farther along (beyond
+    /// the window in which the reference looked for a second hit).
+    fn leaked_by(&self, outcome: &TraceOutcome) -> bool {
+        if !(self.near_edge && self.closed) || self.near_origin {
+            return false;
+        }
+        match outcome {
+            TraceOutcome::Miss { .. } => true,
+            TraceOutcome::Hit(h) => h.t as f64 > self.t + 2.0 * self.tol_t,
+            TraceOutcome::Failed { .. } => false,
+        }
+    }
+}
+
+/// Which edges of the constrained faces are closed: shared by at least two
+/// faces (two scene triangles meeting there, or one triangle split by the
+/// tetrahedralization), so that a ray crossing there must hit one of them.
+/// An edge of a single face is open (the boundary of an open surface).
+#[derive(Clone, Debug, Default)]
+struct EdgeSharing {
+    /// Faces per edge, the edge as its sorted vertex pair.
+    faces: HashMap<(u32, u32), u32>,
+    /// Vertices with an open edge.
+    open_vertices: std::collections::HashSet<u32>,
+    /// Faces around each vertex.
+    vertex_faces: HashMap<u32, Vec<u32>>,
+}
+
+/// The edge `a`–`b` as a key of [`EdgeSharing::faces`].
+fn edge_key(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+impl EdgeSharing {
+    /// Counts the faces around every edge of `mesh.constrained`.
+    fn new(mesh: &TetMesh) -> Self {
+        let mut faces: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut vertex_faces: HashMap<u32, Vec<u32>> = HashMap::new();
+        for (f, cf) in mesh.constrained.iter().enumerate() {
+            let v = cf.vertices;
+            for k in 0..3 {
+                *faces.entry(edge_key(v[k], v[(k + 1) % 3])).or_default() += 1;
+                vertex_faces.entry(v[k]).or_default().push(f as u32);
+            }
+        }
+        let open_vertices = faces
+            .iter()
+            .filter(|(_, n)| **n < 2)
+            .flat_map(|(e, _)| [e.0, e.1])
+            .collect();
+        EdgeSharing {
+            faces,
+            open_vertices,
+            vertex_faces,
+        }
+    }
+
+    /// True when edge `a`–`b` is shared by at least two faces.
+    fn edge_closed(&self, a: u32, b: u32) -> bool {
+        self.faces.get(&edge_key(a, b)).is_some_and(|n| *n >= 2)
+    }
+
+    /// True when every edge at vertex `v` is closed.
+    fn vertex_closed(&self, v: u32) -> bool {
+        !self.open_vertices.contains(&v)
+    }
+
+    /// True when every edge of face `vertices` (positions `p`) that point
+    /// `x` lies within `tol` of is closed, and so is every vertex within
+    /// `tol` of `x`.
+    fn grazed_closed(&self, vertices: [u32; 3], p: [DVec3; 3], x: DVec3, tol: f64) -> bool {
+        (0..3).all(|k| {
+            let j = (k + 1) % 3;
+            let edge_ok = segment_distance(x, p[k], p[j]) >= tol
+                || self.edge_closed(vertices[k], vertices[j]);
+            let vertex_ok = (x - p[k]).length() >= tol || self.vertex_closed(vertices[k]);
+            edge_ok && vertex_ok
+        })
+    }
+}
+
+/// True when the line `o + s·d` passes through triangle `v` (closed), in
+/// f64 (the test of `tet_trace_cpu::reference::ray_triangle`).
+fn line_hits(o: DVec3, d: DVec3, v: [DVec3; 3]) -> bool {
+    let q = v.map(|p| p - o);
+    let w = [
+        d.dot(q[1].cross(q[2])),
+        d.dot(q[2].cross(q[0])),
+        d.dot(q[0].cross(q[1])),
+    ];
+    let inside =
+        (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0) || (w[0] <= 0.0 && w[1] <= 0.0 && w[2] <= 0.0);
+    inside && w[0] + w[1] + w[2] != 0.0
+}
+
+/// Distance from `p` to segment `ab` (as `tet_trace_cpu::reference::edge_distance`
+/// measures each edge).
+fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let l = ab.length_squared();
+    let s = if l > 0.0 {
+        ((p - a).dot(ab) / l).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + ab * s - p).length()
 }
 
 /// f64 reference over a padded-box BVH.
@@ -58,6 +199,8 @@ pub struct Reference<'m> {
     mesh: &'m TetMesh,
     /// BVH over the faces' boxes, padded by the tolerance.
     bvh: Bvh2,
+    /// Which face edges are closed.
+    sharing: EdgeSharing,
     /// Grazing tolerance (world units).
     pub tol: f64,
 }
@@ -96,7 +239,12 @@ impl<'m> Reference<'m> {
             BvhBuildParams::medium_build(),
             &mut Duration::default(),
         );
-        Reference { mesh, bvh, tol }
+        Reference {
+            mesh,
+            bvh,
+            sharing: EdgeSharing::new(mesh),
+            tol,
+        }
     }
 
     /// The reference hit of `ray`: its closest constrained face in f64, or
@@ -135,11 +283,43 @@ impl<'m> Reference<'m> {
         let cf = &mesh.constrained[face as usize];
         let v = cf.vertices.map(|k| mesh.points[k as usize].as_dvec3());
         let p = ray.origin.as_dvec3() + ray.direction.as_dvec3() * t;
-        let edge = edge_distance(p, v);
+        let near_edge = edge_distance(p, v) < self.tol;
         Some(RefHit {
             face,
             triangle: cf.triangle,
-            ambiguous: edge < self.tol || second - t < tol_t || t < tol_t,
+            t,
+            tol_t,
+            near_edge,
+            closed: near_edge
+                && self.sharing.grazed_closed(cf.vertices, v, p, self.tol)
+                && self.crosses(ray, cf.vertices),
+            second_close: second - t < tol_t,
+            near_origin: t < tol_t,
+        })
+    }
+
+    /// True when the ray crosses the surface around face `vertices` rather
+    /// than touching it: the ray moved sideways by `2·tol` in each of eight
+    /// directions still passes through a face around one of those vertices.
+    /// A ray that grazes the outline of a closed surface (both faces of the
+    /// edge on one side of it) fails this, and stays grazing.
+    fn crosses(&self, ray: &Ray, vertices: [u32; 3]) -> bool {
+        let o = ray.origin.as_dvec3();
+        let d = ray.direction.as_dvec3();
+        let (u, w) = d.normalize().any_orthonormal_pair();
+        let ring: Vec<[DVec3; 3]> = vertices
+            .iter()
+            .flat_map(|v| self.sharing.vertex_faces.get(v).into_iter().flatten())
+            .map(|&f| {
+                self.mesh.constrained[f as usize]
+                    .vertices
+                    .map(|k| self.mesh.points[k as usize].as_dvec3())
+            })
+            .collect();
+        (0..8).all(|k| {
+            let a = k as f64 * std::f64::consts::FRAC_PI_4;
+            let shifted = o + (u * a.cos() + w * a.sin()) * (2.0 * self.tol);
+            ring.iter().any(|&v| line_hits(shifted, d, v))
         })
     }
 
@@ -162,8 +342,12 @@ pub struct MethodAccuracy {
     pub rays: u64,
     /// Same first triangle as the reference (or both miss).
     pub agree: u64,
-    /// Grazing rays (see tolerance) whose result differs: not counted as failures.
+    /// Grazing rays (see tolerance) whose result differs: not counted as
+    /// failures. Never a leak.
     pub ambiguous: u64,
+    /// Missed, or hit farther along, where the reference hit grazes only
+    /// closed edges (the ray slipped through a watertight surface).
+    pub leaks: u64,
     /// Hit a different triangle than the reference, beyond the tolerance.
     pub wrong_triangle: u64,
     /// Missed where the reference hits, beyond the tolerance.
@@ -178,7 +362,7 @@ pub struct MethodAccuracy {
     pub invalid: u64,
     /// Hits with a NaN parameter or barycentric.
     pub nans: u64,
-    /// wrong_triangle + false_misses + false_hits + step_cap + lost + invalid + nans.
+    /// leaks + wrong_triangle + false_misses + false_hits + step_cap + lost + invalid + nans.
     pub failures: u64,
     /// Failures per 1024² rays (the unit of Maria et al. Table 4).
     pub failures_per_1024_squared: f64,
@@ -284,41 +468,101 @@ fn check(
         ..Default::default()
     };
     for (((ray, _), o), e) in set.rays.iter().zip(&outcomes).zip(expected) {
-        match (o, e) {
-            (TraceOutcome::Failed { failure, .. }, _) => match failure {
-                Failure::StepCap => m.step_cap += 1,
-                Failure::Lost => m.lost += 1,
-                Failure::InvalidRay => m.invalid += 1,
-            },
-            (TraceOutcome::Hit(h), _)
-                if h.t.is_nan() || h.barycentrics.iter().any(|b| b.is_nan()) =>
-            {
-                m.nans += 1
-            }
-            (TraceOutcome::Hit(h), Some(r)) if h.triangle == r.triangle || h.face == r.face => {
-                m.agree += 1
-            }
-            (TraceOutcome::Miss { .. }, None) => m.agree += 1,
-            (_, Some(r)) if r.ambiguous => m.ambiguous += 1,
-            // The method's own hit grazes an edge of its triangle: the
-            // reference may rightly have passed just outside that triangle.
-            (TraceOutcome::Hit(h), _)
-                if reference.near_edge(
-                    h.face,
-                    ray.origin.as_dvec3() + ray.direction.as_dvec3() * h.t as f64,
-                ) =>
-            {
-                m.ambiguous += 1
-            }
-            (TraceOutcome::Hit(_), None) => m.false_hits += 1,
-            (TraceOutcome::Hit(_), Some(_)) => m.wrong_triangle += 1,
-            (TraceOutcome::Miss { .. }, Some(_)) => m.false_misses += 1,
-        }
+        // The method's own hit grazes an edge of its triangle: the
+        // reference may rightly have passed just outside that triangle.
+        let own_hit_grazes = |h: &Hit| {
+            reference.near_edge(
+                h.face,
+                ray.origin.as_dvec3() + ray.direction.as_dvec3() * h.t as f64,
+            )
+        };
+        m.count(classify(o, e.as_ref(), own_hit_grazes));
     }
-    m.failures =
-        m.wrong_triangle + m.false_misses + m.false_hits + m.step_cap + m.lost + m.invalid + m.nans;
+    m.failures = m.leaks
+        + m.wrong_triangle
+        + m.false_misses
+        + m.false_hits
+        + m.step_cap
+        + m.lost
+        + m.invalid
+        + m.nans;
     m.failures_per_1024_squared = m.failures as f64 * (1024.0 * 1024.0) / m.rays.max(1) as f64;
     m
+}
+
+/// How one method's result on one ray compares with the reference.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Verdict {
+    /// Same first triangle (or both miss).
+    Agree,
+    /// Different, but the ray grazes (not a failure).
+    Ambiguous,
+    /// Slipped through a closed surface the reference hit grazes.
+    Leak,
+    /// Another triangle, beyond the tolerance.
+    WrongTriangle,
+    /// Missed a hit the reference finds away from any edge.
+    FalseMiss,
+    /// Hit where the reference misses.
+    FalseHit,
+    /// The walk stopped at the step cap.
+    StepCap,
+    /// The walk lost its way.
+    Lost,
+    /// The ray was rejected.
+    Invalid,
+    /// A NaN parameter or barycentric.
+    Nan,
+}
+
+/// Judges one ray: `outcome` of the method, `expected` the reference hit,
+/// `own_hit_grazes` whether a hit of the method lies within the tolerance
+/// of an edge of the face it reports. A leak is decided before any
+/// grazing excuse, so a miss across a closed edge is never ambiguous.
+fn classify(
+    outcome: &TraceOutcome,
+    expected: Option<&RefHit>,
+    own_hit_grazes: impl FnOnce(&Hit) -> bool,
+) -> Verdict {
+    match (outcome, expected) {
+        (TraceOutcome::Failed { failure, .. }, _) => match failure {
+            Failure::StepCap => Verdict::StepCap,
+            Failure::Lost => Verdict::Lost,
+            Failure::InvalidRay => Verdict::Invalid,
+        },
+        (TraceOutcome::Hit(h), _) if h.t.is_nan() || h.barycentrics.iter().any(|b| b.is_nan()) => {
+            Verdict::Nan
+        }
+        (TraceOutcome::Hit(h), Some(r)) if h.triangle == r.triangle || h.face == r.face => {
+            Verdict::Agree
+        }
+        (TraceOutcome::Miss { .. }, None) => Verdict::Agree,
+        (o, Some(r)) if r.leaked_by(o) => Verdict::Leak,
+        (_, Some(r)) if r.ambiguous() => Verdict::Ambiguous,
+        (TraceOutcome::Hit(h), _) if own_hit_grazes(h) => Verdict::Ambiguous,
+        (TraceOutcome::Hit(_), None) => Verdict::FalseHit,
+        (TraceOutcome::Hit(_), Some(_)) => Verdict::WrongTriangle,
+        (TraceOutcome::Miss { .. }, Some(_)) => Verdict::FalseMiss,
+    }
+}
+
+impl MethodAccuracy {
+    /// Adds one ray's verdict to its counter.
+    fn count(&mut self, v: Verdict) {
+        let c = match v {
+            Verdict::Agree => &mut self.agree,
+            Verdict::Ambiguous => &mut self.ambiguous,
+            Verdict::Leak => &mut self.leaks,
+            Verdict::WrongTriangle => &mut self.wrong_triangle,
+            Verdict::FalseMiss => &mut self.false_misses,
+            Verdict::FalseHit => &mut self.false_hits,
+            Verdict::StepCap => &mut self.step_cap,
+            Verdict::Lost => &mut self.lost,
+            Verdict::Invalid => &mut self.invalid,
+            Verdict::Nan => &mut self.nans,
+        };
+        *c += 1;
+    }
 }
 
 /// Runs every method on one mesh.
@@ -357,7 +601,7 @@ pub fn run_case(
         rays: set.rays.len(),
         reference_ambiguous: expected
             .iter()
-            .filter(|e| e.is_some_and(|e| e.ambiguous))
+            .filter(|e| e.is_some_and(|e| e.ambiguous()))
             .count(),
         methods: out,
         skipped: None,
@@ -398,4 +642,243 @@ pub fn all_cases(
         }
     }
     Ok(cases)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tet_core::synthetic::{GridSpec, constrain_faces, kuhn_grid};
+
+    /// A method that never hits anything.
+    struct AlwaysMiss<'m>(&'m TetMesh);
+
+    impl Tracer for AlwaysMiss<'_> {
+        fn name(&self) -> String {
+            "always-miss".into()
+        }
+        fn mesh(&self) -> &TetMesh {
+            self.0
+        }
+        fn trace(&self, _: &Ray, _: Start) -> TraceOutcome {
+            TraceOutcome::Miss { tets_visited: 0 }
+        }
+    }
+
+    /// A method that reports the farthest constrained face along the ray
+    /// (brute force): it passes through every surface but the last.
+    struct Farthest<'m>(&'m TetMesh);
+
+    impl Tracer for Farthest<'_> {
+        fn name(&self) -> String {
+            "farthest".into()
+        }
+        fn mesh(&self) -> &TetMesh {
+            self.0
+        }
+        fn trace(&self, ray: &Ray, _: Start) -> TraceOutcome {
+            let m = self.0;
+            let far = (0..m.constrained.len() as u32)
+                .filter_map(|f| {
+                    let cf = &m.constrained[f as usize];
+                    let (t, b) = ray_triangle(ray, cf.vertices.map(|k| m.points[k as usize]))?;
+                    (t >= 0.0).then_some((t, b, f))
+                })
+                .max_by(|a, b| a.0.total_cmp(&b.0));
+            match far {
+                Some((t, b, f)) => TraceOutcome::Hit(Hit {
+                    triangle: m.constrained[f as usize].triangle,
+                    face: f,
+                    t: t as f32,
+                    barycentrics: b.map(|x| x as f32),
+                    tet: 0,
+                    far_tet: tet_core::NO_TET,
+                    tets_visited: 0,
+                }),
+                None => TraceOutcome::Miss { tets_visited: 0 },
+            }
+        }
+    }
+
+    /// The closed surface of the box [1, 3]³ inside a 4³ grid, unjittered.
+    fn closed_box() -> TetMesh {
+        kuhn_grid(&GridSpec {
+            cells: [4, 4, 4],
+            jitter: 0.0,
+            shell: Some(([1, 1, 1], [3, 3, 3])),
+            ..Default::default()
+        })
+    }
+
+    /// Every edge midpoint and every corner of every constrained face.
+    fn edges_and_vertices(mesh: &TetMesh) -> Vec<Vec3> {
+        let mut out = Vec::new();
+        for cf in &mesh.constrained {
+            let p = cf.vertices.map(|k| mesh.points[k as usize]);
+            for k in 0..3 {
+                out.push(p[k]);
+                out.push((p[k] + p[(k + 1) % 3]) * 0.5);
+            }
+        }
+        out
+    }
+
+    /// Rays from `origin` through each target, each with the reference
+    /// hit; starts in tet 0 (the fake tracers ignore it).
+    fn aimed(origin: Vec3, targets: &[Vec3]) -> RaySet {
+        RaySet {
+            rays: targets
+                .iter()
+                .map(|&p| (Ray::new(origin, p - origin), Some(Start::Tet(0))))
+                .collect(),
+            view: None,
+        }
+    }
+
+    fn expected(reference: &Reference, set: &RaySet) -> Vec<Option<RefHit>> {
+        set.rays.iter().map(|(r, _)| reference.closest(r)).collect()
+    }
+
+    #[test]
+    fn a_miss_across_a_closed_edge_or_vertex_is_a_leak() {
+        let mesh = closed_box();
+        assert_eq!(mesh.constrained.len(), 48);
+        let reference = Reference::new(&mesh);
+        let grazing = edges_and_vertices(&mesh);
+        let centroids: Vec<Vec3> = mesh
+            .constrained
+            .iter()
+            .map(|cf| cf.vertices.map(|k| mesh.points[k as usize]))
+            .map(|p| (p[0] + p[1] + p[2]) / 3.0)
+            .collect();
+        let origin = Vec3::new(2.0, 2.0, 2.0);
+        let set = aimed(origin, &[grazing.clone(), centroids.clone()].concat());
+        let exp = expected(&reference, &set);
+        // Every grazing ray hits the box near an edge: the rays that the
+        // old counting filed under "grazing" whatever the method did.
+        for e in &exp[..grazing.len()] {
+            let e = e.expect("a ray from inside the box hits it");
+            assert!(e.near_edge && e.ambiguous(), "{e:?}");
+        }
+        let m = check(&AlwaysMiss(&mesh), "f32", &reference, &exp, &set);
+        assert_eq!(m.leaks, grazing.len() as u64, "{m:?}");
+        assert_eq!(m.ambiguous, 0, "{m:?}");
+        // A miss away from any edge stays a false miss.
+        assert_eq!(m.false_misses, centroids.len() as u64, "{m:?}");
+        assert_eq!(m.failures, m.rays, "{m:?}");
+        assert_eq!(m.failures_per_1024_squared, 1024.0 * 1024.0);
+    }
+
+    #[test]
+    fn a_farther_hit_across_a_closed_edge_is_a_leak() {
+        let mesh = closed_box();
+        let reference = Reference::new(&mesh);
+        // From above the box, at the inner edges and vertex of its top
+        // side (not its rim, where the ray would graze the box's outline):
+        // the first hit is the top, the farthest the bottom or a side.
+        let inside = |c: f32| c > 1.0 && c < 3.0;
+        let grazing: Vec<Vec3> = edges_and_vertices(&mesh)
+            .into_iter()
+            .filter(|p| p.z == 3.0 && inside(p.x) && inside(p.y))
+            .collect();
+        assert!(!grazing.is_empty());
+        let set = aimed(Vec3::new(2.1, 1.95, 3.9), &grazing);
+        let exp = expected(&reference, &set);
+        for e in &exp {
+            let e = e.expect("the top of the box is hit");
+            assert!(e.near_edge && e.ambiguous(), "{e:?}");
+        }
+        let m = check(&Farthest(&mesh), "f32", &reference, &exp, &set);
+        assert_eq!(m.leaks, grazing.len() as u64, "{m:?}");
+        assert_eq!(m.ambiguous + m.agree + m.wrong_triangle, 0, "{m:?}");
+        assert_eq!(m.failures, m.leaks);
+    }
+
+    #[test]
+    fn a_miss_at_an_open_edge_or_vertex_is_grazing_not_a_leak() {
+        // An open square: the plane z = 1 of a 2³ grid, 8 triangles; its
+        // inner edges join two triangles, its border edges bound one.
+        let grid = kuhn_grid(&GridSpec {
+            cells: [2, 2, 2],
+            jitter: 0.0,
+            ..Default::default()
+        });
+        let mesh = constrain_faces(grid, |v| v.iter().all(|p| p.z == 1.0), None);
+        assert_eq!(mesh.constrained.len(), 8);
+        let reference = Reference::new(&mesh);
+        let on_border = |p: Vec3| [p.x, p.y].iter().any(|&c| c == 0.0 || c == 2.0);
+        let (border, inner): (Vec<Vec3>, Vec<Vec3>) = edges_and_vertices(&mesh)
+            .into_iter()
+            .partition(|&p| on_border(p));
+        assert!(!border.is_empty() && !inner.is_empty());
+        for (targets, leak) in [(&border, false), (&inner, true)] {
+            let set = aimed(Vec3::new(0.9, 1.15, 1.8), targets);
+            let exp = expected(&reference, &set);
+            assert!(exp.iter().all(|e| e.is_some_and(|e| e.near_edge)));
+            let m = check(&AlwaysMiss(&mesh), "f32", &reference, &exp, &set);
+            let n = targets.len() as u64;
+            if leak {
+                assert_eq!((m.leaks, m.ambiguous, m.failures), (n, 0, n), "{m:?}");
+            } else {
+                assert_eq!((m.leaks, m.ambiguous, m.failures), (0, n, 0), "{m:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_miss_along_the_outline_of_a_closed_surface_is_grazing() {
+        // Rays from outside that touch an edge and a corner of the box and
+        // go on outside it: both faces of the edge lie on one side of them.
+        let mesh = closed_box();
+        let reference = Reference::new(&mesh);
+        let edge = Vec3::new(1.0, 1.0, 2.5);
+        let corner = Vec3::new(1.0, 1.0, 1.0);
+        let set = RaySet {
+            rays: vec![
+                (
+                    Ray::new(Vec3::new(0.0, 1.5, 2.5), edge - Vec3::new(0.0, 1.5, 2.5)),
+                    Some(Start::Tet(0)),
+                ),
+                (
+                    Ray::new(Vec3::new(0.0, 2.0, 2.0), corner - Vec3::new(0.0, 2.0, 2.0)),
+                    Some(Start::Tet(0)),
+                ),
+            ],
+            view: None,
+        };
+        let exp = expected(&reference, &set);
+        assert!(
+            exp.iter().all(|e| e.is_some_and(|e| e.near_edge)),
+            "{exp:?}"
+        );
+        let m = check(&AlwaysMiss(&mesh), "f32", &reference, &exp, &set);
+        assert_eq!((m.leaks, m.ambiguous, m.failures), (0, 2, 0), "{m:?}");
+        // The same points entered across the edge and the corner leak.
+        let set = aimed(Vec3::new(0.0, 0.5, 2.5), &[edge]);
+        let set = RaySet {
+            rays: [set.rays, aimed(Vec3::new(0.0, 0.2, 0.1), &[corner]).rays].concat(),
+            view: None,
+        };
+        let exp = expected(&reference, &set);
+        let m = check(&AlwaysMiss(&mesh), "f32", &reference, &exp, &set);
+        assert_eq!((m.leaks, m.ambiguous, m.failures), (2, 0, 2), "{m:?}");
+    }
+
+    #[test]
+    fn the_walk_does_not_leak_through_the_closed_box() {
+        let mesh = closed_box();
+        let reference = Reference::new(&mesh);
+        let origin = Vec3::new(2.1, 1.95, 2.05);
+        let mut set = aimed(origin, &edges_and_vertices(&mesh));
+        set.view = Some(Viewpoint::locate(&mesh, origin).unwrap());
+        for r in &mut set.rays {
+            r.1 = None;
+        }
+        let exp = expected(&reference, &set);
+        for method in [Method::Tet20, Method::Tet32, Method::Sctp] {
+            let t = tracer(method, false, &mesh).unwrap();
+            let m = check(t.as_ref(), "f32", &reference, &exp, &set);
+            assert_eq!((m.leaks, m.failures), (0, 0), "{m:?}");
+            assert_eq!(m.agree + m.ambiguous, m.rays, "{m:?}");
+        }
+    }
 }

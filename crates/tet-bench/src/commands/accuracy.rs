@@ -97,10 +97,11 @@ pub fn print_doc(doc: &AccuracyDoc) -> Result<()> {
             c.reference_ambiguous
         )?;
         outln!(
-            "  {:<18} {:>9} {:>9} {:>7} {:>7} {:>7} {:>6} {:>6} {:>5} {:>9} {:>9}",
+            "  {:<18} {:>9} {:>9} {:>7} {:>7} {:>7} {:>7} {:>6} {:>6} {:>5} {:>9} {:>9}",
             "method",
             "agree",
             "grazing",
+            "leaks",
             "wrong",
             "f.miss",
             "f.hit",
@@ -112,10 +113,11 @@ pub fn print_doc(doc: &AccuracyDoc) -> Result<()> {
         )?;
         for m in &c.methods {
             outln!(
-                "  {:<18} {:>9} {:>9} {:>7} {:>7} {:>7} {:>6} {:>6} {:>5} {:>9.2} {:>9.2}",
+                "  {:<18} {:>9} {:>9} {:>7} {:>7} {:>7} {:>7} {:>6} {:>6} {:>5} {:>9.2} {:>9.2}",
                 m.method,
                 m.agree,
                 m.ambiguous,
+                m.leaks,
                 m.wrong_triangle,
                 m.false_misses,
                 m.false_hits,

@@ -37,13 +37,16 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     );
     let _ = writeln!(
         m,
-        "Failures = wrong triangle + false miss + false hit + step cap + lost + NaN, beyond the grazing tolerance, per 1024² rays, against an f64 reference. Seed 001 reports 0 for its Plücker method in f32.\n"
+        "Failures = leaks + wrong triangle + false miss + false hit + step cap + lost + NaN, beyond the grazing tolerance, per 1024² rays, against an f64 reference. A leak is a ray that misses, or hits something farther along, where the reference hit grazes only closed edges (shared by two or more faces): it slipped through a watertight surface. Grazing rays (not failures) hit one of the triangles they graze, or graze an open edge. Seed 001 reports 0 for its Plücker method in f32.\n"
     );
     let _ = writeln!(
         m,
-        "| scene | method | rays | grazing | wrong | false miss | false hit | cap | lost | failures per 1024² | Mrays/s (render) |"
+        "| scene | method | rays | grazing | leaks | wrong | false miss | false hit | cap | lost | failures per 1024² | Mrays/s (render) |"
     );
-    let _ = writeln!(m, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        m,
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
     for sc in &doc.scenes {
         if let Some(a) = &sc.accuracy {
             for x in &a.methods {
@@ -54,13 +57,14 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
                     .map_or(f64::NAN, |r| r.mrays_per_s);
                 let _ = writeln!(
                     m,
-                    "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} |",
+                    "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} |",
                     sc.info
                         .as_ref()
                         .map_or(sc.spec.as_str(), |i| i.name.as_str()),
                     x.method,
                     x.rays,
                     x.ambiguous,
+                    x.leaks,
                     x.wrong_triangle,
                     x.false_misses,
                     x.false_hits,

@@ -62,22 +62,26 @@ pub fn markdown(m: &mut String, x: &SpeedAccuracy) {
     }
     let _ = writeln!(
         m,
-        "| case | method | precision | rays | wrong | false miss | false hit | cap | lost + NaN | failures per 1024² | Mrays/s |"
+        "| case | method | precision | rays | leaks | wrong | false miss | false hit | cap | lost + NaN | failures per 1024² | Mrays/s |"
     );
-    let _ = writeln!(m, "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        m,
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
     for c in &x.cases {
         if let Some(why) = &c.skipped {
-            let _ = writeln!(m, "| {} | skipped: {why} | | | | | | | | | |", c.case);
+            let _ = writeln!(m, "| {} | skipped: {why} | | | | | | | | | | |", c.case);
             continue;
         }
         for r in &c.methods {
             let _ = writeln!(
                 m,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} |",
                 c.case,
                 r.method,
                 r.precision,
                 r.rays,
+                r.leaks,
                 r.wrong_triangle,
                 r.false_misses,
                 r.false_hits,
