@@ -43,7 +43,9 @@ use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::Viewpoint;
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Failure, Hit, Ray, TraceOutcome};
-use tet_trace_cpu::reference::{Aim, edge_distance, random_ray, ray_triangle};
+use tet_trace_cpu::reference::{
+    Aim, edge_distance, line_triangle, random_ray, ray_triangle, segment_distance,
+};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Start;
 
@@ -164,33 +166,6 @@ impl EdgeSharing {
             edge_ok && vertex_ok
         })
     }
-}
-
-/// True when the line `o + s·d` passes through triangle `v` (closed), in
-/// f64 (the test of `tet_trace_cpu::reference::ray_triangle`).
-fn line_hits(o: DVec3, d: DVec3, v: [DVec3; 3]) -> bool {
-    let q = v.map(|p| p - o);
-    let w = [
-        d.dot(q[1].cross(q[2])),
-        d.dot(q[2].cross(q[0])),
-        d.dot(q[0].cross(q[1])),
-    ];
-    let inside =
-        (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0) || (w[0] <= 0.0 && w[1] <= 0.0 && w[2] <= 0.0);
-    inside && w[0] + w[1] + w[2] != 0.0
-}
-
-/// Distance from `p` to segment `ab` (as `tet_trace_cpu::reference::edge_distance`
-/// measures each edge).
-fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let ab = b - a;
-    let l = ab.length_squared();
-    let s = if l > 0.0 {
-        ((p - a).dot(ab) / l).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + ab * s - p).length()
 }
 
 /// f64 reference over a padded-box BVH.
@@ -319,7 +294,7 @@ impl<'m> Reference<'m> {
         (0..8).all(|k| {
             let a = k as f64 * std::f64::consts::FRAC_PI_4;
             let shifted = o + (u * a.cos() + w * a.sin()) * (2.0 * self.tol);
-            ring.iter().any(|&v| line_hits(shifted, d, v))
+            ring.iter().any(|&v| line_triangle(shifted, d, v).is_some())
         })
     }
 

@@ -54,36 +54,34 @@ type Module = Vec<String>;
 
 /// Every `.rs` file under `src` with its module path.
 fn modules(src: &Path) -> BTreeMap<Module, PathBuf> {
-    fn walk(dir: &Path, src: &Path, out: &mut BTreeMap<Module, PathBuf>) {
-        for entry in std::fs::read_dir(dir).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                walk(&path, src, out);
-            } else if path.extension().is_some_and(|e| e == "rs") {
-                let rel = path.strip_prefix(src).unwrap().with_extension("");
-                let mut m: Module = rel
-                    .components()
-                    .map(|c| c.as_os_str().to_string_lossy().into_owned())
-                    .collect();
-                if m == ["main"] || m == ["lib"] || m.last().is_some_and(|l| l == "mod") {
-                    m.pop();
-                }
-                out.insert(m, path);
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    files
+        .into_iter()
+        .map(|path| {
+            let rel = path.strip_prefix(src).unwrap().with_extension("");
+            let mut m: Module = rel
+                .components()
+                .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                .collect();
+            if m == ["main"] || m == ["lib"] || m.last().is_some_and(|l| l == "mod") {
+                m.pop();
             }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(src, src, &mut out);
-    out
+            (m, path)
+        })
+        .collect()
+}
+
+/// The source before its unit-test module (`#[cfg(test)] mod tests`).
+fn without_unit_tests(text: &str) -> &str {
+    let end = text.find("#[cfg(test)]\nmod tests").unwrap_or(text.len());
+    &text[..end]
 }
 
 /// The source without unit tests and line comments.
 fn code(text: &str) -> String {
-    let text = match text.find("#[cfg(test)]\nmod tests") {
-        Some(i) => &text[..i],
-        None => text,
-    };
-    text.lines()
+    without_unit_tests(text)
+        .lines()
         .filter(|l| !l.trim_start().starts_with("//"))
         .collect::<Vec<_>>()
         .join("\n")
@@ -316,8 +314,7 @@ fn no_source_file_longer_than_the_limit_without_a_reason() {
         rust_files(&src, &mut files);
         for file in files {
             let text = fs::read_to_string(&file).expect("readable source");
-            let end = text.find("#[cfg(test)]\nmod tests").unwrap_or(text.len());
-            let lines = text[..end].lines().count();
+            let lines = without_unit_tests(&text).lines().count();
             let explained = text
                 .lines()
                 .take(40)

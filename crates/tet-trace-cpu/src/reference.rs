@@ -37,7 +37,7 @@ pub struct RefHit {
 }
 
 /// Distance from `p` to segment `ab`.
-fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+pub fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
     let ab = b - a;
     let l = ab.length_squared();
     let s = if l > 0.0 {
@@ -55,12 +55,11 @@ pub fn edge_distance(p: DVec3, v: [DVec3; 3]) -> f64 {
         .min(segment_distance(p, v[2], v[0]))
 }
 
-/// Intersection of the ray's line with triangle `v` (closed), as
-/// `(t, barycentrics)`; `None` when the line misses it or is parallel.
-pub fn ray_triangle(ray: &Ray, v: [Vec3; 3]) -> Option<(f64, [f64; 3])> {
-    let o = ray.origin.as_dvec3();
-    let d = ray.direction.as_dvec3();
-    let q = v.map(|p| p.as_dvec3() - o);
+/// Where the line `o + s·d` passes through triangle `v` (closed), in f64:
+/// its barycentrics w.r.t. `v`, or `None` when the line misses the
+/// triangle or is parallel to it.
+pub fn line_triangle(o: DVec3, d: DVec3, v: [DVec3; 3]) -> Option<[f64; 3]> {
+    let q = v.map(|p| p - o);
     let w = [
         d.dot(q[1].cross(q[2])),
         d.dot(q[2].cross(q[0])),
@@ -72,7 +71,17 @@ pub fn ray_triangle(ray: &Ray, v: [Vec3; 3]) -> Option<(f64, [f64; 3])> {
     if !inside || sum == 0.0 {
         return None;
     }
-    let b = w.map(|x| x / sum);
+    Some(w.map(|x| x / sum))
+}
+
+/// Intersection of the ray's line with triangle `v` (closed), as
+/// `(t, barycentrics)`; `None` when the line misses it or is parallel.
+pub fn ray_triangle(ray: &Ray, v: [Vec3; 3]) -> Option<(f64, [f64; 3])> {
+    let o = ray.origin.as_dvec3();
+    let d = ray.direction.as_dvec3();
+    let v = v.map(|p| p.as_dvec3());
+    let b = line_triangle(o, d, v)?;
+    let q = v.map(|p| p - o);
     let p = q[0] * b[0] + q[1] * b[1] + q[2] * b[2];
     Some((p.dot(d) / d.length_squared(), b))
 }

@@ -154,6 +154,6 @@ mod tests {
         let m = TetMesh::default();
         let b = to_bytes(&m);
         assert_eq!(b.len(), HEADER_LEN);
-        assert_eq!(super::super::from_bytes(&b).unwrap(), m);
+        assert_eq!(crate::format::from_bytes(&b).unwrap(), m);
     }
 }

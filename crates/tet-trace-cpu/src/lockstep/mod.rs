@@ -143,7 +143,6 @@ fn dispatch<T: Topology>(
 ) {
     #[cfg(not(target_arch = "x86_64"))]
     let _ = wide;
-    #[cfg(target_arch = "x86_64")]
     // Records the gathers of the projected walks can read (the baseline's
     // `Ids` rule is ScTP's, `sctp`).
     #[cfg(target_arch = "x86_64")]
