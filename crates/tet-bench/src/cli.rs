@@ -60,6 +60,11 @@ pub struct BuildFlags {
     /// Skip Hilbert reordering of points and tets.
     #[arg(long)]
     pub no_sort: bool,
+    /// Do not split triangles that cross, touch in their interiors or
+    /// overlap: such a scene then fails with the list of intersecting
+    /// pairs instead of being resolved.
+    #[arg(long)]
+    pub no_resolve: bool,
 }
 
 /// `build` arguments.

@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
+use tet_build::resolve::ResolveReport;
 use tet_build::scene::Scene;
 use tet_core::TetMesh;
 use tet_core::scene::{Camera, PointLight};
@@ -45,6 +46,9 @@ pub struct BuildSummary {
     pub steiner_points: usize,
     /// Seconds: cleaning.
     pub clean_s: f64,
+    /// Seconds: resolving self-intersections (on a clean scene, only the
+    /// exact check that finds none).
+    pub resolve_s: f64,
     /// Seconds: TetGen (including worker start and transfer).
     pub tetgen_s: f64,
     /// Seconds: neighbours, constrained faces and validation.
@@ -58,6 +62,9 @@ pub struct BuildSummary {
     /// Cleaning: vertices merged, triangles dropped (repeated vertex, zero
     /// area, duplicate), unused vertices removed.
     pub cleaning: CleaningSummary,
+    /// Resolving self-intersections: pairs found, triangles split, points
+    /// added, pieces merged, rounds (all zero for a clean scene).
+    pub resolve: ResolveReport,
 }
 
 /// Counts of what cleaning changed.
@@ -220,6 +227,9 @@ pub fn build_scene_in(
         })),
         ..BuildOptions::default()
     };
+    if flags.no_resolve {
+        options.resolve = None;
+    }
     options.tetgen.quality = flags.quality;
     options.tetgen.max_steiner = flags.max_steiner;
     if !flags.no_sort {
@@ -236,6 +246,7 @@ pub fn build_scene_in(
         scene_triangles: report.scene_triangles,
         steiner_points: report.steiner_points,
         clean_s: t.clean.as_secs_f64(),
+        resolve_s: t.resolve.as_secs_f64(),
         tetgen_s: t.tetgen.as_secs_f64(),
         assemble_s: (t.constrained_faces + t.assemble + t.validate + t.rounding).as_secs_f64(),
         reorder_s,
@@ -248,6 +259,7 @@ pub fn build_scene_in(
             duplicate_triangles: report.clean.duplicate_triangles.len(),
             unused_vertices: report.clean.unused_vertices.len(),
         },
+        resolve: report.resolve.clone(),
     };
     Ok((mesh, summary))
 }

@@ -23,8 +23,11 @@
 //!   - three shared vertices: a duplicate.
 //! * Exactly degenerate (collinear) triangles are skipped and listed
 //!   separately; [`crate::clean`] removes them.
+//! * The cells are tested in parallel (rayon); the report is sorted, so it
+//!   does not depend on the thread count.
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 use robust::{Coord, Coord3D};
 
 /// How two triangles meet.
@@ -362,10 +365,13 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
             }
         }
     }
-    for z in 0..nz {
-        for y in 0..ny {
-            for x in 0..nx {
-                let c = (z * ny + y) * nx + x;
+    // Every cell's pairs, in parallel (cells are independent).
+    let (candidates, pairs) = (0..ncells)
+        .into_par_iter()
+        .fold(
+            || (0u64, Vec::new()),
+            |(mut candidates, mut pairs), c| {
+                let cell_xyz = [c % nx, c / nx % ny, c / (nx * ny)];
                 let list = &entries[counts[c] as usize..counts[c + 1] as usize];
                 for (i, &s) in list.iter().enumerate() {
                     let (sl, sh) = bb(s as usize);
@@ -375,15 +381,15 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
                             continue;
                         }
                         // Test the pair only in the cell of the overlap's lower corner.
-                        if cell_of(sl.max(tl)) != [x, y, z] {
+                        if cell_of(sl.max(tl)) != cell_xyz {
                             continue;
                         }
-                        report.candidates += 1;
+                        candidates += 1;
                         let (a, b) = (s.min(t) as usize, s.max(t) as usize);
                         if let Some(kind) =
                             classify(&tris[a], axes[a] as usize, &tris[b], axes[b] as usize)
                         {
-                            report.pairs.push(IntersectingPair {
+                            pairs.push(IntersectingPair {
                                 first: a as u32,
                                 second: b as u32,
                                 kind,
@@ -391,9 +397,18 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
                         }
                     }
                 }
-            }
-        }
-    }
+                (candidates, pairs)
+            },
+        )
+        .reduce(
+            || (0u64, Vec::new()),
+            |(ca, mut pa), (cb, pb)| {
+                pa.extend(pb);
+                (ca + cb, pa)
+            },
+        );
+    report.candidates = candidates;
+    report.pairs = pairs;
     report.pairs.sort_unstable_by_key(|p| (p.first, p.second));
     report
 }

@@ -15,8 +15,9 @@ pub fn print_build(b: &BuildSummary) -> Result<()> {
         b.steiner_points
     )?;
     outln!(
-        "  times: clean {:.3} s, TetGen {:.3} s, assemble+validate {:.3} s, reorder {:.3} s, total {:.3} s; TetGen peak {}",
+        "  times: clean {:.3} s, resolve {:.3} s, TetGen {:.3} s, assemble+validate {:.3} s, reorder {:.3} s, total {:.3} s; TetGen peak {}",
         b.clean_s,
+        b.resolve_s,
         b.tetgen_s,
         b.assemble_s,
         b.reorder_s,
@@ -33,5 +34,16 @@ pub fn print_build(b: &BuildSummary) -> Result<()> {
         c.duplicate_triangles,
         c.unused_vertices
     )?;
+    let r = &b.resolve;
+    if r.pairs > 0 {
+        outln!(
+            "  resolved: {} intersecting pairs; {} triangles split, {} points added, {} overlapping pieces merged, {} rounds",
+            r.pairs,
+            r.split_triangles,
+            r.added_points,
+            r.merged_pieces,
+            r.rounds
+        )?;
+    }
     Ok(())
 }

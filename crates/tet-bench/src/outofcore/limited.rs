@@ -406,12 +406,14 @@ impl Limited<'_> {
             scene_triangles: plan.scene_triangles,
             steiner_points: points.saturating_sub(plan.scene_vertices + 8),
             clean_s: plan.clean_s,
+            resolve_s: 0.0,
             tetgen_s,
             assemble_s: 0.0,
             reorder_s,
             total_s,
             worker_peak_kib: max_peak,
             cleaning: plan.cleaning.clone(),
+            resolve: Default::default(),
         };
         let s = merged.stream;
         let memory = MemoryReport {

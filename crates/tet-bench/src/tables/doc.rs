@@ -154,8 +154,8 @@ pub struct TablesDoc {
     pub total_s: f64,
 }
 
-/// How every scene of the tables is built: TetGen `-pY` in a box, Hilbert
-/// order, the default time limit.
+/// How every scene of the tables is built: self-intersections resolved,
+/// TetGen `-pY` in a box, Hilbert order, the default time limit.
 pub const TABLE_FLAGS: BuildFlags = BuildFlags {
     quality: None,
     max_steiner: None,
@@ -163,6 +163,7 @@ pub const TABLE_FLAGS: BuildFlags = BuildFlags {
     no_box: false,
     wide_box: false,
     no_sort: false,
+    no_resolve: false,
 };
 
 /// Speed against accuracy (seed 001 Table 4 beside render speed): every CPU method in f32 and,

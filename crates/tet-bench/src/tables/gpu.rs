@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use tet_trace_cpu::render::RenderOptions;
 
 use super::doc::TablesDoc;
+use super::paper::paper_scene;
 use crate::cli::Method;
 use crate::gpu::time_gpu;
 use crate::load::Loaded;
@@ -43,14 +44,17 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     let _ = writeln!(m, "\n## GPU (seed 000 Table 3)\n");
     let _ = writeln!(
         m,
-        "| scene | method (device) | best ms | Mrays/s | tets/ray | GPU bytes (tets + points) | failures |"
+        "| scene | method (device) | best ms | Mrays/s | tets/ray | GPU bytes (tets + points) | failures | paper ms |"
     );
-    let _ = writeln!(m, "|---|---|---:|---:|---:|---:|---:|");
+    let _ = writeln!(m, "|---|---|---:|---:|---:|---:|---:|---:|");
     for sc in &doc.scenes {
         for r in &sc.gpu_renders {
+            let paper = paper_scene(&sc.spec)
+                .and_then(|p| p.gpu_ms(r.method))
+                .map_or("–".to_string(), |v| format!("{v:.2}"));
             let _ = writeln!(
                 m,
-                "| {} | {} | {:.2} | {:.2} | {:.1} | {} | {} |",
+                "| {} | {} | {:.2} | {:.2} | {:.1} | {} | {} | {paper} |",
                 r.scene,
                 r.tracer,
                 r.best_ms,
@@ -61,7 +65,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
             );
         }
         if let Some(note) = &sc.gpu_note {
-            let _ = writeln!(m, "| {} | no GPU rows: {note} | | | | | |", sc.spec);
+            let _ = writeln!(m, "| {} | no GPU rows: {note} | | | | | | |", sc.spec);
         }
     }
 }

@@ -39,6 +39,7 @@ mod figures;
 mod gpu;
 mod memory;
 mod out_of_core;
+mod paper;
 mod plan;
 mod quality;
 mod render_speed;

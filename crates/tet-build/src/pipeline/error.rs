@@ -6,6 +6,7 @@ use thiserror::Error;
 use crate::bbox::BoxError;
 use crate::clean::CleanError;
 use crate::intersect::{IntersectingPair, find_self_intersections};
+use crate::resolve::ResolveError;
 use crate::scene::Scene;
 use crate::tetgen::TetgenError;
 
@@ -78,6 +79,9 @@ pub enum BuildError {
         /// TetGen runs made.
         rounds: u32,
     },
+    /// Resolving self-intersections failed (names input triangles).
+    #[error("resolving self-intersections: {0}")]
+    Resolve(#[from] ResolveError),
     /// Assembly or validation failed (a bug in this pipeline or TetGen).
     #[error("mesh: {0}")]
     Mesh(#[from] MeshError),

@@ -4,15 +4,20 @@
 //!
 //! 1. `prepare`: clean the scene (merge equal vertices, drop degenerate
 //!    and duplicate triangles);
-//! 2. `prepare`: add the optional enclosing box and mark TetGen's facets;
-//! 3. `rounding`: TetGen `-pY`, then the exact f32 rounding check, with
+//! 2. `resolve`: where triangles cross, touch in their interiors or
+//!    overlap, split them along the intersections ([`crate::resolve`]);
+//!    pieces keep their input triangle's id (off with
+//!    [`BuildOptions::resolve`] = `None`: such a scene then fails with
+//!    [`BuildError::SelfIntersections`]);
+//! 3. `prepare`: add the optional enclosing box and mark TetGen's facets;
+//! 4. `rounding`: TetGen `-pY`, then the exact f32 rounding check, with
 //!    snapping and re-runs where rounding flattens tets;
-//! 4. `faces`: every scene triangle is exactly one TetGen face;
-//! 5. `assemble`: neighbour links and the constrained-face table
+//! 5. `faces`: every scene triangle is exactly one TetGen face;
+//! 6. `assemble`: neighbour links and the constrained-face table
 //!    ([`Assembly`]), then normals and uvs;
-//! 6. `reorder`: optional Hilbert order ([`Reorder`]), tet-core's sort run
+//! 7. `reorder`: optional Hilbert order ([`Reorder`]), tet-core's sort run
 //!    in parallel;
-//! 7. `validate`: tet-core's validator ([`Validation`]); the pipeline
+//! 8. `validate`: tet-core's validator ([`Validation`]); the pipeline
 //!    never returns a mesh that fails [`TetMesh::validate`].
 //!
 //! Options and the report are in [`options`], errors in [`error`]; the
@@ -26,6 +31,7 @@ mod faces;
 pub mod options;
 mod prepare;
 mod reorder;
+mod resolve;
 mod rounding;
 mod validate;
 
@@ -69,11 +75,21 @@ pub fn build(scene: &Scene, options: &BuildOptions) -> Result<(TetMesh, BuildRep
     report.times.clean = t.elapsed();
     report.clean = cleaned.map.report.clone();
 
-    // Resolving self-intersections belongs here, between cleaning and
-    // TetGen: today a self-intersecting scene fails in TetGen and comes back
-    // as `BuildError::SelfIntersections` naming the pairs.
+    // 2. Resolve self-intersections (without it, a self-intersecting scene
+    // fails in TetGen and comes back as `BuildError::SelfIntersections`).
+    let cleaned = match &options.resolve {
+        Some(resolve_options) => {
+            progress(Stage::Resolve);
+            let t = Instant::now();
+            let (resolved, resolve_report) = resolve::resolve_scene(cleaned, resolve_options)?;
+            report.times.resolve = t.elapsed();
+            report.resolve = resolve_report;
+            resolved
+        }
+        None => cleaned,
+    };
 
-    // 2. Enclosing box and TetGen's PLC.
+    // 3. Enclosing box and TetGen's PLC.
     if options.enclosing_box.is_some() {
         progress(Stage::EnclosingBox);
     }
@@ -86,7 +102,7 @@ pub fn build(scene: &Scene, options: &BuildOptions) -> Result<(TetMesh, BuildRep
     }
     let fixed_points = plc.input.points.len();
 
-    // 3. TetGen and f32 rounding.
+    // 4. TetGen and f32 rounding.
     let rounded =
         rounding::tetrahedralize_rounded(scene, plc.input, &tetgen_options, options, &progress)?;
     let stats = &rounded.stats;
@@ -99,7 +115,7 @@ pub fn build(scene: &Scene, options: &BuildOptions) -> Result<(TetMesh, BuildRep
     report.worker_peak_memory_kib = stats.worker_peak_kib;
     report.steiner_points = rounded.points.len() - fixed_points;
 
-    // 4. Constrained faces.
+    // 5. Constrained faces.
     progress(Stage::ConstrainedFaces);
     let t = Instant::now();
     let faces = faces::match_scene_faces(
@@ -111,7 +127,7 @@ pub fn build(scene: &Scene, options: &BuildOptions) -> Result<(TetMesh, BuildRep
     )?;
     report.times.constrained_faces = t.elapsed();
 
-    // 5. Assembly and attributes.
+    // 6. Assembly and attributes.
     progress(Stage::Assemble);
     let t = Instant::now();
     let triangle_count = scene.triangles.len() as u32;
@@ -119,7 +135,7 @@ pub fn build(scene: &Scene, options: &BuildOptions) -> Result<(TetMesh, BuildRep
     report.times.assemble = t.elapsed();
     assemble::attach_attributes(&mut mesh, &cleaned, scene);
 
-    // 6. Reorder.
+    // 7. Reorder.
     if options.reorder == Reorder::Hilbert {
         progress(Stage::Reorder);
         let t = Instant::now();
@@ -129,7 +145,7 @@ pub fn build(scene: &Scene, options: &BuildOptions) -> Result<(TetMesh, BuildRep
         report.times.reorder = t.elapsed();
     }
 
-    // 7. Validate.
+    // 8. Validate.
     progress(Stage::Validate);
     let t = Instant::now();
     validate::validate(&mesh, options.validation)?;

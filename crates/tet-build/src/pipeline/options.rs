@@ -9,6 +9,7 @@ use tet_core::reorder::Reordering;
 
 use crate::bbox::BoxSpec;
 use crate::clean::CleanReport;
+use crate::resolve::{ResolveOptions, ResolveReport};
 use crate::tetgen::{Isolation, TetgenOptions};
 
 /// Progress callback, called at the start of every stage.
@@ -19,6 +20,8 @@ pub type ProgressFn = Arc<dyn Fn(&Progress) + Send + Sync>;
 pub enum Stage {
     /// Cleaning the scene.
     Clean,
+    /// Resolving self-intersections ([`BuildOptions::resolve`]).
+    Resolve,
     /// Adding the enclosing box.
     EnclosingBox,
     /// Running TetGen (round 1, 2, … when rounding forces a re-run).
@@ -97,6 +100,11 @@ pub struct BuildOptions {
     pub tetgen: TetgenOptions,
     /// Where TetGen runs.
     pub isolation: Isolation,
+    /// Split triangles that cross, touch in their interiors or overlap
+    /// ([`crate::resolve`]) before TetGen; `None` refuses such a scene with
+    /// [`BuildError::SelfIntersections`](super::BuildError::SelfIntersections)
+    /// instead. A clean scene builds the same either way.
+    pub resolve: Option<ResolveOptions>,
     /// Enclosing box around the scene (its faces become the mesh boundary).
     pub enclosing_box: Option<BoxSpec>,
     /// How many extra TetGen runs may be spent repairing f32 rounding.
@@ -116,6 +124,7 @@ impl Default for BuildOptions {
         BuildOptions {
             tetgen: TetgenOptions::default(),
             isolation: Isolation::InProcess,
+            resolve: Some(ResolveOptions::default()),
             enclosing_box: None,
             max_rounding_rounds: 4,
             progress: None,
@@ -131,6 +140,7 @@ impl std::fmt::Debug for BuildOptions {
         f.debug_struct("BuildOptions")
             .field("tetgen", &self.tetgen)
             .field("isolation", &self.isolation)
+            .field("resolve", &self.resolve)
             .field("enclosing_box", &self.enclosing_box)
             .field("max_rounding_rounds", &self.max_rounding_rounds)
             .field("progress", &self.progress.as_ref().map(|_| "callback"))
@@ -146,6 +156,8 @@ impl std::fmt::Debug for BuildOptions {
 pub struct StageTimes {
     /// Cleaning.
     pub clean: Duration,
+    /// Resolving self-intersections (the exact check alone on a clean scene).
+    pub resolve: Duration,
     /// Enclosing box.
     pub enclosing_box: Duration,
     /// TetGen, all rounds, as seen by the caller (includes the worker's
@@ -172,7 +184,10 @@ pub struct StageTimes {
 pub struct BuildReport {
     /// Cleaning actions.
     pub clean: CleanReport,
-    /// Scene triangles after cleaning (= constrained faces).
+    /// What resolving self-intersections did (all zero for a clean scene
+    /// or with [`BuildOptions::resolve`] off).
+    pub resolve: ResolveReport,
+    /// Scene triangles after cleaning and resolving (= constrained faces).
     pub scene_triangles: usize,
     /// Box triangles added (0 or 12).
     pub boundary_triangles: usize,
