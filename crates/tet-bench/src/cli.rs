@@ -301,6 +301,11 @@ pub struct AccuracyArgs {
     /// Kernel precision.
     #[arg(long, value_enum, default_value_t = Precision::F32)]
     pub precision: Precision,
+    /// Time each method over the rays for at least this many seconds in
+    /// all (at least 3 passes over the same rays) and report the best
+    /// pass's Mrays/s.
+    #[arg(long, default_value_t = 0.5)]
+    pub min_time: f64,
     /// View of the camera rays (overrides the scene's camera).
     #[command(flatten)]
     pub view: ViewArgs,
@@ -340,6 +345,17 @@ pub struct TablesArgs {
     /// Timed frames per method (default: 5, or 3 with `--quick`).
     #[arg(long)]
     pub frames: Option<u32>,
+    /// Seconds each method is timed over the accuracy rays, at least, in
+    /// repeated passes (default: 0.5, or 0.2 with `--quick`).
+    #[arg(long)]
+    pub min_time: Option<f64>,
+}
+
+impl TablesArgs {
+    /// Seconds each method is timed over the accuracy rays, at least.
+    pub fn min_time_s(&self) -> f64 {
+        self.min_time.unwrap_or(if self.quick { 0.2 } else { 0.5 })
+    }
 }
 
 /// How `build --memory-limit` splits a scene whose prediction exceeds the

@@ -132,6 +132,8 @@ fn render_and_accuracy_agree_with_the_reference() {
 
     let a = json(&[
         "accuracy",
+        "--min-time",
+        "0",
         "torus-knot",
         "--methods",
         "tet20,tet16,tet32,obvhs",
@@ -432,6 +434,8 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
         "24",
         "--frames",
         "1",
+        "--min-time",
+        "0",
         "--out",
         out.to_str().unwrap(),
         "--plots",
@@ -600,6 +604,8 @@ fn scenes_without_a_camera_are_framed_from_outside() {
     // The accuracy command checks every camera ray against the reference.
     let a = json(&[
         "accuracy",
+        "--min-time",
+        "0",
         file,
         "--methods",
         "tet20,tet80",
@@ -661,6 +667,8 @@ fn view_flags_move_the_camera_and_are_checked() {
     // The same view through `accuracy`: every camera ray agrees.
     let mut args = vec![
         "accuracy",
+        "--min-time",
+        "0",
         file,
         "--methods",
         "tet20",
@@ -714,14 +722,35 @@ fn a_closed_stdout_ends_every_command_quietly() {
         vec!["build", obj, "-o", again.to_str().unwrap()],
         vec!["render", file, "--json"],
         vec!["render", file],
-        vec!["accuracy", file, "--rays", "100", "--image", "8"],
-        vec!["accuracy", file, "--rays", "100", "--image", "8", "--json"],
+        vec![
+            "accuracy",
+            file,
+            "--rays",
+            "100",
+            "--image",
+            "8",
+            "--min-time",
+            "0",
+        ],
+        vec![
+            "accuracy",
+            file,
+            "--rays",
+            "100",
+            "--image",
+            "8",
+            "--min-time",
+            "0",
+            "--json",
+        ],
     ];
     commands[3].extend_from_slice(&small);
     commands[4].extend_from_slice(&small);
     let mut t = vec![
         "tables",
         "--quick",
+        "--min-time",
+        "0",
         "--scene",
         file,
         "--out",
@@ -757,6 +786,8 @@ fn a_closed_stdout_ends_every_command_quietly() {
 fn accuracy_counters_partition_the_rays_and_leaks_are_failures() {
     let a = json(&[
         "accuracy",
+        "--min-time",
+        "0",
         "torus-knot",
         "--methods",
         "tet20,obvhs",

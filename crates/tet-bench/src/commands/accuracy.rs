@@ -4,7 +4,7 @@
 use anyhow::{Result, bail};
 use serde::Serialize;
 
-use crate::accuracy::{CaseAccuracy, all_cases};
+use crate::accuracy::{CaseAccuracy, RayPlan, all_cases};
 use crate::cli::{AccuracyArgs, Method};
 use crate::load::{load, require_tets};
 use crate::methods::cpu_methods;
@@ -53,9 +53,12 @@ pub fn run(args: &AccuracyArgs, json: bool) -> Result<()> {
         &loaded,
         &methods,
         args.precision,
-        args.image,
-        args.rays,
-        args.seed,
+        RayPlan {
+            side: args.image,
+            random: args.rays,
+            seed: args.seed,
+            min_time_s: args.min_time,
+        },
         args.extremes.then_some(&args.build),
         json,
     )?;

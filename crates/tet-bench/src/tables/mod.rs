@@ -82,7 +82,8 @@ fn measure_scene(
     }
     let (info, bvh_build_s) = construction::measure(&loaded)?;
     let renders = render_speed::measure(spec, &loaded, opts, frames, pool)?;
-    let accuracy = robustness::measure(spec, &loaded, &cpu_methods(), args.quick)?;
+    let accuracy =
+        robustness::measure(spec, &loaded, &cpu_methods(), args.quick, args.min_time_s())?;
     let unsorted_tet20 = Some(sorting::measure(planned, cache, opts, frames, pool)?);
     let wide_box_tet20 = Some(entry::measure(planned, cache, opts, frames, pool)?);
     let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames);
@@ -178,7 +179,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
     let exit_face = Some(exit_face::measure(args.quick)?);
     let speed_accuracy = scene_specs(args)?.first().map(|spec| {
         eprintln!("speed vs accuracy: {spec}, f32 and f64, as given and at the extremes");
-        speed_accuracy::measure(spec, args.quick)
+        speed_accuracy::measure(spec, args.quick, args.min_time_s())
     });
     let mut doc = TablesDoc {
         setup,

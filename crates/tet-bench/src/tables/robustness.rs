@@ -7,18 +7,19 @@ use std::fmt::Write as _;
 use anyhow::Result;
 
 use super::doc::TablesDoc;
-use crate::accuracy::{CaseAccuracy, run_case};
+use crate::accuracy::{CaseAccuracy, RayPlan, run_case};
 use crate::cli::{Method, Precision};
 use crate::load::Loaded;
 
 /// Every CPU method (`methods`) in f32 on the scene's camera image and
 /// random interior rays (256² + 20,000 with `--quick`, else 1024² +
-/// 100,000).
+/// 100,000), each method timed for at least `min_time_s`.
 pub fn measure(
     spec: &str,
     loaded: &Loaded,
     methods: &[Method],
     quick: bool,
+    min_time_s: f64,
 ) -> Result<CaseAccuracy> {
     let (side, rays) = if quick {
         (256, 20_000)
@@ -26,7 +27,13 @@ pub fn measure(
         (1024, 100_000)
     };
     eprintln!("  {spec}: accuracy ({side}² camera rays + {rays} random rays)");
-    run_case("as-is", loaded, methods, Precision::F32, side, rays, 1)
+    let plan = RayPlan {
+        side,
+        random: rays,
+        seed: 1,
+        min_time_s,
+    };
+    run_case("as-is", loaded, methods, Precision::F32, plan)
 }
 
 /// The table.
