@@ -130,6 +130,9 @@ pub enum Method {
     Sctp,
     /// Maria et al. Plücker traversal (Tet80 layout).
     Tet80,
+    /// Tet80 with consistent side products: one per edge, the same in
+    /// every tet around it (canonical edge orientation, one rule for zero).
+    Tet80Consistent,
     /// Aman et al. 2-D projected traversal on Tet32.
     Tet32,
     /// Aman et al. on Tet20.
@@ -160,6 +163,7 @@ impl Method {
         match self {
             Method::Sctp => "sctp",
             Method::Tet80 => "tet80",
+            Method::Tet80Consistent => "tet80-consistent",
             Method::Tet32 => "tet32",
             Method::Tet20 => "tet20",
             Method::Tet16 => "tet16",

@@ -7,7 +7,7 @@ use tet_trace_cpu::sctp::SctpTracer;
 use tet_trace_cpu::tet16::{Tet16Tracer, Tet16TracerF64};
 use tet_trace_cpu::tet20::{Tet20Tracer, Tet20TracerF64};
 use tet_trace_cpu::tet32::{Tet32Tracer, Tet32TracerF64};
-use tet_trace_cpu::tet80::Tet80Tracer;
+use tet_trace_cpu::tet80::{Tet80ConsistentTracer, Tet80Tracer};
 
 use crate::bvh::BvhTracer;
 use crate::cli::Method;
@@ -17,6 +17,7 @@ pub fn tracer<'m>(method: Method, f64: bool, mesh: &'m TetMesh) -> Result<Box<dy
     Ok(match (method, f64) {
         (Method::Sctp, false) => Box::new(<SctpTracer<'_>>::new(mesh)?),
         (Method::Tet80, false) => Box::new(Tet80Tracer::new(mesh)?),
+        (Method::Tet80Consistent, false) => Box::new(Tet80ConsistentTracer::consistent(mesh)?),
         (Method::Tet32, false) => Box::new(<Tet32Tracer<'_>>::new(mesh)?),
         (Method::Tet32, true) => Box::new(Tet32TracerF64::new(mesh)?),
         (Method::Tet20, false) => Box::new(<Tet20Tracer<'_>>::new(mesh)?),
@@ -57,6 +58,7 @@ pub fn cpu_methods() -> Vec<Method> {
         Method::Tet16,
         Method::Tet32,
         Method::Tet80,
+        Method::Tet80Consistent,
         Method::Sctp,
         Method::Obvhs,
     ];

@@ -47,6 +47,40 @@
 //! in the frame of a different vertex in each tet around it, so two tets can
 //! disagree on a ray that grazes the edge, and zero is simply "right". Maria
 //! et al. report no failures in f32; the tests measure it.
+//!
+//! # The consistent variant (`tet80-consistent`)
+//!
+//! [`Tet80ConsistentTracer`] keeps the layout, the tables and the two side
+//! products per tet, but computes each side product from quantities that
+//! depend only on the edge's two vertices and the ray, never on the tet:
+//! the side product of `P → Q` is `d · ((P − o) × (Q − o))`, which is
+//! `|d|` times the 2-D determinant `det(P′, Q′)` of the two vertices
+//! projected into a frame `(u, v)` normal to the ray (Duff et al.'s basis,
+//! `u × v = d/|d|`). Each vertex is projected by the same expression in
+//! every tet ([`DuffF32`]), so both tets around a face, and every tet
+//! around an edge, see bitwise the same `P′`, `Q′` and the same
+//! determinant, whose two products are subtracted in the opposite order
+//! for `Q → P` (an exact negation). A zero determinant is decided by one
+//! rule, a symbolic perturbation of the ray's projected origin (the tie
+//! rule of [`crate::walk`]'s projections; two vertices projected onto the
+//! same point are ordered by position, the layout having no vertex ids).
+//! So two tets can never disagree on which side of a shared edge the ray
+//! passes, and the signs are those of real points in the plane. Cost per
+//! tet: three projected vertices (3 sub + 6 mul + 4 add each) and two
+//! determinants, against 9 + 2 × 8 operations for the faithful form.
+//!
+//! What consistency does not repair: the exit rule reads two of the three
+//! side products around the apex and takes the third from the table, which
+//! is only right when the entry face really contains the ray's projected
+//! origin. Rounded projections can break that in a start tet whose origin
+//! lies within rounding of a face (Algorithm 2 then starts from a wrong
+//! exit), and the walk can then go round; the step cap reports it. The
+//! accuracy tables count these step caps beside the faithful walk's.
+//!
+//! ScTP ([`crate::sctp`]) cannot be repaired the same way within its
+//! operation count: its triple products are taken in the frame of the
+//! entry face's projected vertices, which differ per tet by design; a
+//! consistent rule per edge is exactly the Plücker form above.
 
 use glam::Vec3;
 use tet_core::layout::{LayoutError, Tet80Face, Tet80Mesh};
@@ -56,7 +90,10 @@ use tet_core::{FACE_VERTICES, NO_TET, TetMesh};
 use crate::kernel::Tracer;
 use crate::ray::{Failure, Hit, Ray, TraceOutcome};
 use crate::secondary::{ShadowTracer, stops_at};
-use crate::walk::{Start, TripleF32, degenerate_crossing, face_hit, start_exit_face, step_cap};
+use crate::walk::{
+    DuffF32, Projection, Start, TripleF32, degenerate_crossing, face_hit, left_f32,
+    start_exit_face, step_cap,
+};
 
 /// `EXIT[e][2·s₁ + s₂]`: the exit face of a tet entered through face `e`,
 /// from the sign `s₁` of the side product with edge `V_e → A` and the sign
@@ -91,16 +128,35 @@ const SECOND: [[u8; 2]; 4] = {
     t
 };
 
-/// The Plücker (Tet80) tracer.
-pub struct Tet80Tracer<'m> {
+/// The Plücker (Tet80) tracer: Maria et al.'s side products in the frame
+/// of the entry face's complement vertex (`CONSISTENT = false`), or one
+/// side product per edge, the same in every tet (`CONSISTENT = true`, see
+/// the module docs).
+pub struct Tet80Tracer<'m, const CONSISTENT: bool = false> {
     mesh: &'m TetMesh,
     layout: Tet80Mesh,
     cap: u32,
 }
 
-impl<'m> Tet80Tracer<'m> {
-    /// Encodes `mesh` (validated) in the Tet80 layout.
+/// The Tet80 layout walked with consistent side products (`tet80-consistent`).
+pub type Tet80ConsistentTracer<'m> = Tet80Tracer<'m, true>;
+
+impl<'m> Tet80Tracer<'m, false> {
+    /// Encodes `mesh` (validated) in the Tet80 layout: the faithful walk.
     pub fn new(mesh: &'m TetMesh) -> Result<Self, LayoutError> {
+        Self::with_layout(mesh)
+    }
+}
+
+impl<'m> Tet80Tracer<'m, true> {
+    /// Encodes `mesh` (validated) in the Tet80 layout: the consistent walk.
+    pub fn consistent(mesh: &'m TetMesh) -> Result<Self, LayoutError> {
+        Self::with_layout(mesh)
+    }
+}
+
+impl<'m, const CONSISTENT: bool> Tet80Tracer<'m, CONSISTENT> {
+    fn with_layout(mesh: &'m TetMesh) -> Result<Self, LayoutError> {
         Ok(Tet80Tracer {
             mesh,
             layout: Tet80Mesh::from_mesh(mesh)?,
@@ -132,7 +188,7 @@ impl<'m> Tet80Tracer<'m> {
         stop: S,
     ) -> TraceOutcome {
         let tets = &self.layout.tets[..];
-        let (o, d) = (ray.origin, ray.direction);
+        let side = Side::<CONSISTENT>::new(ray);
         loop {
             if visited >= self.cap {
                 return TraceOutcome::Failed {
@@ -147,7 +203,7 @@ impl<'m> Tet80Tracer<'m> {
                 };
             }
             let rec = &tets[tet as usize];
-            let exit = exit_face(|k| rec.vertex(k), o, d, entry);
+            let exit = side.exit_face(|k| rec.vertex(k), entry);
             match self.leave(ray, tet, rec.f[exit], visited) {
                 Ok((n, f)) => {
                     tet = n;
@@ -203,12 +259,12 @@ impl<'m> Tet80Tracer<'m> {
     }
 }
 
-impl Tet80Tracer<'_> {
+impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
     /// Maria et al.'s Algorithm 2 on start tet `tet` (see [`algorithm2`]).
     #[inline(always)]
     pub fn algorithm2_exit_face(&self, ray: &Ray, tet: u32) -> usize {
         let rec = &self.layout.tets[tet as usize];
-        algorithm2(|k| rec.vertex(k), ray.origin, ray.direction)
+        Side::<CONSISTENT>::new(ray).algorithm2(|k| rec.vertex(k))
     }
 
     /// The start of a walk from `Start::Tet(t)`: the start tet and its exit
@@ -218,6 +274,10 @@ impl Tet80Tracer<'_> {
     fn start_tet(&self, ray: &Ray, t: u32, inside: bool) -> Option<(u32, usize)> {
         if inside {
             Some((t, self.algorithm2_exit_face(ray, t)))
+        } else if CONSISTENT {
+            // The engine's search with the same projected vertices and tie
+            // rule as the walk.
+            start_exit_face::<DuffF32>(self.mesh, ray, t)
         } else {
             start_exit_face::<TripleF32>(self.mesh, ray, t)
         }
@@ -299,18 +359,94 @@ impl Tet80Tracer<'_> {
     }
 }
 
-/// Algorithm 1 (two side products in the frame of the entry face's
-/// complement vertex `V_e`) in the tet whose slot-`k` vertex is `v(k)`,
-/// entered through face `entry`.
+/// How a walk decides which side of an edge the ray passes: in the frame
+/// of the entry face's complement vertex (faithful, `CONSISTENT = false`)
+/// or from each vertex's projection into the ray's frame (consistent; see
+/// the module docs).
+#[derive(Clone, Copy)]
+struct Side<const CONSISTENT: bool> {
+    o: Vec3,
+    d: Vec3,
+    /// The ray's 2-D frame (consistent only; unused otherwise).
+    projection: Option<DuffF32>,
+}
+
+impl<const CONSISTENT: bool> Side<CONSISTENT> {
+    #[inline(always)]
+    fn new(ray: &Ray) -> Self {
+        Side {
+            o: ray.origin,
+            d: ray.direction,
+            projection: CONSISTENT.then(|| DuffF32::setup(ray)),
+        }
+    }
+
+    /// Algorithm 1 in the tet whose slot-`k` vertex is `v(k)`, entered
+    /// through face `entry`: two side products of edges from the entry
+    /// face's complement vertex `V_e`.
+    #[inline(always)]
+    fn exit_face(&self, v: impl Fn(usize) -> Vec3, entry: usize) -> usize {
+        let apex = v(entry);
+        let a = FACE_VERTICES[entry][0];
+        let (s1, s2) = match &self.projection {
+            Some(p) if CONSISTENT => {
+                let pa = p.project(apex);
+                let s1 = left_projected(pa, apex, p.project(v(a)), v(a));
+                let second = v(SECOND[entry][s1 as usize] as usize);
+                (s1, left_projected(pa, apex, p.project(second), second))
+            }
+            _ => {
+                let m = self.d.cross(apex - self.o);
+                let s1 = (v(a) - apex).dot(m) > 0.0;
+                let second = SECOND[entry][s1 as usize] as usize;
+                (s1, (v(second) - apex).dot(m) > 0.0)
+            }
+        };
+        EXIT[entry][2 * s1 as usize + s2 as usize] as usize
+    }
+
+    /// Algorithm 2 (see [`algorithm2`]) with this side rule.
+    #[inline(always)]
+    fn algorithm2(&self, v: impl Fn(usize) -> Vec3) -> usize {
+        let v2 = v(2);
+        // left(V₂ → V₃) = d · ((V₂ − o) × (V₃ − V₂)) = (V₃ − V₂) · (d × (V₂ − o)).
+        let left23 = match &self.projection {
+            Some(p) if CONSISTENT => left_projected(p.project(v2), v2, p.project(v(3)), v(3)),
+            _ => (v(3) - v2).dot(self.d.cross(v2 - self.o)) > 0.0,
+        };
+        // Exiting through F₀ = (V₁, V₂, V₃) needs the ray left of V₂ → V₃,
+        // through F₁ = (V₀, V₃, V₂) left of V₃ → V₂: left of V₂ → V₃ rules
+        // out F₁.
+        let entry = if left23 { 1 } else { 0 };
+        self.exit_face(v, entry)
+    }
+}
+
+/// True when `p` comes before `q` in the lexicographic order of positions
+/// (x, then y, then z): the last tie-break of the consistent side test.
 #[inline(always)]
-fn exit_face(v: impl Fn(usize) -> Vec3, o: Vec3, d: Vec3, entry: usize) -> usize {
-    let apex = v(entry);
-    let m = d.cross(apex - o);
-    let a = FACE_VERTICES[entry][0];
-    let s1 = (v(a) - apex).dot(m) > 0.0;
-    let second = SECOND[entry][s1 as usize] as usize;
-    let s2 = (v(second) - apex).dot(m) > 0.0;
-    EXIT[entry][2 * s1 as usize + s2 as usize] as usize
+fn lex_less(p: Vec3, q: Vec3) -> bool {
+    (p.x, p.y, p.z) < (q.x, q.y, q.z)
+}
+
+/// The consistent side test on projected vertices `pp`, `pq` (of the 3-D
+/// positions `p`, `q`): the ray passes left of `p → q`. Exactly
+/// antisymmetric, with the projections' tie rule.
+#[inline(always)]
+fn left_projected(pp: glam::Vec2, p: Vec3, pq: glam::Vec2, q: Vec3) -> bool {
+    let (ip, iq) = if lex_less(p, q) { (0, 1) } else { (1, 0) };
+    left_f32(pp, ip, pq, iq)
+}
+
+/// The consistent side test of `tet80-consistent` for one ray: does the ray
+/// `o + t·d` pass left of the directed edge `p → q`, i.e. is the Plücker
+/// side product `d · ((p − o) × (q − o))` positive, evaluated as the 2-D
+/// determinant of `p` and `q` projected into the ray's frame, with one rule
+/// for zero. `left_of(p, q, ray) == !left_of(q, p, ray)` for distinct
+/// points, and the answer depends only on the edge and the ray.
+pub fn left_of(p: Vec3, q: Vec3, ray: &Ray) -> bool {
+    let proj = DuffF32::setup(ray);
+    left_projected(proj.project(p), p, proj.project(q), q)
 }
 
 /// Maria et al.'s Algorithm 2: the exit face of a start tet (slot-`k`
@@ -322,13 +458,12 @@ fn exit_face(v: impl Fn(usize) -> Vec3, o: Vec3, d: Vec3, entry: usize) -> usize
 /// products in all.
 #[inline(always)]
 pub fn algorithm2(v: impl Fn(usize) -> Vec3, o: Vec3, d: Vec3) -> usize {
-    let v2 = v(2);
-    // left(V₂ → V₃) = d · ((V₂ − o) × (V₃ − V₂)) = (V₃ − V₂) · (d × (V₂ − o)).
-    let s23 = (v(3) - v2).dot(d.cross(v2 - o));
-    // Exiting through F₀ = (V₁, V₂, V₃) needs the ray left of V₂ → V₃,
-    // through F₁ = (V₀, V₃, V₂) left of V₃ → V₂: `s23 > 0` rules out F₁.
-    let entry = if s23 > 0.0 { 1 } else { 0 };
-    exit_face(v, o, d, entry)
+    Side::<false> {
+        o,
+        d,
+        projection: None,
+    }
+    .algorithm2(v)
 }
 
 /// True when `p` lies strictly inside tet `t` of `mesh` (exact orientation
@@ -355,9 +490,13 @@ pub fn start_exit(mesh: &TetMesh, ray: &Ray, t: u32) -> Option<(u32, usize)> {
     }
 }
 
-impl Tracer for Tet80Tracer<'_> {
+impl<const CONSISTENT: bool> Tracer for Tet80Tracer<'_, CONSISTENT> {
     fn name(&self) -> String {
-        "tet80/f32".into()
+        if CONSISTENT {
+            "tet80-consistent/f32".into()
+        } else {
+            "tet80/f32".into()
+        }
     }
     fn mesh(&self) -> &TetMesh {
         self.mesh
@@ -387,7 +526,7 @@ impl Tracer for Tet80Tracer<'_> {
     }
 }
 
-impl ShadowTracer for Tet80Tracer<'_> {
+impl<const CONSISTENT: bool> ShadowTracer for Tet80Tracer<'_, CONSISTENT> {
     fn mesh(&self) -> &TetMesh {
         self.mesh
     }
