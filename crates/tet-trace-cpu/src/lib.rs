@@ -12,6 +12,8 @@
 //!   batch walk each projection takes;
 //! * [`scaled`]: the scaled basis of Eq. 1–3, specialised per direction case;
 //! * kernels, one per method: [`sctp`], [`tet32`], [`tet20`], [`tet16`], [`tet80`];
+//! * [`exact`]: the exact reference walk (exact predicates, symbolic
+//!   perturbation), the yardstick of the accuracy measurement;
 //! * [`mod@reference`]: f64 brute-force closest hit and ray generators for tests;
 //! * [`render`]: pinhole renderer, Lambert shading, PNG, heat maps, stats;
 //! * [`secondary`]: shadow, reflection and refraction rays (seed 000 §6).
@@ -41,6 +43,7 @@
 pub mod area_light;
 pub mod batch;
 pub mod entry;
+pub mod exact;
 pub mod kernel;
 pub mod locate;
 pub mod lockstep;
