@@ -44,7 +44,7 @@ use tet_trace_cpu::Viewpoint;
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Failure, Hit, Ray, TraceOutcome};
 use tet_trace_cpu::reference::{
-    Aim, edge_distance, line_triangle, random_ray, ray_triangle, segment_distance,
+    Aim, edge_distance, line_triangle, random_direction, random_ray, ray_triangle, segment_distance,
 };
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Start;
@@ -378,8 +378,16 @@ pub struct RaySet {
 
 /// Camera rays of a `side × side` image plus `n` rays from random interior
 /// points: 70 % random directions, 10 % aimed at vertices, 10 % at edge
-/// midpoints, 10 % at face centroids.
-pub fn ray_set(loaded: &Loaded, mesh: &TetMesh, side: u32, n: usize, seed: u64) -> Result<RaySet> {
+/// midpoints, 10 % at face centroids; then `adversarial` rays of
+/// [`adversarial_rays`] (same seed).
+pub fn ray_set(
+    loaded: &Loaded,
+    mesh: &TetMesh,
+    side: u32,
+    n: usize,
+    adversarial: usize,
+    seed: u64,
+) -> Result<RaySet> {
     let mut rays = Vec::with_capacity((side * side) as usize + n);
     let mut view = None;
     if side > 0 {
@@ -405,7 +413,78 @@ pub fn ray_set(loaded: &Loaded, mesh: &TetMesh, side: u32, n: usize, seed: u64) 
         let (ray, tet) = random_ray(mesh, &mut rng, aim);
         rays.push((ray, Some(Start::Tet(tet))));
     }
+    rays.extend(adversarial_rays(mesh, adversarial, seed));
     Ok(RaySet { rays, view })
+}
+
+/// `n` rays (`accuracy --adversarial`) aimed at or started on the mesh's
+/// features, where a floating-point walk must decide ties: in turn, from a
+/// random interior point exactly at a vertex, at a point of an edge, at a
+/// point of a face; along an edge (from one vertex of a tet towards
+/// another); from a point of a face, and from a vertex, in a random
+/// direction. The triangle each ray uses is a scene triangle every other
+/// ray and a face of a random tet (a scene triangle or not) otherwise.
+/// Points of edges and faces are random combinations rounded to f32 (on
+/// the feature up to that rounding). Each ray starts in a tet holding its
+/// origin (exact location).
+pub fn adversarial_rays(mesh: &TetMesh, n: usize, seed: u64) -> Vec<(Ray, Option<Start>)> {
+    let mut rng = SplitMix64(seed ^ 0xad5e_7a71);
+    let mut out = Vec::with_capacity(n);
+    if mesh.tets.is_empty() {
+        return out;
+    }
+    let (tets, scene) = (mesh.tets.len() as u64, mesh.constrained.len() as u64);
+    for k in 0..n {
+        let t = (rng.next_u64() % tets) as u32;
+        let p = mesh.tet_points(t);
+        let (tri, near) = if k % 2 == 0 && scene > 0 {
+            let cf = &mesh.constrained[(rng.next_u64() % scene) as usize];
+            let near = if cf.front.exists() {
+                cf.front.tet
+            } else {
+                cf.back.tet
+            };
+            (cf.vertices.map(|v| mesh.points[v as usize]), near)
+        } else {
+            let f = tet_core::FACE_VERTICES[(rng.next_u64() % 4) as usize];
+            (f.map(|s| p[s]), t)
+        };
+        let (a, b) = (rng.next_f64(), rng.next_f64());
+        let on_edge = tri[0].as_dvec3().lerp(tri[1].as_dvec3(), a).as_vec3();
+        let (a, b) = if a + b > 1.0 {
+            (1.0 - a, 1.0 - b)
+        } else {
+            (a, b)
+        };
+        let d = tri.map(|v| v.as_dvec3());
+        let on_face = (d[0] + (d[1] - d[0]) * a + (d[2] - d[0]) * b).as_vec3();
+        let (origin, dir, hint) = match k % 6 {
+            0..=2 => {
+                let (o, at) = tet_trace_cpu::reference::random_point_inside(mesh, &mut rng);
+                let target = [tri[0], on_edge, on_face][k % 6];
+                (o, target - o, at)
+            }
+            3 => {
+                let r = rng.next_u64() as usize;
+                let (i, j) = (r % 4, (r % 4 + 1 + r / 4 % 3) % 4);
+                (p[i], p[j] - p[i], t)
+            }
+            4 => (on_face, random_direction(&mut rng), near),
+            _ => (tri[0], random_direction(&mut rng), near),
+        };
+        if dir.length_squared() == 0.0 || !dir.is_finite() {
+            continue;
+        }
+        let hint = if hint < mesh.tets.len() as u32 {
+            hint
+        } else {
+            t
+        };
+        if let Ok(start) = tet_trace_cpu::locate(mesh, origin, hint) {
+            out.push((Ray::new(origin, dir), Some(Start::Tet(start))));
+        }
+    }
+    out
 }
 
 /// Timed passes per measurement, at least (the best is reported).
@@ -422,6 +501,8 @@ pub struct RayPlan {
     pub seed: u64,
     /// Seconds each method's passes over the rays take at least, in all.
     pub min_time_s: f64,
+    /// Rays aimed at or started on mesh features ([`adversarial_rays`]).
+    pub adversarial: usize,
 }
 
 /// Traces every ray of `set` once with `t`, in parallel.
@@ -583,7 +664,14 @@ pub fn run_case(
 ) -> Result<CaseAccuracy> {
     let mesh = &loaded.mesh;
     let reference = Reference::new(mesh);
-    let set = ray_set(loaded, mesh, plan.side, plan.random, plan.seed)?;
+    let set = ray_set(
+        loaded,
+        mesh,
+        plan.side,
+        plan.random,
+        plan.adversarial,
+        plan.seed,
+    )?;
     let expected: Vec<Option<RefHit>> = set
         .rays
         .par_iter()
@@ -876,6 +964,37 @@ mod tests {
         let exp = expected(&reference, &set);
         let m = check(&AlwaysMiss(&mesh), "f32", &reference, &exp, &set, 0.0);
         assert_eq!((m.leaks, m.ambiguous, m.failures), (2, 0, 2), "{m:?}");
+    }
+
+    /// The exact walk against the reference on every adversarial ray of
+    /// jittered grids with a closed shell and random scene triangles: no
+    /// failure of any kind, only agreement or a ray the reference itself
+    /// calls ambiguous.
+    #[test]
+    fn the_exact_walk_passes_every_adversarial_ray() {
+        for (seed, jitter) in [(1u64, 0.0f32), (2, 0.12)] {
+            let grid = kuhn_grid(&GridSpec {
+                cells: [5, 5, 5],
+                jitter,
+                shell: Some(([1, 1, 1], [4, 4, 4])),
+                constrained_fraction: 0.05,
+                seed,
+                ..Default::default()
+            });
+            grid.validate().unwrap();
+            let reference = Reference::new(&grid);
+            let set = RaySet {
+                rays: adversarial_rays(&grid, 1200, seed),
+                view: None,
+            };
+            assert!(set.rays.len() > 1100, "{}", set.rays.len());
+            let exp = expected(&reference, &set);
+            let t = tracer(Method::Exact, false, &grid).unwrap();
+            let m = check(t.as_ref(), "f32", &reference, &exp, &set, 0.0);
+            assert_eq!(m.failures, 0, "{m:?}");
+            assert_eq!(m.agree + m.ambiguous, m.rays, "{m:?}");
+            assert!(m.agree > m.rays / 2, "{m:?}");
+        }
     }
 
     #[test]

@@ -147,6 +147,9 @@ pub enum Method {
     Embree8,
     /// f64 brute force over all triangles (reference; slow).
     Brute,
+    /// The exact reference walk: exact side products with a symbolic tie
+    /// rule (reference; not in the default comparisons).
+    Exact,
     /// Tet20 walk as a wgpu compute shader (needs the `gpu` feature).
     GpuTet20,
     /// Tet32 on the GPU.
@@ -171,6 +174,7 @@ impl Method {
             Method::Embree => "embree",
             Method::Embree8 => "embree8",
             Method::Brute => "brute",
+            Method::Exact => "exact",
             Method::GpuTet20 => "gpu-tet20",
             Method::GpuTet32 => "gpu-tet32",
             Method::GpuTet16 => "gpu-tet16",
@@ -302,6 +306,11 @@ pub struct AccuracyArgs {
     /// Repeat on the scene scaled by 1e-4 and 1e4 and translated by 1e5.
     #[arg(long)]
     pub extremes: bool,
+    /// Add as many adversarial rays as `--rays`: aimed exactly at mesh
+    /// vertices, at points of edges and faces (scene triangles or not),
+    /// along edges, and started on faces and vertices.
+    #[arg(long)]
+    pub adversarial: bool,
     /// Kernel precision.
     #[arg(long, value_enum, default_value_t = Precision::F32)]
     pub precision: Precision,

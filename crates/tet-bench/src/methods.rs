@@ -36,6 +36,7 @@ pub fn tracer<'m>(method: Method, f64: bool, mesh: &'m TetMesh) -> Result<Box<dy
             method.name()
         ),
         (Method::Brute, _) => Box::new(crate::brute::BruteTracer { mesh }),
+        (Method::Exact, false) => Box::new(tet_trace_cpu::exact::ExactTracer::new(mesh)),
         (m, true) => bail!("method {} has no f64 variant", m.name()),
         (m, false) => bail!("{} runs on the GPU: only `render` supports it", m.name()),
     })

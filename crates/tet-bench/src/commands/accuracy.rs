@@ -58,6 +58,7 @@ pub fn run(args: &AccuracyArgs, json: bool) -> Result<()> {
             random: args.rays,
             seed: args.seed,
             min_time_s: args.min_time,
+            adversarial: if args.adversarial { args.rays } else { 0 },
         },
         args.extremes.then_some(&args.build),
         json,

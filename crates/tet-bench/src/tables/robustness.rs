@@ -32,6 +32,7 @@ pub fn measure(
         random: rays,
         seed: 1,
         min_time_s,
+        adversarial: 0,
     };
     run_case("as-is", loaded, methods, Precision::F32, plan)
 }

@@ -26,6 +26,7 @@ pub fn measure(spec: &str, quick: bool, min_time_s: f64) -> SpeedAccuracy {
             random: rays,
             seed: 7,
             min_time_s,
+            adversarial: 0,
         };
         all_cases(
             &loaded,
