@@ -60,7 +60,7 @@ use tet_core::{FACE_VERTICES, NO_TET, TetMesh};
 
 use crate::kernel::Tracer;
 use crate::ray::{Failure, Hit, Ray, TraceOutcome};
-use crate::walk::{Start, face_hit, step_cap};
+use crate::walk::{EntryHint, LANES, Start, Starts, face_hit, prefetch_index, step_cap};
 use predicates::{Line, side_filtered};
 use tet_core::predicates::orient3d_f32;
 
@@ -111,21 +111,22 @@ impl<'m> ExactTracer<'m> {
     /// products around the apex (see the module docs).
     #[inline(always)]
     fn exit_from(&self, line: &Line, tet: u32, entry: usize) -> usize {
-        let p = self.points(tet);
-        let apex = line.rel(p[entry]);
+        let ids = &self.mesh.tets[tet as usize];
+        let rel = |slot: usize| line.rel(self.mesh.points[ids[slot] as usize]);
+        let apex = rel(entry);
         let x0 = FACE_VERTICES[entry][0];
         let x1 = NEXT[entry][x0] as usize;
         let x2 = NEXT[entry][x1] as usize;
         // Faces around the apex: (apex, x0, x1) opposite x2, (apex, x1, x2)
         // opposite x0, (apex, x2, x0) opposite x1; the line leaves through
         // the one whose first edge it passes left of and second right of.
-        if side_filtered(line, &apex, &line.rel(p[x0])) {
-            if side_filtered(line, &apex, &line.rel(p[x1])) {
+        if side_filtered(line, &apex, &rel(x0)) {
+            if side_filtered(line, &apex, &rel(x1)) {
                 x0
             } else {
                 x2
             }
-        } else if side_filtered(line, &apex, &line.rel(p[x2])) {
+        } else if side_filtered(line, &apex, &rel(x2)) {
             x1
         } else {
             x0
@@ -153,85 +154,128 @@ impl<'m> ExactTracer<'m> {
             .all(|&[a, b, c]| orient3d_f32(p[a], p[b], p[c], o) <= 0.0)
     }
 
-    /// The walk from `tet`, entered through `entry` (`None`: the line's
-    /// exit face is searched among all four). Constrained faces are hits
-    /// as `accept` says.
-    fn walk(
-        &self,
-        ray: &Ray,
-        line: &Line,
-        mut tet: u32,
-        mut entry: Option<usize>,
-        mut visited: u32,
-        accept: Accept,
-    ) -> TraceOutcome {
-        loop {
-            if visited >= self.cap {
-                return TraceOutcome::Failed {
-                    failure: Failure::StepCap,
-                    tets_visited: visited,
-                };
-            }
-            visited += 1;
-            let exit = match entry {
+    /// One step of `w`: enters its tet and leaves it; `Some(outcome)` when
+    /// the walk ends. Moving on to a neighbour prefetches its records, and
+    /// the entry face there is found at the next step (by then loaded).
+    #[inline(always)]
+    fn step(&self, ray: &Ray, w: &mut Walk) -> Option<TraceOutcome> {
+        if w.visited >= self.cap {
+            return Some(TraceOutcome::Failed {
+                failure: Failure::StepCap,
+                tets_visited: w.visited,
+            });
+        }
+        w.visited += 1;
+        let (tet, line) = (w.tet, &w.line);
+        let exit = match w.entry {
+            Entry::Face(e) => self.exit_from(line, tet, e as usize),
+            Entry::From(prev) => match self.mesh.face_towards(tet, prev) {
                 Some(e) => self.exit_from(line, tet, e),
-                None => match self.crossing_face(line, tet) {
-                    Some(x) => x,
-                    None => return lost(visited),
-                },
-            };
-            let link: Link = self.mesh.neighbors[tet as usize][exit];
-            if let Some(n) = link.as_tet() {
-                match self.mesh.face_towards(n, tet) {
-                    Some(f) => {
-                        tet = n;
-                        entry = Some(f);
-                        continue;
-                    }
-                    None => return lost(visited),
+                None => return Some(lost(w.visited)),
+            },
+            Entry::Any => match self.crossing_face(line, tet) {
+                Some(x) => x,
+                None => return Some(lost(w.visited)),
+            },
+        };
+        let link: Link = self.mesh.neighbors[tet as usize][exit];
+        if let Some(n) = link.as_tet() {
+            prefetch_index(&self.mesh.tets, n);
+            prefetch_index(&self.mesh.neighbors, n);
+            w.tet = n;
+            w.entry = Entry::From(tet);
+            return None;
+        }
+        let miss = TraceOutcome::Miss {
+            tets_visited: w.visited,
+        };
+        let Some(c) = link.as_constrained() else {
+            return Some(miss);
+        };
+        let Some(cf) = self.mesh.constrained.get(c as usize) else {
+            return Some(lost(w.visited));
+        };
+        if w.accept.skip != Some(c) {
+            let (t, bary) = face_hit(self.mesh, ray, cf.vertices);
+            if w.accept.any_t || t >= ray.t_min as f64 {
+                if t > ray.t_max as f64 {
+                    return Some(miss);
                 }
-            }
-            let Some(c) = link.as_constrained() else {
-                return TraceOutcome::Miss {
-                    tets_visited: visited,
-                };
-            };
-            let Some(cf) = self.mesh.constrained.get(c as usize) else {
-                return lost(visited);
-            };
-            if accept.skip != Some(c) {
-                let (t, w) = face_hit(self.mesh, ray, cf.vertices);
-                if accept.any_t || t >= ray.t_min as f64 {
-                    if t > ray.t_max as f64 {
-                        return TraceOutcome::Miss {
-                            tets_visited: visited,
-                        };
-                    }
-                    let far = cf.other_side(tet).map_or(NO_TET, |s| s.tet);
-                    return TraceOutcome::Hit(Hit {
-                        triangle: cf.triangle,
-                        face: c,
-                        t: t.max(0.0) as f32,
-                        barycentrics: w.map(|x| x as f32),
-                        tet,
-                        far_tet: far,
-                        tets_visited: visited,
-                    });
-                }
-            }
-            match cf.other_side(tet).filter(|s| s.exists()) {
-                Some(s) => {
-                    tet = s.tet;
-                    entry = Some(s.face as usize);
-                }
-                None => {
-                    return TraceOutcome::Miss {
-                        tets_visited: visited,
-                    };
-                }
+                let far = cf.other_side(tet).map_or(NO_TET, |s| s.tet);
+                return Some(TraceOutcome::Hit(Hit {
+                    triangle: cf.triangle,
+                    face: c,
+                    t: t.max(0.0) as f32,
+                    barycentrics: bary.map(|x| x as f32),
+                    tet,
+                    far_tet: far,
+                    tets_visited: w.visited,
+                }));
             }
         }
+        match cf.other_side(tet).filter(|s| s.exists()) {
+            Some(s) => {
+                w.tet = s.tet;
+                w.entry = Entry::Face(s.face as u8);
+                None
+            }
+            None => Some(miss),
+        }
     }
+
+    /// The walk of `ray` from `start`, ready for its first step, or the
+    /// outcome when it cannot begin.
+    fn begin(&self, ray: &Ray, start: Start) -> Result<Walk, TraceOutcome> {
+        if !ray.is_valid() {
+            return Err(TraceOutcome::Failed {
+                failure: Failure::InvalidRay,
+                tets_visited: 0,
+            });
+        }
+        let n = self.mesh.tets.len() as u32;
+        let (tet, skip) = match start {
+            Start::Tet(t) if t < n && self.holds(ray.origin, t) => (t, None),
+            Start::Face { face, tet } if tet < n => {
+                match self.mesh.constrained.get(face as usize) {
+                    Some(cf) if cf.side_of(tet).is_some() => (tet, Some(face)),
+                    _ => return Err(lost(0)),
+                }
+            }
+            Start::Entry { tet, face } if self.mesh.is_boundary_face(tet, face) => (tet, None),
+            _ => return Err(lost(0)),
+        };
+        Ok(Walk {
+            line: Line::new(ray.origin, ray.direction, self.points(tet)),
+            accept: Accept {
+                any_t: matches!(start, Start::Tet(_)) && ray.t_min <= 0.0,
+                skip,
+            },
+            tet,
+            entry: Entry::Any,
+            visited: 0,
+        })
+    }
+}
+
+/// How a walk entered its current tet.
+#[derive(Clone, Copy)]
+enum Entry {
+    /// The first tet: the exit is searched among all four faces.
+    Any,
+    /// Through this face.
+    Face(u8),
+    /// From this neighbour (the face is found when the tet is loaded).
+    From(u32),
+}
+
+/// One walk in progress.
+#[derive(Clone, Copy)]
+struct Walk {
+    line: Line,
+    accept: Accept,
+    tet: u32,
+    entry: Entry,
+    visited: u32,
 }
 
 /// The exact walk's decision for one directed edge: true when `ray`'s
@@ -269,30 +313,60 @@ impl Tracer for ExactTracer<'_> {
         self.mesh
     }
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
-        if !ray.is_valid() {
-            return TraceOutcome::Failed {
-                failure: Failure::InvalidRay,
-                tets_visited: 0,
-            };
+        let mut w = match self.begin(ray, start) {
+            Ok(w) => w,
+            Err(out) => return out,
+        };
+        loop {
+            if let Some(out) = self.step(ray, &mut w) {
+                return out;
+            }
         }
-        let n = self.mesh.tets.len() as u32;
-        let (tet, skip) = match start {
-            Start::Tet(t) if t < n && self.holds(ray.origin, t) => (t, None),
-            Start::Face { face, tet } if tet < n => {
-                match self.mesh.constrained.get(face as usize) {
-                    Some(cf) if cf.side_of(tet).is_some() => (tet, Some(face)),
-                    _ => return lost(0),
+    }
+
+    fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
+        self.trace_batch_from(rays, Starts::Same(start), out)
+    }
+
+    /// [`LANES`] walks per thread, one step each per round (the same steps
+    /// as [`Tracer::trace`], so the same outcomes): their memory loads
+    /// overlap.
+    fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
+        let mut n = rays.len().min(out.len());
+        if let Starts::Each(s) = starts {
+            n = n.min(s.len());
+        }
+        let mut hint = EntryHint::default();
+        let mut lanes: [Option<(usize, Walk)>; LANES] = [None; LANES];
+        let mut next = 0;
+        loop {
+            let mut active = false;
+            for lane in lanes.iter_mut() {
+                while lane.is_none() && next < n {
+                    let (i, r) = (next, &rays[next]);
+                    next += 1;
+                    let start = match starts {
+                        Starts::Same(s) => Ok(s),
+                        Starts::Each(s) => Ok(s[i]),
+                        Starts::Outside(entry) => self.start_outside(entry, r, &mut hint),
+                    };
+                    match start.and_then(|s| self.begin(r, s)) {
+                        Ok(w) => *lane = Some((i, w)),
+                        Err(done) => out[i] = done,
+                    }
+                }
+                if let Some((i, w)) = lane {
+                    active = true;
+                    if let Some(o) = self.step(&rays[*i], w) {
+                        out[*i] = o;
+                        *lane = None;
+                    }
                 }
             }
-            Start::Entry { tet, face } if self.mesh.is_boundary_face(tet, face) => (tet, None),
-            _ => return lost(0),
-        };
-        let line = Line::new(ray.origin, ray.direction, self.points(tet));
-        let accept = Accept {
-            any_t: matches!(start, Start::Tet(_)) && ray.t_min <= 0.0,
-            skip,
-        };
-        self.walk(ray, &line, tet, None, 0, accept)
+            if !active {
+                break;
+            }
+        }
     }
 }
 

@@ -10,10 +10,10 @@ use tet_core::TetMesh;
 use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::exact::{ExactTracer, left_of};
 use tet_trace_cpu::reference::{Aim, axis_ray, closest_hit, random_ray, ray_from_feature};
-use tet_trace_cpu::{Ray, Start, TraceOutcome, Tracer, locate};
+use tet_trace_cpu::{Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint, locate};
 
 mod common;
-use common::{assert_outcomes_match, grid, unambiguous_reference};
+use common::{assert_outcomes_match, bits, grid, unambiguous_reference};
 
 /// Traces `ray` from the tet holding its origin: never a failure, and the
 /// reference's answer on unambiguous rays. Returns the outcome and whether
@@ -77,6 +77,55 @@ fn random_faces_agree_with_reference() {
         let mesh = grid(4, jitter, 0.3, false, seed);
         let checked = run(&mesh, seed * 13, 450);
         assert!(checked > 150, "too few unambiguous rays: {checked}");
+    }
+}
+
+/// The interleaved batch walk gives each ray's single-ray outcome, bit for
+/// bit, from one start, from a start per ray and from outside the mesh.
+#[test]
+fn batches_equal_single_rays() {
+    let mesh = grid(4, 0.1, 0.2, true, 9);
+    let tracer = ExactTracer::new(&mesh);
+    let mut rng = SplitMix64(9);
+    let rays = adversarial_rays(&mesh, &mut rng, 200);
+    let starts: Vec<Start> = rays
+        .iter()
+        .map(|r| Start::Tet(locate(&mesh, r.origin, 0).unwrap()))
+        .collect();
+    let mut out = vec![TraceOutcome::Miss { tets_visited: 0 }; rays.len()];
+    tracer.trace_batch_from(&rays, Starts::Each(&starts), &mut out);
+    for ((r, s), o) in rays.iter().zip(&starts).zip(&out) {
+        assert_eq!(bits(o), bits(&tracer.trace(r, *s)), "{r:?}");
+    }
+    // One origin for all (a camera inside the mesh).
+    let origin = Vec3::new(1.3, 2.2, 1.7);
+    let start = Start::Tet(locate(&mesh, origin, 0).unwrap());
+    let fan: Vec<Ray> = (0..100)
+        .map(|_| Ray::new(origin, tet_trace_cpu::reference::random_direction(&mut rng)))
+        .collect();
+    let mut out = vec![TraceOutcome::Miss { tets_visited: 0 }; fan.len()];
+    tracer.trace_batch(&fan, start, &mut out);
+    for (r, o) in fan.iter().zip(&out) {
+        assert_eq!(bits(o), bits(&tracer.trace(r, start)), "{r:?}");
+    }
+    // From outside the mesh: every ray enters and gets the reference's
+    // answer where it is unambiguous.
+    let eye = Vec3::new(-3.0, 1.9, 2.3);
+    let view = Viewpoint::locate(&mesh, eye).unwrap();
+    let rays: Vec<Ray> = (0..100)
+        .map(|i| {
+            let target = Vec3::new(2.0, 0.3 + 0.035 * i as f32, 1.0 + 0.02 * i as f32);
+            Ray::new(eye, target - eye)
+        })
+        .collect();
+    let mut out = vec![TraceOutcome::Miss { tets_visited: 0 }; rays.len()];
+    view.trace_batch(&tracer, &rays, &mut out);
+    let boxed: Vec<Box<dyn Tracer + '_>> = vec![Box::new(ExactTracer::new(&mesh))];
+    for (r, o) in rays.iter().zip(&out) {
+        assert!(!o.is_failure(), "{r:?}: {o:?}");
+        if let Some(reference) = unambiguous_reference(&mesh, r) {
+            assert_outcomes_match(&boxed, &[*o], r, reference);
+        }
     }
 }
 
