@@ -28,7 +28,14 @@
 //! Cost: the side products are first evaluated in f64 with an error bound
 //! ([`predicates`]); the exact sum (a 960-bit fixed-point accumulation)
 //! only runs when the bound cannot decide, which in practice is a ray
-//! through (or within ~10⁻¹⁴ relative of) a vertex or an edge.
+//! through (or within ~10⁻¹⁴ relative of) a vertex or an edge. Per tet:
+//! the entry face from the previous tet's ids, three vertices relative to
+//! the origin in f64 and two filtered side products. Batches walk
+//! [`LANES`] rays per thread round-robin, each prefetching its next tet,
+//! with the same outcomes as [`Tracer::trace`] ray by ray. It is a scalar
+//! walk over the canonical mesh (no compact layout, no SIMD): about the
+//! speed of the scalar Plücker walk ([`crate::tet80`]), several times
+//! slower than the lockstep Tet20 walk.
 //!
 //! # Start
 //!
