@@ -23,6 +23,7 @@
 mod assemble;
 pub mod error;
 mod faces;
+mod frame;
 pub mod options;
 mod prepare;
 mod reorder;
@@ -87,8 +88,14 @@ pub fn build(scene: &Scene, options: &BuildOptions) -> Result<(TetMesh, BuildRep
     let fixed_points = plc.input.points.len();
 
     // 3. TetGen and f32 rounding.
-    let rounded =
-        rounding::tetrahedralize_rounded(scene, plc.input, &tetgen_options, options, &progress)?;
+    let rounded = rounding::tetrahedralize_rounded(
+        scene,
+        plc.input,
+        &plc.frame,
+        &tetgen_options,
+        options,
+        &progress,
+    )?;
     let stats = &rounded.stats;
     report.tetgen_rounds = stats.rounds;
     report.rounding_failures = stats.failures.clone();
