@@ -18,7 +18,10 @@ use crate::procedural::BOX_TRIANGLES;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BoxSpec {
     /// Scene bounds grown on every side by `margin` × the largest scene
-    /// extent (at least a tiny absolute amount for flat scenes).
+    /// extent, and at least by `1e-4` × the largest coordinate magnitude
+    /// (a few hundred f32 steps, so the box stays strictly outside the
+    /// scene far from the origin). Both are relative: a scene and its
+    /// scaled copy get scaled boxes.
     Relative {
         /// Relative margin (e.g. 0.1).
         margin: f32,
@@ -69,6 +72,18 @@ pub enum BoxError {
     /// Margin is negative, zero or not finite.
     #[error("invalid relative margin {0}")]
     BadMargin(f32),
+    /// A corner of the box is not finite: grown around the scene, it
+    /// overflows f32 (or a fixed box was given with infinite corners).
+    #[error(
+        "the enclosing box {min:?}..{max:?} is not finite: it overflows f32, whose largest value is {limit:e}",
+        limit = f32::MAX
+    )]
+    Overflows {
+        /// Box lower corner.
+        min: Vec3,
+        /// Box upper corner.
+        max: Vec3,
+    },
 }
 
 /// An enclosing box: corners and outward triangles (local indices 0..8;
@@ -113,7 +128,7 @@ impl EnclosingBox {
                     return Err(BoxError::BadMargin(margin));
                 }
                 let extent = (smax - smin).max_element();
-                let scale = smin.abs().max(smax.abs()).max_element().max(1.0);
+                let scale = smin.abs().max(smax.abs()).max_element();
                 let pad = (margin * extent).max(scale * 1e-4);
                 (smin - Vec3::splat(pad), smax + Vec3::splat(pad))
             }
@@ -129,6 +144,9 @@ impl EnclosingBox {
                 (min, max)
             }
         };
+        if !(min.is_finite() && max.is_finite()) {
+            return Err(BoxError::Overflows { min, max });
+        }
         let corners = std::array::from_fn(|i| {
             Vec3::new(
                 if i & 1 != 0 { max.x } else { min.x },
@@ -222,6 +240,29 @@ mod tests {
         assert!(matches!(
             EnclosingBox::new(s.bounds(), BoxSpec::Relative { margin: -1.0 }),
             Err(BoxError::BadMargin(_))
+        ));
+    }
+
+    #[test]
+    fn relative_boxes_scale_with_the_scene_and_overflow_is_an_error() {
+        // A scene and its copy scaled by 2⁻¹⁰⁰ get boxes scaled by 2⁻¹⁰⁰:
+        // the pad is relative (no absolute floor that would dwarf a tiny scene).
+        let s = 2f32.powi(-100);
+        let (lo, hi) = (Vec3::new(-1.0, 0.0, 2.0), Vec3::new(1.0, 0.5, 3.0));
+        let unit = EnclosingBox::new(Some((lo, hi)), BoxSpec::default()).unwrap();
+        let tiny = EnclosingBox::new(Some((lo * s, hi * s)), BoxSpec::default()).unwrap();
+        assert_eq!((tiny.min, tiny.max), (unit.min * s, unit.max * s));
+        // Far from the origin the box keeps a margin of many f32 steps.
+        let far = EnclosingBox::new(
+            Some((Vec3::splat(1e5), Vec3::splat(1e5 + 0.01))),
+            BoxSpec::default(),
+        )
+        .unwrap();
+        assert!(far.min.x <= 1e5 - 10.0 && far.max.x >= 1e5 + 10.0);
+        let huge = (Vec3::splat(-3e38), Vec3::splat(3e38));
+        assert!(matches!(
+            EnclosingBox::new(Some(huge), BoxSpec::default()),
+            Err(BoxError::Overflows { .. })
         ));
     }
 

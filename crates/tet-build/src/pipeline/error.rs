@@ -82,6 +82,35 @@ pub enum BuildError {
     /// Resolving self-intersections failed (names input triangles).
     #[error("resolving self-intersections: {0}")]
     Resolve(#[from] ResolveError),
+    /// The scene's extent along an axis overflows f32: differences of its
+    /// coordinates (which building and tracing compute) are infinite.
+    #[error(
+        "the scene spans {min:e} to {max:e} along axis {axis} (vertex {vertex}): the extent overflows f32, whose largest value is {limit:e}",
+        limit = f32::MAX
+    )]
+    ExtentOverflows {
+        /// Axis (0 = x, 1 = y, 2 = z).
+        axis: u8,
+        /// Smallest coordinate on that axis.
+        min: f32,
+        /// Largest coordinate on that axis.
+        max: f32,
+        /// Input vertex at the end of larger magnitude.
+        vertex: u32,
+    },
+    /// Every coordinate of the scene is below the smallest normal f32, where
+    /// f32 keeps fewer than 24 significant bits: the stored points could not
+    /// hold the scene's shape nor its Steiner points.
+    #[error(
+        "every coordinate of the scene is below the smallest normal f32 ({limit:e}); the largest, {largest:e}, is at vertex {vertex}: f32 subnormals keep fewer than 24 significant bits",
+        limit = f32::MIN_POSITIVE
+    )]
+    SubnormalScene {
+        /// Largest coordinate magnitude.
+        largest: f32,
+        /// Input vertex that has it.
+        vertex: u32,
+    },
     /// Assembly or validation failed (a bug in this pipeline or TetGen).
     #[error("mesh: {0}")]
     Mesh(#[from] MeshError),

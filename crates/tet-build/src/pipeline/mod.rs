@@ -28,6 +28,7 @@
 mod assemble;
 pub mod error;
 mod faces;
+mod frame;
 pub mod options;
 mod prepare;
 mod reorder;
@@ -103,8 +104,14 @@ pub fn build(scene: &Scene, options: &BuildOptions) -> Result<(TetMesh, BuildRep
     let fixed_points = plc.input.points.len();
 
     // 4. TetGen and f32 rounding.
-    let rounded =
-        rounding::tetrahedralize_rounded(scene, plc.input, &tetgen_options, options, &progress)?;
+    let rounded = rounding::tetrahedralize_rounded(
+        scene,
+        plc.input,
+        &plc.frame,
+        &tetgen_options,
+        options,
+        &progress,
+    )?;
     let stats = &rounded.stats;
     report.tetgen_rounds = stats.rounds;
     report.rounding_failures = stats.failures.clone();

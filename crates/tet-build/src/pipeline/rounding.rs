@@ -3,10 +3,15 @@
 //! process or isolated ([`crate::tetgen::Isolation`]); its points are
 //! rounded to the f32 the mesh stores.
 //!
+//! TetGen works in the normalised [`Frame`] (the PLC centred and scaled to
+//! unit size by a power of two, exactly); its points are mapped back to the
+//! user's coordinates and rounded once to the nearest f32
+//! ([`Frame::user_point`]).
+//!
 //! TetGen computes Steiner points in f64. Every tet is checked with the
 //! exact f32 orientation. If rounding flattened or inverted some, each
 //! Steiner point of those tets is first *snapped*: among the f32 values
-//! within ±2 ulps of its f64 position (nearest first) the stage picks one
+//! within ±4 ulps of its f64 position (nearest first) the stage picks one
 //! that makes every tet around it positive (exact test), keeping TetGen's
 //! connectivity — the mesh stays a valid tetrahedralization of the same
 //! domain with the same constrained faces, only no longer exactly Delaunay
@@ -15,9 +20,11 @@
 //! predicates then see the very coordinates we store), up to
 //! [`BuildOptions::max_rounding_rounds`] times; a failure of such a re-run
 //! (e.g. a rounded point landing on a facet) or exhausting the rounds is
-//! [`BuildError::RoundingFlattens`], naming the tets. Input points are f32
-//! and convert to f64 exactly, so tets made of input points only are never
-//! affected.
+//! [`BuildError::RoundingFlattens`], naming the tets. Input points (and
+//! fed-back Steiner points) are f32 and map to the frame exactly, so tets
+//! made of input points only are never affected, and the exact orientation
+//! in the frame is the orientation of the stored points' exact values
+//! (the frame is a translation and a positive scaling).
 
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
@@ -27,13 +34,14 @@ use rayon::prelude::*;
 use tet_core::predicates::{orient3d, orient3d_f32};
 
 use super::error::{BuildError, self_intersection_error};
+use super::frame::Frame;
 use super::options::{BuildOptions, Stage};
 use crate::scene::Scene;
 use crate::tetgen::{TetgenError, TetgenInput, TetgenOptions, TetgenOutput, tetrahedralize};
 
 /// TetGen's output with positive tets on f32 points (output of this stage).
 pub(super) struct Rounded {
-    /// TetGen's last output (its raw tets and adjacency).
+    /// TetGen's last output (its raw tets and adjacency; points in the frame).
     pub out: TetgenOutput,
     /// The input of TetGen's last run (the PLC plus any rounded Steiner
     /// points fed back).
@@ -67,10 +75,11 @@ pub(super) struct RoundingStats {
 }
 
 /// Runs TetGen on `input` (the PLC of `scene`, for naming self-intersecting
-/// triangles) until rounding to f32 leaves every tet positive.
+/// triangles, in `frame`) until rounding to f32 leaves every tet positive.
 pub(super) fn tetrahedralize_rounded(
     scene: &Scene,
     mut input: TetgenInput,
+    frame: &Frame,
     tetgen_options: &TetgenOptions,
     options: &BuildOptions,
     progress: &dyn Fn(Stage),
@@ -110,17 +119,19 @@ pub(super) fn tetrahedralize_rounded(
         if let Some(i) = (0..input.points.len()).find(|&i| out.points[i] != input.points[i]) {
             return Err(BuildError::InputPointChanged { point: i });
         }
-        let mut points: Vec<Vec3> = out
-            .points
-            .iter()
-            .map(|p| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32))
-            .collect();
+        let mut points: Vec<Vec3> = out.points.iter().map(|&p| frame.user_point(p)).collect();
         let (tets, mut bad) = orient_tets(&out.points, &points, &out.tets);
         stats.failures.push(bad.len());
         if !bad.is_empty() {
             let snapped;
-            (snapped, bad) =
-                snap_steiner_points(&out.points, &mut points, &tets, &bad, input.points.len());
+            (snapped, bad) = snap_steiner_points(
+                &out.points,
+                frame,
+                &mut points,
+                &tets,
+                &bad,
+                input.points.len(),
+            );
             stats.snapped += snapped;
         }
         stats.rounding += t.elapsed();
@@ -144,27 +155,35 @@ pub(super) fn tetrahedralize_rounded(
         }
         last_bad = bad;
         // Feed the rounded Steiner points back as input points (deduplicated,
-        // and without any that coincide with an existing point).
-        let mut known: Vec<[u32; 3]> = input.points.iter().map(|p| key64(*p)).collect();
-        known.sort_unstable();
-        let mut extra: Vec<[f64; 3]> = steiner
+        // and without any that coincide with an existing point), in the
+        // frame: exact, so TetGen sees the very f32 values we store.
+        let mut known: Vec<[u32; 3]> = points[..input.points.len()]
             .iter()
-            .map(|p| p.as_dvec3().to_array())
-            .filter(|p| known.binary_search(&key64(*p)).is_err())
+            .map(|&p| key(p))
             .collect();
-        extra.sort_by_key(|p| key64(*p));
-        extra.dedup_by(|a, b| key64(*a) == key64(*b));
-        input.points.extend(extra);
+        known.sort_unstable();
+        let mut extra: Vec<Vec3> = steiner
+            .iter()
+            .copied()
+            .filter(|&p| known.binary_search(&key(p)).is_err())
+            .collect();
+        extra.sort_by_key(|&p| key(p));
+        extra.dedup_by_key(|p| key(*p));
+        input
+            .points
+            .extend(extra.into_iter().map(|p| frame.tetgen_point(p)));
     }
 }
 
-fn key64(p: [f64; 3]) -> [u32; 3] {
-    // Points here are f32 values widened to f64: compare their f32 bits.
-    [
-        (p[0] as f32 + 0.0).to_bits(),
-        (p[1] as f32 + 0.0).to_bits(),
-        (p[2] as f32 + 0.0).to_bits(),
-    ]
+/// How far (in ulps per coordinate) snapping looks for an f32 position
+/// that keeps every tet around a Steiner point positive: ±4, i.e. 9³
+/// candidates, nearest first (±2 left the Neptune scene of scenes.json, in
+/// its tight enclosing box, with two flat tets after every TetGen re-run).
+const SNAP_ULPS: usize = 4;
+
+/// The bits of an f32 point (`-0.0` as `0.0`), for sorting and equality.
+fn key(p: Vec3) -> [u32; 3] {
+    (p + Vec3::ZERO).to_array().map(f32::to_bits)
 }
 
 /// Orients TetGen's tets positively by their exact f64 orientation, and lists
@@ -199,10 +218,12 @@ pub(super) fn orient_tets(
 }
 
 /// Snaps the Steiner points (index ≥ `first_steiner`) of the `bad` tets to
-/// a nearby f32 value that makes all their tets positive (exact test).
-/// Returns how many points moved and the tets still bad.
+/// a nearby f32 value that makes all their tets positive (exact test),
+/// nearest to TetGen's point first (`p64`, in `frame`). Returns how many
+/// points moved and the tets still bad.
 fn snap_steiner_points(
     p64: &[[f64; 3]],
+    frame: &Frame,
     p32: &mut [Vec3],
     tets: &[[u32; 4]],
     bad: &[u32],
@@ -233,7 +254,7 @@ fn snap_steiner_points(
     let steps = |x: f32| {
         let mut v = vec![x];
         let (mut up, mut down) = (x, x);
-        for _ in 0..2 {
+        for _ in 0..SNAP_ULPS {
             up = up.next_up();
             down = down.next_down();
             v.push(up);
@@ -251,7 +272,7 @@ fn snap_steiner_points(
             if incident.iter().all(|&t| positive(p32, t)) {
                 continue;
             }
-            let target = DVec3::from_array(p64[v as usize]);
+            let target = frame.user_point_f64(p64[v as usize]);
             let r = p32[v as usize];
             let mut candidates = Vec::with_capacity(125);
             for x in steps(r.x) {
@@ -323,7 +344,8 @@ mod tests {
             .collect();
         let (tets, bad) = orient_tets(&p64, &p32, &[[0, 1, 2, 3]]);
         assert_eq!(bad, vec![0]);
-        let (moved, still) = snap_steiner_points(&p64, &mut p32, &tets, &bad, 3);
+        let frame = Frame::IDENTITY;
+        let (moved, still) = snap_steiner_points(&p64, &frame, &mut p32, &tets, &bad, 3);
         assert_eq!((moved, still), (1, vec![]));
         assert!(p32[3].z > 0.0 && p32[3].z <= 3.0 * f32::from_bits(1));
         assert_eq!(p32[3].x, 0.25);
@@ -332,7 +354,7 @@ mod tests {
             .iter()
             .map(|p| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32))
             .collect();
-        let (moved, still) = snap_steiner_points(&p64, &mut q32, &tets, &bad, 4);
+        let (moved, still) = snap_steiner_points(&p64, &frame, &mut q32, &tets, &bad, 4);
         assert_eq!((moved, still), (0, vec![0]));
     }
 }
