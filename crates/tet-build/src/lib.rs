@@ -41,6 +41,8 @@ pub mod outofcore;
 pub mod pipeline;
 pub mod procedural;
 pub mod quality;
+/// Making a self-intersecting triangle soup meet only in shared vertices and edges.
+pub mod resolve;
 pub mod scene;
 pub mod source;
 pub mod tetgen_files;

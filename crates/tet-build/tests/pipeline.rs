@@ -380,13 +380,21 @@ fn bad_scenes_are_typed_errors() {
     v.extend([Vec3::new(-1.0, -1.0, -1.0), Vec3::new(2.0, 2.0, 2.0)]);
     t.push([4, 5, 6]);
     let crossing = scene(v, t);
-    let isolated = BuildOptions {
+    // Resolved by default: the crossing triangles are split and it builds.
+    let resolving = BuildOptions {
         isolation: worker(),
         enclosing_box: Some(BoxSpec::default()),
         ..BuildOptions::default()
     };
-    // The error names the pairs by input index: only the added triangle (4)
-    // crosses the tet's faces (0..4).
+    let (mesh, report) = build(&crossing, &resolving).unwrap();
+    mesh.validate().unwrap();
+    assert!(report.resolve.pairs >= 1 && report.resolve.split_triangles >= 2);
+    // Without resolving, the error names the pairs by input index: only the
+    // added triangle (4) crosses the tet's faces (0..4).
+    let isolated = BuildOptions {
+        resolve: None,
+        ..resolving
+    };
     match build(&crossing, &isolated) {
         Err(BuildError::SelfIntersections { pairs, total }) => {
             assert!(total >= 1 && total == pairs.len());

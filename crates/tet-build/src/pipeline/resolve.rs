@@ -28,13 +28,47 @@ pub(super) fn resolve_scene(
     cleaned: Cleaned,
     options: &ResolveOptions,
 ) -> Result<(Cleaned, ResolveReport), BuildError> {
-    let resolved = resolve(&cleaned.scene.vertices, &cleaned.scene.triangles, options)
+    // The exact arithmetic wants coordinates of moderate size: resolve in
+    // a frame scaled by a power of two (exact both ways, checked), so that
+    // the scene's scale does not matter.
+    let scale = unit_scale(&cleaned.scene.vertices);
+    let scaled: Vec<Vec3> = cleaned.scene.vertices.iter().map(|&v| v * scale).collect();
+    let mut resolved = resolve(&scaled, &cleaned.scene.triangles, options)
         .map_err(|e| name_input_triangles(e, &cleaned.map.triangle_source))?;
+    if scale != 1.0 {
+        let n = cleaned.scene.vertices.len();
+        resolved.vertices[..n].copy_from_slice(&cleaned.scene.vertices);
+        for v in &mut resolved.vertices[n..] {
+            *v /= scale;
+        }
+    }
     let report = resolved.report.clone();
     if unchanged(&resolved, &cleaned.scene) {
         return Ok((cleaned, report));
     }
     Ok((rebuild(cleaned, resolved), report))
+}
+
+/// A power of two that brings the largest coordinate magnitude near 1,
+/// when that scaling is exact for every coordinate (no underflow into
+/// subnormals, no overflow); 1 otherwise.
+fn unit_scale(vertices: &[Vec3]) -> f32 {
+    let largest = vertices
+        .iter()
+        .map(|v| v.abs().max_element())
+        .fold(0.0f32, f32::max);
+    if !(largest.is_finite() && largest > 0.0) || (1e-8..=1e8).contains(&largest) {
+        return 1.0;
+    }
+    let k = ((largest as f64).log2().ceil() as i32).clamp(-126, 126);
+    let scale = (2.0f64).powi(-k) as f32;
+    // A power of two scales exactly unless a coordinate falls into the
+    // subnormals (or out of range): the round trip says so.
+    let exact = vertices.iter().all(|&v| {
+        let s = v * scale;
+        s.is_finite() && s / scale == v
+    });
+    if exact { scale } else { 1.0 }
 }
 
 /// True when the resolved soup is the cleaned scene itself.
@@ -200,6 +234,32 @@ fn barycentric(p: Vec3, t: [Vec3; 3]) -> [f32; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_resolve_frame_is_an_exact_power_of_two() {
+        let at = |x: f32| {
+            vec![
+                Vec3::new(x, -0.75 * x, 0.0),
+                Vec3::new(0.5 * x, x, 0.25 * x),
+            ]
+        };
+        // Moderate scenes are left alone.
+        assert_eq!(unit_scale(&at(3.0)), 1.0);
+        for x in [1e30f32, 1e-30, 3e38, 1e20] {
+            let v = at(x);
+            let s = unit_scale(&v);
+            assert!(s != 1.0 && s.log2().fract() == 0.0, "{x}: {s}");
+            let largest = v
+                .iter()
+                .map(|p| (*p * s).abs().max_element())
+                .fold(0.0, f32::max);
+            assert!((0.5..=4.0).contains(&largest), "{x}: {largest}");
+            assert!(v.iter().all(|&p| (p * s) / s == p));
+        }
+        // A tiny coordinate that would fall into the subnormals: no scaling.
+        let v = vec![Vec3::new(1e30, 1e-30, 0.0)];
+        assert_eq!(unit_scale(&v), 1.0);
+    }
 
     #[test]
     fn barycentric_weights_reproduce_the_point() {
