@@ -145,7 +145,7 @@ pub fn collinear(a: Vec3, b: Vec3, c: Vec3) -> bool {
 /// from the caller's own scene, so there is no adversary to defend against
 /// (a collision-heavy input only costs time, never correctness).
 #[derive(Default)]
-struct FxHasher(u64);
+pub(crate) struct FxHasher(u64);
 
 impl Hasher for FxHasher {
     fn write(&mut self, bytes: &[u8]) {
@@ -169,7 +169,7 @@ impl Hasher for FxHasher {
     }
 }
 
-type FxMap<K, V> = HashMap<K, V, BuildHasherDefault<FxHasher>>;
+pub(crate) type FxMap<K, V> = HashMap<K, V, BuildHasherDefault<FxHasher>>;
 
 fn key(p: Vec3) -> [u32; 3] {
     // `+ 0.0` turns -0.0 into +0.0 so both merge.

@@ -9,11 +9,11 @@ use proptest::prelude::*;
 use tet_core::TetMesh;
 use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::exact::{ExactTracer, left_of};
-use tet_trace_cpu::reference::{Aim, axis_ray, closest_hit, random_ray, ray_from_feature};
+use tet_trace_cpu::reference::closest_hit;
 use tet_trace_cpu::{Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint, locate};
 
 mod common;
-use common::{assert_outcomes_match, bits, grid, unambiguous_reference};
+use common::{adversarial_rays, assert_outcomes_match, bits, grid, unambiguous_reference};
 
 /// Traces `ray` from the tet holding its origin: never a failure, and the
 /// reference's answer on unambiguous rays. Returns the outcome and whether
@@ -29,36 +29,6 @@ fn check(mesh: &TetMesh, ray: &Ray) -> (TraceOutcome, bool) {
     let boxed: Vec<Box<dyn Tracer + '_>> = vec![Box::new(ExactTracer::new(mesh))];
     assert_outcomes_match(&boxed, &[out], ray, reference);
     (out, true)
-}
-
-/// Rays aimed at features, started on features, along mesh edges (origin
-/// on a vertex, through another vertex of its tet) and along grid axes.
-fn adversarial_rays(mesh: &TetMesh, rng: &mut SplitMix64, n: usize) -> Vec<Ray> {
-    let (lo, hi) = mesh.point_bounds();
-    (0..n)
-        .map(|i| match i % 9 {
-            0..=3 => {
-                let aim = [
-                    Aim::Random,
-                    Aim::Vertex,
-                    Aim::EdgeMidpoint,
-                    Aim::FaceCentroid,
-                ][i % 4];
-                random_ray(mesh, rng, aim).0
-            }
-            4 => ray_from_feature(mesh, rng, Aim::Vertex),
-            5 => ray_from_feature(mesh, rng, Aim::EdgeMidpoint),
-            6 => ray_from_feature(mesh, rng, Aim::FaceCentroid),
-            7 => {
-                let t = (rng.next_u64() % mesh.tets.len() as u64) as u32;
-                let p = mesh.tet_points(t);
-                let r = rng.next_u64() as usize;
-                let (a, b) = (r % 4, (r % 4 + 1 + r / 4 % 3) % 4);
-                Ray::new(p[a], p[b] - p[a])
-            }
-            _ => axis_ray(rng, lo, hi),
-        })
-        .collect()
 }
 
 /// Runs `n` adversarial rays on `mesh`; returns how many were checked

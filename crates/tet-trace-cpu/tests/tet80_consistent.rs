@@ -9,12 +9,12 @@ use glam::Vec3;
 use proptest::prelude::*;
 use tet_core::TetMesh;
 use tet_core::synthetic::SplitMix64;
-use tet_trace_cpu::reference::{Aim, axis_ray, closest_hit, random_ray, ray_from_feature};
+use tet_trace_cpu::reference::closest_hit;
 use tet_trace_cpu::tet80::{Tet80ConsistentTracer, left_of};
 use tet_trace_cpu::{Ray, Start, TraceOutcome, Tracer, locate};
 
 mod common;
-use common::{assert_outcomes_match, grid, unambiguous_reference};
+use common::{adversarial_rays, assert_outcomes_match, grid, unambiguous_reference};
 
 /// Traces `ray` from the tet holding its origin: never a failure, and the
 /// reference's answer on unambiguous rays.
@@ -32,27 +32,6 @@ fn check(mesh: &TetMesh, tracer: &dyn Tracer, ray: &Ray) -> TraceOutcome {
         assert_outcomes_match(&boxed, &[out], ray, reference);
     }
     out
-}
-
-/// Rays aimed at features, started on features and along axes.
-fn adversarial_rays(mesh: &TetMesh, rng: &mut SplitMix64, n: usize) -> Vec<Ray> {
-    let (lo, hi) = mesh.point_bounds();
-    (0..n)
-        .map(|i| match i % 7 {
-            0..=3 => {
-                let aim = [
-                    Aim::Random,
-                    Aim::Vertex,
-                    Aim::EdgeMidpoint,
-                    Aim::FaceCentroid,
-                ][i % 4];
-                random_ray(mesh, rng, aim).0
-            }
-            4 => ray_from_feature(mesh, rng, Aim::Vertex),
-            5 => ray_from_feature(mesh, rng, Aim::EdgeMidpoint),
-            _ => axis_ray(rng, lo, hi),
-        })
-        .collect()
 }
 
 #[test]
@@ -137,7 +116,13 @@ proptest! {
         let mesh = grid(cells.max(if shell { 3 } else { 2 }), jitter, fraction, shell, seed);
         let tracer = Tet80ConsistentTracer::consistent(&mesh).unwrap();
         let mut rng = SplitMix64(seed ^ 0xabcd);
+        let (lo, hi) = mesh.point_bounds();
         for ray in adversarial_rays(&mesh, &mut rng, 70) {
+            // Origins on the mesh boundary are left out (see
+            // `closed_shells_are_watertight`).
+            if (0..3).any(|a| ray.origin[a] <= lo[a] || ray.origin[a] >= hi[a]) {
+                continue;
+            }
             check(&mesh, &tracer, &ray);
         }
     }

@@ -2,8 +2,10 @@
 #![allow(dead_code)]
 
 use tet_core::TetMesh;
-use tet_core::synthetic::{GridSpec, kuhn_grid};
-use tet_trace_cpu::reference::{RefHit, closest_hit, grazes_an_edge};
+use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
+use tet_trace_cpu::reference::{
+    Aim, RefHit, axis_ray, closest_hit, grazes_an_edge, random_ray, ray_from_feature,
+};
 use tet_trace_cpu::{Ray, TraceOutcome, Tracer};
 
 /// A validated jittered Kuhn grid of `cells³` cells with a `fraction` of
@@ -96,4 +98,34 @@ pub fn bits(o: &TraceOutcome) -> (u8, [u32; 9]) {
             tets_visited,
         } => (2, [tets_visited, failure as u32, 0, 0, 0, 0, 0, 0, 0]),
     }
+}
+
+/// Rays aimed at features, started on features, along mesh edges (origin
+/// on a vertex, through another vertex of its tet) and along grid axes.
+pub fn adversarial_rays(mesh: &TetMesh, rng: &mut SplitMix64, n: usize) -> Vec<Ray> {
+    let (lo, hi) = mesh.point_bounds();
+    (0..n)
+        .map(|i| match i % 9 {
+            0..=3 => {
+                let aim = [
+                    Aim::Random,
+                    Aim::Vertex,
+                    Aim::EdgeMidpoint,
+                    Aim::FaceCentroid,
+                ][i % 4];
+                random_ray(mesh, rng, aim).0
+            }
+            4 => ray_from_feature(mesh, rng, Aim::Vertex),
+            5 => ray_from_feature(mesh, rng, Aim::EdgeMidpoint),
+            6 => ray_from_feature(mesh, rng, Aim::FaceCentroid),
+            7 => {
+                let t = (rng.next_u64() % mesh.tets.len() as u64) as u32;
+                let p = mesh.tet_points(t);
+                let r = rng.next_u64() as usize;
+                let (a, b) = (r % 4, (r % 4 + 1 + r / 4 % 3) % 4);
+                Ray::new(p[a], p[b] - p[a])
+            }
+            _ => axis_ray(rng, lo, hi),
+        })
+        .collect()
 }
