@@ -1,13 +1,7 @@
-//! The adversarial cases of `accuracy --extremes`: the scene scaled by 1e-4,
-//! 1e4, 1e-30 and 1e30 and translated by 1e5 (each rebuilt from the
-//! transformed triangles, since rounding a built mesh's points can invert
-//! tets; the builder works in a normalised frame, so every one of them
-//! builds like the scene as given), and a sliver-heavy synthetic mesh.
-//!
-//! At 1e-30 and 1e30 the f32 kernels' products of projected coordinates
-//! under- and overflow f32 (about 1e-60 and 1e60): these cases measure how
-//! far the f32 walks are from scale-invariant, the f64 ones are not
-//! affected.
+//! The adversarial cases of `accuracy --extremes`: the scene scaled by 1e-4
+//! and 1e4 and translated by 1e5 (each rebuilt from the transformed
+//! triangles, since rounding a built mesh's points can invert tets), and a
+//! sliver-heavy synthetic mesh.
 
 use anyhow::{Result, bail};
 use glam::Vec3;
@@ -20,11 +14,9 @@ use crate::cli::BuildFlags;
 use crate::load::{Loaded, from_scene};
 
 /// The transforms applied to the scene.
-const TRANSFORMS: [(&str, f32, f32); 5] = [
+const TRANSFORMS: [(&str, f32, f32); 3] = [
     ("scale-1e-4", 1e-4, 0.0),
     ("scale-1e4", 1e4, 0.0),
-    ("scale-1e-30", 1e-30, 0.0),
-    ("scale-1e30", 1e30, 0.0),
     ("translate-1e5", 1.0, 1e5),
 ];
 
