@@ -24,7 +24,9 @@
 //! * [`scene`]: triangle scenes (OBJ files, `scenes.json`); [`procedural`]:
 //!   scenes made in code; [`source`]: a scene named by a spec string.
 //! * [`clean`], [`intersect`], [`bbox`], [`quality`]: cleaning, exact
-//!   self-intersection search, the enclosing box, tet quality.
+//!   self-intersection search, the enclosing box, tet quality;
+//!   [`resolve`]: self-intersecting triangles split along their
+//!   intersections so that they meet only in shared vertices and edges.
 //! * [`tetgen`]: TetGen in process or in a worker process;
 //!   [`tetgen_files`], [`vtk`]: TetGen's and ParaView's file formats.
 //! * [`pipeline`]: the in-core build, stage by stage.

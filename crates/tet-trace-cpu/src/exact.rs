@@ -11,7 +11,7 @@
 //! decided by the signs of two side products `d · ((V_e − o) × (X − o))`
 //! with edges `V_e → X` of the entry face. Every sign is the exact sign of
 //! that product of the f32 inputs, decided by the simulation of simplicity
-//! of [`predicates`] when it is zero: the ray's line is replaced by an
+//! of `predicates` when it is zero: the ray's line is replaced by an
 //! infinitesimally perturbed real line in general position. So
 //!
 //! * no decision is ever a tie, and the sign of an edge depends on the
@@ -26,7 +26,7 @@
 //!   face plane, still goes through one well-defined tet after the other.
 //!
 //! Cost: the side products are first evaluated in f64 with an error bound
-//! ([`predicates`]); the exact sum (a 960-bit fixed-point accumulation)
+//! (`predicates`); the exact sum (a 960-bit fixed-point accumulation)
 //! only runs when the bound cannot decide, which in practice is a ray
 //! through (or within ~10⁻¹⁴ relative of) a vertex or an edge. Per tet:
 //! the entry face from the previous tet's ids, three vertices relative to
@@ -41,7 +41,7 @@
 //!
 //! From `Start::Tet(t)` (the origin in the closed tet `t`, checked with
 //! exact orientation tests, else [`Failure::Lost`]), the perturbation moves
-//! the origin towards `t`'s centroid first ([`predicates`]), so the
+//! the origin towards `t`'s centroid first (`predicates`), so the
 //! perturbed origin lies strictly inside `t` even when the origin lies on
 //! its boundary: the walk leaves `t` through the face its line exits by.
 //! The caller's start tet thus decides on which side of a face, edge or
