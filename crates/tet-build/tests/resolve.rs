@@ -791,3 +791,51 @@ fn stress_random_soups() {
         failures[0]
     );
 }
+
+/// End to end on the shared meshes: TetGen accepts the resolved scene that
+/// it refuses unresolved, and every piece comes back as a constrained face
+/// (`cargo test --release -p tet-build --test resolve -- --ignored --nocapture tetgen`).
+#[cfg(feature = "tetgen")]
+#[test]
+#[ignore]
+fn resolved_meshes_tetrahedralize() {
+    use tet_build::pipeline::{BuildOptions, build};
+    use tet_build::scene::Scene;
+    for name in ["teapot.obj", "neptune_aimatshape_30k.obj"] {
+        let Some(path) = shared(name) else {
+            eprintln!("skipping {name}: not found");
+            continue;
+        };
+        let (cleaned, _) = tet_build::clean::clean_scene(&Scene::load_obj(&path).unwrap()).unwrap();
+        let raw = Scene {
+            vertices: cleaned.vertices.clone(),
+            triangles: cleaned.triangles.clone(),
+            ..Scene::default()
+        };
+        assert!(
+            build(&raw, &BuildOptions::default()).is_err(),
+            "{name} builds unresolved"
+        );
+        let out = resolve(
+            &cleaned.vertices,
+            &cleaned.triangles,
+            &ResolveOptions::default(),
+        )
+        .unwrap();
+        let scene = Scene {
+            vertices: out.vertices,
+            triangles: out.triangles,
+            ..Scene::default()
+        };
+        let start = Instant::now();
+        let (mesh, _) = build(&scene, &BuildOptions::default()).unwrap();
+        println!(
+            "{name}: {} pieces -> {} tets, {} constrained faces, {:.1} s",
+            scene.triangles.len(),
+            mesh.tets.len(),
+            mesh.constrained.len(),
+            start.elapsed().as_secs_f64()
+        );
+        assert_eq!(mesh.constrained.len(), scene.triangles.len());
+    }
+}

@@ -12,12 +12,13 @@
 //!
 //! Pieces are wound like the triangle in the projection, except a sliver
 //! whose rounded corners tilt its normal against the input triangle's: it
-//! is turned over, so every piece's normal agrees with its input triangle.
+//! is turned over, so every piece's normal agrees with its input triangle
+//! (unless the two are exactly perpendicular).
 //!
 //! Faces inside the boundary are found by a flood fill from the convex hull
 //! that stops at boundary constraints. If the boundary could not be
 //! inserted as a closed polygon, faces are kept by whether their centroid
-//! lies in the triangle instead. Pieces are wound like the triangle.
+//! lies in the triangle instead.
 
 use std::collections::HashSet;
 

@@ -350,6 +350,11 @@ pub(crate) fn run_round(
         let p = soup.parent[t];
         match by_tri.get(&(t as u32)) {
             None => {
+                // A triangle of a pair that could not be cut (it would have
+                // to be degenerate) stays, and is checked again.
+                if g.interior.contains_key(&(t as u32)) {
+                    outcome.dirty.push(triangles.len() as u32);
+                }
                 triangles.push(tri);
                 parent.push(p);
             }
