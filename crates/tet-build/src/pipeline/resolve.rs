@@ -14,6 +14,8 @@
 //! with their geometric normal. A scene that needs nothing goes through
 //! untouched.
 
+use std::borrow::Cow;
+
 use glam::{DVec3, Vec2, Vec3};
 
 use super::error::BuildError;
@@ -32,8 +34,12 @@ pub(super) fn resolve_scene(
     // a frame scaled by a power of two (exact both ways, checked), so that
     // the scene's scale does not matter.
     let scale = unit_scale(&cleaned.scene.vertices);
-    let scaled: Vec<Vec3> = cleaned.scene.vertices.iter().map(|&v| v * scale).collect();
-    let mut resolved = resolve(&scaled, &cleaned.scene.triangles, options)
+    let vertices: Cow<'_, [Vec3]> = if scale == 1.0 {
+        Cow::Borrowed(&cleaned.scene.vertices)
+    } else {
+        Cow::Owned(cleaned.scene.vertices.iter().map(|&v| v * scale).collect())
+    };
+    let mut resolved = resolve(&vertices, &cleaned.scene.triangles, options)
         .map_err(|e| name_input_triangles(e, &cleaned.map.triangle_source))?;
     if scale != 1.0 {
         let n = cleaned.scene.vertices.len();
@@ -95,7 +101,6 @@ fn name_input_triangles(e: crate::resolve::ResolveError, source: &[u32]) -> Buil
                 .collect(),
             total,
         },
-        #[allow(unreachable_patterns)]
         other => other,
     })
 }
