@@ -30,12 +30,22 @@ pub fn grid(cells: u32, jitter: f32, fraction: f64, shell: bool, seed: u64) -> T
 pub const EDGE_TOL: f64 = 1e-3;
 
 /// The f64 brute-force hit of `ray`, or `None` when the ray is ambiguous
-/// (it grazes an edge of a constrained face, or its hit lies within
-/// [`EDGE_TOL`] of its origin or of a second hit): `Some(reference)` when
-/// the outcomes must match it.
+/// (it grazes an edge of a constrained face, its hit lies within
+/// [`EDGE_TOL`] of its origin or of a second hit, or its origin lies within
+/// [`EDGE_TOL`] of a constrained face, in front of it or behind):
+/// `Some(reference)` when the outcomes must match it.
 pub fn unambiguous_reference(mesh: &TetMesh, ray: &Ray) -> Option<Option<RefHit>> {
     let reference = closest_hit(mesh, ray);
-    let clear = !grazes_an_edge(mesh, ray, EDGE_TOL)
+    // An origin rounded onto a face may sit just behind it, where the
+    // brute force (t < t_min) skips the face a walk may rightly report.
+    let widened = Ray {
+        t_min: ray.t_min - EDGE_TOL as f32,
+        ..*ray
+    };
+    let origin_clear =
+        closest_hit(mesh, &widened).is_none_or(|h| h.t > ray.t_min as f64 + EDGE_TOL);
+    let clear = origin_clear
+        && !grazes_an_edge(mesh, ray, EDGE_TOL)
         && reference.is_none_or(|h| h.t > EDGE_TOL && h.t_gap > EDGE_TOL);
     clear.then_some(reference)
 }
