@@ -69,13 +69,19 @@
 //! tet: three projected vertices (3 sub + 6 mul + 4 add each) and two
 //! determinants, against 9 + 2 × 8 operations for the faithful form.
 //!
-//! What consistency does not repair: the exit rule reads two of the three
-//! side products around the apex and takes the third from the table, which
-//! is only right when the entry face really contains the ray's projected
-//! origin. Rounded projections can break that in a start tet whose origin
-//! lies within rounding of a face (Algorithm 2 then starts from a wrong
-//! exit), and the walk can then go round; the step cap reports it. The
-//! accuracy tables count these step caps beside the faithful walk's.
+//! What consistency does not repair by itself: the exit rule reads two of
+//! the three side products around the apex and takes the third from the
+//! table, which is only right when the entry face really contains the
+//! ray's projected origin. Algorithm 2's fake entry breaks that when the
+//! origin lies within rounding of a face of the start tet: its one side
+//! product then picks a face the projected line does not leave by, and the
+//! walk went round until the step cap (about one feature ray in a few
+//! hundred on jittered grids). So the consistent variant does not use
+//! Algorithm 2: every start runs the engine's search
+//! ([`crate::walk::start_exit_face`]) with the same projected vertices and
+//! tie rule as the walk, which finds the face the projected line really
+//! leaves by; from there each entry face contains the projected origin by
+//! construction. The faithful variant keeps Algorithm 2, as the paper.
 //!
 //! ScTP ([`crate::sctp`]) cannot be repaired the same way within its
 //! operation count: its triple products are taken in the frame of the
@@ -268,16 +274,17 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
     }
 
     /// The start of a walk from `Start::Tet(t)`: the start tet and its exit
-    /// face. Algorithm 2 when the origin lies strictly inside `t`
+    /// face. Faithful: Algorithm 2 when the origin lies strictly inside `t`
     /// (`inside`), else the engine's search over the tets around an origin
-    /// on a face, edge or vertex ([`start_exit_face`]).
+    /// on a face, edge or vertex ([`start_exit_face`]). Consistent: always
+    /// the engine's search (see the module docs).
     fn start_tet(&self, ray: &Ray, t: u32, inside: bool) -> Option<(u32, usize)> {
-        if inside {
-            Some((t, self.algorithm2_exit_face(ray, t)))
-        } else if CONSISTENT {
+        if CONSISTENT {
             // The engine's search with the same projected vertices and tie
             // rule as the walk.
             start_exit_face::<DuffF32>(self.mesh, ray, t)
+        } else if inside {
+            Some((t, self.algorithm2_exit_face(ray, t)))
         } else {
             start_exit_face::<TripleF32>(self.mesh, ray, t)
         }
@@ -317,7 +324,8 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
                 if stop(t) {
                     return TraceOutcome::Miss { tets_visited: 1 };
                 }
-                let inside = inside.unwrap_or_else(|| self.strictly_inside(t, ray.origin));
+                let inside =
+                    !CONSISTENT && inside.unwrap_or_else(|| self.strictly_inside(t, ray.origin));
                 let Some((t, k)) = self.start_tet(ray, t, inside) else {
                     return TraceOutcome::Failed {
                         failure: Failure::Lost,

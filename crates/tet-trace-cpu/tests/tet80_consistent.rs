@@ -83,13 +83,9 @@ fn closed_shells_are_watertight() {
         for ray in adversarial_rays(&mesh, &mut rng, 900) {
             // Origins on the mesh boundary are left out (a ray started
             // exactly on a hull vertex and leaving the mesh at once can
-            // loop in every walk, tet20 included), and so are origins
-            // within 1e-3 of the shell: Algorithm 2's start tet then has
-            // an exit face decided by near-zero side products, and the
-            // two-product exit rule can go round in circles.
-            if !(0..3).all(|a| ray.origin[a] > 0.0 && ray.origin[a] < 5.0)
-                || closest_hit(&mesh, &ray).is_some_and(|r| r.t < 1e-3)
-            {
+            // loop in every walk, tet20 included). Origins on or a hair
+            // off the shell stay in.
+            if !(0..3).all(|a| ray.origin[a] > 0.0 && ray.origin[a] < 5.0) {
                 continue;
             }
             let out = check(&mesh, &tracer, &ray);
