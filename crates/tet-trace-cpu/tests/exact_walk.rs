@@ -155,7 +155,7 @@ fn rays_at_shell_vertices_and_edges_hit() {
 
 /// Rays started exactly on a hull vertex, edge or face, pointing out of
 /// the mesh, in it, or along the hull: a miss or the reference's hit,
-/// never a loop (the failure the f32 walks can report there).
+/// never a loop (`hull_origins.rs` holds the f32 walks to the same).
 #[test]
 fn rays_from_the_hull() {
     let mesh = grid(3, 0.0, 0.3, false, 7);

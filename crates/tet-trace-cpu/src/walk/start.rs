@@ -3,6 +3,8 @@
 //! or the entry face when the walk enters a tet through a constrained face
 //! or the mesh boundary; everything before the hot loop.
 
+use glam::Vec3;
+use tet_core::predicates::orient3d;
 use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
 
 use super::projection::Projection;
@@ -64,26 +66,52 @@ pub(crate) struct State<P: Projection> {
 fn start_in_tet<P: Projection>(mesh: &TetMesh, proj: &P, tet: u32) -> Option<State<P>> {
     let v = mesh.tets[tet as usize];
     let p = v.map(|i| proj.project(mesh.points[i as usize]));
-    let state = |k: usize| {
-        let [a, b, c] = FACE_VERTICES[k];
-        State {
-            tet,
-            ids: [v[a], v[b], v[c]],
-            p: P::face([p[a], p[b], p[c]]),
-            link: mesh.neighbors[tet as usize][k].0,
-            visited: 1,
-        }
-    };
-    for (k, s) in FACE_VERTICES.iter().enumerate() {
-        let [a, b, c] = *s;
-        if proj.left(p[a], v[a], p[b], v[b])
-            && proj.left(p[b], v[b], p[c], v[c])
-            && proj.left(p[c], v[c], p[a], v[a])
-        {
-            return Some(state(k));
-        }
+    FACE_VERTICES
+        .iter()
+        .position(|&[a, b, c]| {
+            proj.left(p[a], v[a], p[b], v[b])
+                && proj.left(p[b], v[b], p[c], v[c])
+                && proj.left(p[c], v[c], p[a], v[a])
+        })
+        .map(|k| exit_state(mesh, proj, tet, k))
+}
+
+/// The walk state after choosing face `k` of `tet` as the exit.
+fn exit_state<P: Projection>(mesh: &TetMesh, proj: &P, tet: u32, k: usize) -> State<P> {
+    let v = mesh.tets[tet as usize];
+    let [a, b, c] = FACE_VERTICES[k];
+    let ids = [v[a], v[b], v[c]];
+    State {
+        tet,
+        ids,
+        p: P::face(ids.map(|i| proj.project(mesh.points[i as usize]))),
+        link: mesh.neighbors[tet as usize][k].0,
+        visited: 1,
     }
-    None
+}
+
+/// A face on the mesh boundary (no tet behind it, constrained or not) that
+/// contains `p` (exact), among the faces of the tets `around` (each
+/// containing `p`): `(tet, face)`.
+///
+/// Where no tet around the origin has a counter-clockwise exit face, the
+/// ray's (perturbed) line passes through none of them. Inside the mesh that
+/// can only be rounding, and the fallback guesses the exit; on the boundary
+/// it is the ray leaving the mesh at once (a ray from a hull vertex or edge
+/// pointing outward), so the walk leaves through this face: a miss, or the
+/// constrained face the origin lies on at `t = 0`. Guessing an exit there
+/// instead sent the walk round an edge until the step cap.
+fn boundary_face_at(mesh: &TetMesh, p: Vec3, around: &[u32]) -> Option<(u32, usize)> {
+    let q = p.as_dvec3();
+    around.iter().find_map(|&t| {
+        let v = mesh.tet_points(t).map(|x| x.as_dvec3());
+        (0..4)
+            .find(|&k| {
+                let [a, b, c] = FACE_VERTICES[k];
+                mesh.across(t, k).is_none() && orient3d(v[a], v[b], v[c], q) == 0.0
+            })
+            .map(|k| (t, k))
+    })
 }
 
 /// Last resort when rounding left no tet around the origin with a
@@ -103,15 +131,7 @@ fn start_fallback<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) 
     let k = (0..4)
         .max_by(|&x, &y| score(x).total_cmp(&score(y)))
         .unwrap_or(0);
-    let [a, b, c] = FACE_VERTICES[k];
-    let ids = [v[a], v[b], v[c]];
-    State {
-        tet,
-        ids,
-        p: P::face(ids.map(|i| proj.project(mesh.points[i as usize]))),
-        link: mesh.neighbors[tet as usize][k].0,
-        visited: 1,
-    }
+    exit_state(mesh, proj, tet, k)
 }
 
 /// The tet around the ray origin and the face through which the ray line
@@ -134,10 +154,12 @@ pub fn start_exit_face<P: Projection>(mesh: &TetMesh, ray: &Ray, tet: u32) -> Op
     };
     found(tet)
         .or_else(|| {
-            star(mesh, ray.origin, tet, 256)
-                .into_iter()
+            let around = star(mesh, ray.origin, tet, 256);
+            around
+                .iter()
                 .skip(1)
-                .find_map(found)
+                .find_map(|&t| found(t))
+                .or_else(|| boundary_face_at(mesh, ray.origin, &around))
         })
         .or_else(|| {
             let s = start_fallback(mesh, &proj, ray, tet);
@@ -199,10 +221,15 @@ pub(crate) fn begin_with<P: Projection>(
                 None => {
                     // The origin is on the start tet's boundary and the ray
                     // leaves it at once: try the other tets around the origin.
-                    let found = star(mesh, ray.origin, t, 256)
-                        .into_iter()
+                    let around = star(mesh, ray.origin, t, 256);
+                    let found = around
+                        .iter()
                         .skip(1)
-                        .find_map(|c| start_in_tet(mesh, &proj, c));
+                        .find_map(|&c| start_in_tet(mesh, &proj, c))
+                        .or_else(|| {
+                            boundary_face_at(mesh, ray.origin, &around)
+                                .map(|(c, k)| exit_state(mesh, &proj, c, k))
+                        });
                     found.unwrap_or_else(|| start_fallback(mesh, &proj, ray, t))
                 }
             }
