@@ -315,6 +315,7 @@ impl Limited<'_> {
             },
             isolation: crate::load::worker_isolation(flags.time_limit)?,
             parallel_parts: parallel,
+            resolve: (!flags.no_resolve).then(Default::default),
         };
         Ok(Some(Plan {
             start,
@@ -413,7 +414,7 @@ impl Limited<'_> {
             total_s,
             worker_peak_kib: max_peak,
             cleaning: plan.cleaning.clone(),
-            resolve: Default::default(),
+            resolve: report.resolve.clone().unwrap_or_default(),
         };
         let s = merged.stream;
         let memory = MemoryReport {

@@ -14,6 +14,7 @@ use thiserror::Error;
 use super::plane::SplitPlane;
 use crate::bbox::BoxError;
 use crate::clean::CleanError;
+use crate::resolve::ResolveError;
 use crate::tetgen::TetgenError;
 
 /// A failure of [`build_split_once`](super::seam::build_split_once) and the other out-of-core builders.
@@ -22,6 +23,10 @@ pub enum SeamError {
     /// Cleaning rejected the scene.
     #[error("cleaning: {0}")]
     Clean(#[from] CleanError),
+    /// Resolving the scene's self-intersections failed (triangle ids are
+    /// the input scene's).
+    #[error("resolving self-intersections: {0}")]
+    Resolve(#[from] ResolveError),
     /// The scene has no triangles after cleaning.
     #[error("the scene has no triangles")]
     EmptyScene,

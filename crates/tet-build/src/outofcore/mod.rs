@@ -31,6 +31,8 @@
 //!   section (cut segments, in-plane scene edges and vertices as
 //!   constraints), given to both neighbouring parts as facets; TetGen `-pY`
 //!   keeps every facet.
+//! * `prepare`: the whole scene cleaned and, by default, its
+//!   self-intersections resolved ([`crate::resolve`]) before any cut.
 //! * `parts`: each part's TetGen run (parts run concurrently in worker
 //!   processes with `parallel_parts`) and the [`seam::SeamReport`].
 //! * `merge`: what becomes of finished parts. In memory: exact point
@@ -88,6 +90,7 @@ pub mod memory_model;
 mod merge;
 mod parts;
 pub mod plane;
+mod prepare;
 pub mod report;
 pub mod seam;
 pub mod seam_index;

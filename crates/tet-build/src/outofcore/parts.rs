@@ -10,6 +10,7 @@ use tet_core::face_key;
 use super::error::SeamError;
 use super::plane::{SplitPlane, key};
 use crate::bbox::BoxSpec;
+use crate::resolve::{ResolveOptions, ResolveReport};
 use crate::tetgen::{Isolation, TetgenError, TetgenInput, TetgenOptions, tetrahedralize};
 
 /// What [`build_slabs`](super::seam::build_slabs) (and [`build_split_once`](super::seam::build_split_once)) did.
@@ -44,10 +45,13 @@ pub struct SeamReport {
     /// Predicted peak memory of each part's TetGen run from its real input
     /// ([`super::memory_model::predict_part_peak_memory`], bytes, with margin).
     pub part_predicted_bytes: Vec<u64>,
+    /// What resolving the whole scene's self-intersections did, before it
+    /// was split (`None` when [`SeamOptions::resolve`] is off).
+    pub resolve: Option<ResolveReport>,
 }
 
 /// Options of [`build_slabs`](super::seam::build_slabs).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SeamOptions {
     /// Box around the scene (the whole mesh's boundary).
     pub enclosing_box: BoxSpec,
@@ -59,6 +63,24 @@ pub struct SeamOptions {
     /// time; 0 or 1 = one after the other). Only worth it with
     /// [`Isolation::Worker`]: in-process TetGen runs are serialized.
     pub parallel_parts: usize,
+    /// Resolve the cleaned scene's self-intersections before splitting it
+    /// ([`crate::resolve`], as the in-core build does); `None` hands
+    /// crossing triangles to TetGen as they are.
+    pub resolve: Option<ResolveOptions>,
+}
+
+impl Default for SeamOptions {
+    /// The in-core build's defaults: no box spec beyond the default,
+    /// default TetGen switches, in-process, one part at a time, resolving.
+    fn default() -> Self {
+        SeamOptions {
+            enclosing_box: BoxSpec::default(),
+            tetgen: TetgenOptions::default(),
+            isolation: Isolation::default(),
+            parallel_parts: 0,
+            resolve: Some(ResolveOptions::default()),
+        }
+    }
 }
 
 /// A facet of a part's PLC and what it becomes in the merged mesh.

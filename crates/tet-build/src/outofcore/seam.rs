@@ -42,6 +42,7 @@ use tet_core::TetMesh;
 use super::merge::{InMemory, Merge, PartInputs, finish_parts};
 use super::parts::FacetKind;
 use super::plane::{SplitPlane, fan};
+use super::prepare::{Prepared, prepare};
 use super::stream::{StreamOptions, StreamSummary, ToFile};
 use crate::bbox::EnclosingBox;
 use crate::clean::clean_scene;
@@ -102,10 +103,11 @@ fn build_slabs_with<M: Merge>(
     options: &SeamOptions,
     merge: &M,
 ) -> Result<(M::Output, SeamReport), SeamError> {
-    let (cleaned, cm) = clean_scene(scene)?;
-    if cleaned.triangles.is_empty() {
-        return Err(SeamError::EmptyScene);
-    }
+    let Prepared {
+        scene: cleaned,
+        map: cm,
+        resolve,
+    } = prepare(scene, options)?;
     let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
     let a = axis;
     let planes: Vec<SplitPlane> = values
@@ -133,7 +135,10 @@ fn build_slabs_with<M: Merge>(
         }
     }
     let n = planes.len();
-    let mut report = SeamReport::default();
+    let mut report = SeamReport {
+        resolve,
+        ..SeamReport::default()
+    };
     let mut parts: Vec<Vec<([Vec3; 3], FacetKind)>> = vec![Vec::new(); n + 1];
     let mut segments: Vec<Vec<[Vec3; 2]>> = vec![Vec::new(); n];
     let mut seam_points: Vec<Vec<Vec3>> = vec![Vec::new(); n];

@@ -45,6 +45,7 @@ pub use options::{
     Assembly, BuildOptions, BuildReport, Progress, ProgressFn, Reorder, Stage, StageTimes,
     Validation,
 };
+pub(crate) use resolve::resolve_cleaned;
 
 use crate::scene::Scene;
 use crate::tetgen::worker::peak_memory_kib;

@@ -20,8 +20,9 @@ use glam::{DVec3, Vec2, Vec3};
 
 use super::error::BuildError;
 use super::prepare::Cleaned;
+use crate::clean::CleanMesh;
 use crate::clean::REMOVED;
-use crate::resolve::{ResolveOptions, ResolveReport, Resolved, resolve};
+use crate::resolve::{ResolveError, ResolveOptions, ResolveReport, Resolved, resolve};
 use crate::scene::{Scene, SceneObject};
 
 /// Resolves the self-intersections of `cleaned` (output: the scene to
@@ -30,29 +31,44 @@ pub(super) fn resolve_scene(
     cleaned: Cleaned,
     options: &ResolveOptions,
 ) -> Result<(Cleaned, ResolveReport), BuildError> {
+    let Cleaned { scene, map } = cleaned;
+    let (scene, map, report) = resolve_cleaned(scene, map, options).map_err(BuildError::Resolve)?;
+    Ok((Cleaned { scene, map }, report))
+}
+
+/// Resolves the self-intersections of a cleaned scene and its map back to
+/// the input (the in-core stage, and the out-of-core builders before they
+/// split the scene): the resolved scene, its map (pieces name their input
+/// triangle) and what was done. Errors name input triangles.
+pub(crate) fn resolve_cleaned(
+    scene: Scene,
+    map: CleanMesh,
+    options: &ResolveOptions,
+) -> Result<(Scene, CleanMesh, ResolveReport), ResolveError> {
     // The exact arithmetic wants coordinates of moderate size: resolve in
     // a frame scaled by a power of two (exact both ways, checked), so that
     // the scene's scale does not matter.
-    let scale = unit_scale(&cleaned.scene.vertices);
+    let scale = unit_scale(&scene.vertices);
     let vertices: Cow<'_, [Vec3]> = if scale == 1.0 {
-        Cow::Borrowed(&cleaned.scene.vertices)
+        Cow::Borrowed(&scene.vertices)
     } else {
-        Cow::Owned(cleaned.scene.vertices.iter().map(|&v| v * scale).collect())
+        Cow::Owned(scene.vertices.iter().map(|&v| v * scale).collect())
     };
-    let mut resolved = resolve(&vertices, &cleaned.scene.triangles, options)
-        .map_err(|e| name_input_triangles(e, &cleaned.map.triangle_source))?;
+    let mut resolved = resolve(&vertices, &scene.triangles, options)
+        .map_err(|e| name_input_triangles(e, &map.triangle_source))?;
     if scale != 1.0 {
-        let n = cleaned.scene.vertices.len();
-        resolved.vertices[..n].copy_from_slice(&cleaned.scene.vertices);
+        let n = scene.vertices.len();
+        resolved.vertices[..n].copy_from_slice(&scene.vertices);
         for v in &mut resolved.vertices[n..] {
             *v /= scale;
         }
     }
     let report = resolved.report.clone();
-    if unchanged(&resolved, &cleaned.scene) {
-        return Ok((cleaned, report));
+    if unchanged(&resolved, &scene) {
+        return Ok((scene, map, report));
     }
-    Ok((rebuild(cleaned, resolved), report))
+    let Cleaned { scene, map } = rebuild(Cleaned { scene, map }, resolved);
+    Ok((scene, map, report))
 }
 
 /// A power of two that brings the largest coordinate magnitude near 1,
@@ -85,10 +101,9 @@ fn unchanged(r: &Resolved, scene: &Scene) -> bool {
 }
 
 /// The error with cleaned triangle ids replaced by input triangle ids.
-fn name_input_triangles(e: crate::resolve::ResolveError, source: &[u32]) -> BuildError {
-    use crate::resolve::ResolveError;
+fn name_input_triangles(e: ResolveError, source: &[u32]) -> ResolveError {
     let input = |t: u32| source.get(t as usize).copied().unwrap_or(t);
-    BuildError::Resolve(match e {
+    match e {
         ResolveError::NotConverged {
             rounds,
             pairs,
@@ -102,7 +117,7 @@ fn name_input_triangles(e: crate::resolve::ResolveError, source: &[u32]) -> Buil
             total,
         },
         other => other,
-    })
+    }
 }
 
 /// The cleaned scene with its triangles replaced by the pieces (ordered by

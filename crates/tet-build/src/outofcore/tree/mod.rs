@@ -54,6 +54,7 @@ use super::error::SeamError;
 use super::merge::{InMemory, Merge, PartInputs, finish_parts};
 use super::parts::{FacetKind, SeamOptions, SeamReport};
 use super::plane::key;
+use super::prepare::{Prepared, prepare};
 use super::split::SplitTree;
 use super::stream::{StreamOptions, StreamSummary, ToFile};
 use crate::bbox::EnclosingBox;
@@ -103,14 +104,16 @@ fn build_tree_with<M: Merge>(
     options: &SeamOptions,
     merge: &M,
 ) -> Result<(M::Output, SeamReport), SeamError> {
-    let (cleaned, cm) = clean_scene(scene)?;
-    if cleaned.triangles.is_empty() {
-        return Err(SeamError::EmptyScene);
-    }
+    let Prepared {
+        scene: cleaned,
+        map: cm,
+        resolve,
+    } = prepare(scene, options)?;
     let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
     let mut cut = run_clipping(&cleaned.vertices, &cleaned.triangles, tree, b.min, b.max)?;
     prepare_walls(&mut cut, b.min, b.max);
     let mut report = SeamReport {
+        resolve,
         triangles_cut: cut.triangles_cut.len(),
         triangles_in_plane: cut.triangles_in_plane.len(),
         ..SeamReport::default()
