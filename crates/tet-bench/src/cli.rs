@@ -303,7 +303,7 @@ pub struct AccuracyArgs {
     /// Random seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Repeat on the scene scaled by 1e-4 and 1e4 and translated by 1e5.
+    /// Repeat on the scene scaled by 1e-4, 1e4, 1e-30 and 1e30 and translated by 1e5.
     #[arg(long)]
     pub extremes: bool,
     /// Add as many adversarial rays as `--rays`: aimed exactly at mesh

@@ -98,7 +98,7 @@ use crate::ray::{Failure, Hit, Ray, TraceOutcome};
 use crate::secondary::{ShadowTracer, stops_at};
 use crate::walk::{
     DuffF32, Projection, Start, TripleF32, degenerate_crossing, face_hit, left_f32,
-    start_exit_face, step_cap,
+    start_exit_face, start_scale, step_cap,
 };
 
 /// `EXIT[e][2·s₁ + s₂]`: the exit face of a tet entered through face `e`,
@@ -191,10 +191,11 @@ impl<'m, const CONSISTENT: bool> Tet80Tracer<'m, CONSISTENT> {
         mut tet: u32,
         mut entry: usize,
         mut visited: u32,
+        scale: f32,
         stop: S,
     ) -> TraceOutcome {
         let tets = &self.layout.tets[..];
-        let side = Side::<CONSISTENT>::new(ray);
+        let side = Side::<CONSISTENT>::new(ray, scale);
         loop {
             if visited >= self.cap {
                 return TraceOutcome::Failed {
@@ -270,7 +271,7 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
     #[inline(always)]
     pub fn algorithm2_exit_face(&self, ray: &Ray, tet: u32) -> usize {
         let rec = &self.layout.tets[tet as usize];
-        Side::<CONSISTENT>::new(ray).algorithm2(|k| rec.vertex(k))
+        Side::<CONSISTENT>::new(ray, 1.0).algorithm2(|k| rec.vertex(k))
     }
 
     /// The start of a walk from `Start::Tet(t)`: the start tet and its exit
@@ -313,6 +314,13 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
                 tets_visited: 0,
             };
         }
+        // The consistent walk's projection factor, the same as its start's
+        // (`start_exit_face` takes it from the same tet).
+        let scale = if CONSISTENT {
+            start_scale(self.mesh, ray, start)
+        } else {
+            1.0
+        };
         match start {
             Start::Tet(t) => {
                 if t as usize >= self.layout.tets.len() {
@@ -334,7 +342,7 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
                 };
                 let f = self.layout.tets[t as usize].f[k];
                 match self.leave(ray, t, f, 1) {
-                    Ok((n, e)) => self.walk(ray, n, e, 1, stop),
+                    Ok((n, e)) => self.walk(ray, n, e, 1, scale, stop),
                     Err(out) => out,
                 }
             }
@@ -346,7 +354,7 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
                     .and_then(|cf| cf.side_of(tet))
                     .filter(|_| (tet as usize) < self.layout.tets.len());
                 match side {
-                    Some(s) => self.walk(ray, tet, s.face as usize, 0, stop),
+                    Some(s) => self.walk(ray, tet, s.face as usize, 0, scale, stop),
                     None => TraceOutcome::Failed {
                         failure: Failure::Lost,
                         tets_visited: 0,
@@ -355,7 +363,7 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
             }
             Start::Entry { tet, face } => {
                 if self.mesh.is_boundary_face(tet, face) {
-                    self.walk(ray, tet, face as usize, 0, stop)
+                    self.walk(ray, tet, face as usize, 0, scale, stop)
                 } else {
                     TraceOutcome::Failed {
                         failure: Failure::Lost,
@@ -381,11 +389,11 @@ struct Side<const CONSISTENT: bool> {
 
 impl<const CONSISTENT: bool> Side<CONSISTENT> {
     #[inline(always)]
-    fn new(ray: &Ray) -> Self {
+    fn new(ray: &Ray, scale: f32) -> Self {
         Side {
             o: ray.origin,
             d: ray.direction,
-            projection: CONSISTENT.then(|| DuffF32::setup(ray)),
+            projection: CONSISTENT.then(|| DuffF32::setup_scaled(ray, scale)),
         }
     }
 

@@ -10,7 +10,7 @@ use glam::{DVec3, Vec3};
 use tet_core::TetMesh;
 use tet_core::scene::Camera;
 use tet_trace_cpu::render::PinholeCamera;
-use tet_trace_cpu::walk::{duff_basis, step_cap};
+use tet_trace_cpu::walk::{duff_basis, start_scale, step_cap};
 use tet_trace_cpu::{Failure, Ray, Start, TraceOutcome, Viewpoint};
 use wgpu::util::DeviceExt;
 
@@ -106,13 +106,16 @@ impl<'a> GpuTracer<'a> {
         for (rc, sc) in rays.chunks(per).zip(starts.chunks(per)) {
             let recs: Vec<RayRec> = rc
                 .iter()
-                .map(|r| {
+                .zip(sc)
+                .map(|(r, &s)| {
                     let (u, v) = if r.is_valid() {
                         duff_basis(r.direction.as_dvec3().normalize())
                     } else {
                         (DVec3::X, DVec3::Y)
                     };
-                    let (u, v) = (u.as_vec3(), v.as_vec3());
+                    // The CPU walk's factor (exact; 1 at ordinary scales).
+                    let k = start_scale(self.mesh, r, s);
+                    let (u, v) = (u.as_vec3() * k, v.as_vec3() * k);
                     RayRec {
                         o: r.origin.extend(r.t_min).to_array(),
                         d: r.direction.extend(r.t_max).to_array(),

@@ -132,6 +132,12 @@ pub fn print_doc(doc: &AccuracyDoc) -> Result<()> {
                 m.mrays_per_s
             )?;
         }
+        if !c.left_out.is_empty() {
+            outln!(
+                "  left out (f32 products out of range at this scale): {}",
+                c.left_out.join(", ")
+            )?;
+        }
     }
     Ok(())
 }

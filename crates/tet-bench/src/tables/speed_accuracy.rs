@@ -97,5 +97,12 @@ pub fn markdown(m: &mut String, x: &SpeedAccuracy) {
                 r.mrays_per_s
             );
         }
+        for left in &c.left_out {
+            let _ = writeln!(
+                m,
+                "| {} | {left}: left out (f32 products out of range) | | | | | | | | | | |",
+                c.case
+            );
+        }
     }
 }

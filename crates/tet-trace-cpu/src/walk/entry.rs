@@ -10,7 +10,7 @@ use tet_core::predicates::orient3d_f32;
 use tet_core::{Link, NO_TET, TetMesh};
 use thiserror::Error;
 
-use super::projection::{DuffF32, Projection};
+use super::projection::{DuffF32, Projection, walk_scale};
 use super::start::Start;
 use super::stop::{Resolved, resolve_constrained};
 use crate::locate::LocateError;
@@ -159,7 +159,14 @@ impl BoundaryEntry {
         if !ray.is_valid() {
             return Err(miss_outside(ray));
         }
-        self.start_projected(mesh, ray, &P::setup(ray), hint)
+        self.start_projected(mesh, ray, &P::setup_scaled(ray, self.scale(ray)), hint)
+    }
+
+    /// The factor of the projection of a ray from outside ([`walk_scale`]):
+    /// from the farthest corner of the mesh's bounds seen from its origin.
+    pub(crate) fn scale(&self, ray: &Ray) -> f32 {
+        let o = ray.origin.as_dvec3();
+        walk_scale((self.lo - o).abs().max((self.hi - o).abs()).max_element())
     }
 
     /// [`BoundaryEntry::start_with`] for a valid ray whose projection is set

@@ -172,7 +172,7 @@ fn begin_outside<P: Projection>(
             tets_visited: 0,
         });
     }
-    let proj = P::setup(ray);
+    let proj = P::setup_scaled(ray, entry.scale(ray));
     let start = entry.start_projected(mesh, ray, &proj, hint)?;
     begin_with(mesh, ray, proj, start)
 }

@@ -105,8 +105,10 @@ pub use entry::{BoundaryEntry, EntryHint, ViewpointError};
 pub use lanes::{LANES, Starts, trace_interleaved};
 pub(crate) use projection::left_f32;
 pub(crate) use projection::simd_face;
-pub use projection::{DuffF32, DuffF64, Face2, OriginF32, Projection, TripleF32, duff_basis};
-pub use start::{Start, start_exit_face};
+pub use projection::{
+    DuffF32, DuffF64, Face2, OriginF32, Projection, TripleF32, duff_basis, walk_scale,
+};
+pub use start::{Start, start_exit_face, start_scale};
 pub use step::{EXIT_SLOT, exit_slot, step_cap, trace};
 pub(crate) use stop::degenerate_crossing;
 pub use stop::face_hit;

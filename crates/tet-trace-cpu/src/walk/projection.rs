@@ -16,6 +16,18 @@ pub trait Projection: Copy + Send + Sync {
     const NAME: &'static str;
     /// Builds the projection of a (valid) ray.
     fn setup(ray: &Ray) -> Self;
+    /// [`Projection::setup`] with the projected coordinates multiplied by
+    /// `scale`, a power of two chosen per ray by [`walk_scale`]. A power of
+    /// two multiplies every product exactly, so every sign — hence every
+    /// exit face — is the one `setup` gives, but the determinants of a
+    /// scene at 1e-30 or 1e30 no longer underflow or overflow f32. The f32
+    /// 2-D projections fold the factor into their basis (no cost per
+    /// vertex); the others ignore it (f64 has the range; the papers' 3-D
+    /// products have no multiplication to fold it into).
+    fn setup_scaled(ray: &Ray, scale: f32) -> Self {
+        let _ = scale;
+        Self::setup(ray)
+    }
     /// Projects one mesh vertex (must be a pure function of `p` and the ray).
     fn project(&self, p: Vec3) -> Self::P;
     /// True when the ray passes to the left of the directed edge `a → b`,
@@ -172,6 +184,27 @@ pub(crate) fn left_f32(a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
     left_2d!(a, ia, b, ib)
 }
 
+/// The power of two [`Projection::setup_scaled`] multiplies a ray's
+/// projected coordinates by, from `magnitude`, the largest coordinate of
+/// the vertices around the start of its walk relative to its origin
+/// (`|P − o|∞`): 1 for scenes of ordinary size (`magnitude` within
+/// 2⁻¹⁶…2¹⁶, so their walks are bit for bit what they always were), else
+/// `2⁻ᵉ` with `2ᵉ ≤ magnitude < 2ᵉ⁺¹`, which brings the projected
+/// coordinates near 1 and their determinants far from f32's limits. Only
+/// the walk's signs depend on the projection, and a power of two keeps
+/// them, so any such factor gives the same walk.
+pub fn walk_scale(magnitude: f64) -> f32 {
+    if !(magnitude.is_finite() && magnitude > 0.0) {
+        return 1.0;
+    }
+    let e = magnitude.log2().floor() as i32;
+    if (-16..=16).contains(&e) {
+        1.0
+    } else {
+        (2.0f64).powi(-e.clamp(-126, 126)) as f32
+    }
+}
+
 /// Duff et al.'s orthonormal basis for a unit vector `n`, ordered so that
 /// `u × v` points along `n` (public so the GPU crate projects batch rays with
 /// exactly the CPU's basis).
@@ -208,8 +241,11 @@ impl Projection for DuffF32 {
     simd_face!();
     const NAME: &'static str = "f32";
     fn setup(ray: &Ray) -> Self {
+        Self::setup_scaled(ray, 1.0)
+    }
+    fn setup_scaled(ray: &Ray, scale: f32) -> Self {
         let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
-        let (u, v) = (u.as_vec3(), v.as_vec3());
+        let (u, v) = (u.as_vec3() * scale, v.as_vec3() * scale);
         DuffF32 {
             o: ray.origin,
             cx: Vec4::new(u.x, v.x, 0.0, 0.0),
@@ -245,8 +281,11 @@ impl Projection for OriginF32 {
     simd_face!();
     const NAME: &'static str = "f32-po";
     fn setup(ray: &Ray) -> Self {
+        Self::setup_scaled(ray, 1.0)
+    }
+    fn setup_scaled(ray: &Ray, scale: f32) -> Self {
         let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
-        let (u, v) = (u.as_vec3(), v.as_vec3());
+        let (u, v) = (u.as_vec3() * scale, v.as_vec3() * scale);
         OriginF32 {
             po: Vec2::new(u.dot(ray.origin), v.dot(ray.origin)),
             u,

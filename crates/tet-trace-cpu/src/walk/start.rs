@@ -7,7 +7,7 @@ use glam::Vec3;
 use tet_core::predicates::orient3d;
 use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
 
-use super::projection::Projection;
+use super::projection::{Projection, walk_scale};
 use super::stop::{Resolved, resolve_constrained};
 use crate::locate::star;
 use crate::ray::{Failure, Ray, TraceOutcome};
@@ -138,7 +138,7 @@ fn start_fallback<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) 
 /// leaves it (the `start_in_tet` search of [`trace`](crate::walk::trace), with its fallback to the
 /// other tets around an origin on a face, edge or vertex).
 pub fn start_exit_face<P: Projection>(mesh: &TetMesh, ray: &Ray, tet: u32) -> Option<(u32, usize)> {
-    let proj = P::setup(ray);
+    let proj = P::setup_scaled(ray, tet_scale(mesh, ray, tet));
     let found = |t: u32| {
         start_in_tet(mesh, &proj, t).map(|s| {
             let k = (0..4)
@@ -197,7 +197,38 @@ pub(crate) fn begin<P: Projection>(
             tets_visited: 0,
         });
     }
-    begin_with(mesh, ray, P::setup(ray), start)
+    begin_with(
+        mesh,
+        ray,
+        P::setup_scaled(ray, start_scale(mesh, ray, start)),
+        start,
+    )
+}
+
+/// The factor of a walk's projection ([`walk_scale`]) for `ray` starting
+/// at `start`: from the start tet's vertices relative to the origin (1 for
+/// a start out of range, which the walk then reports). The GPU kernels
+/// scale their basis by the same factor.
+pub fn start_scale(mesh: &TetMesh, ray: &Ray, start: Start) -> f32 {
+    let tet = match start {
+        Start::Tet(t) => t,
+        Start::Face { tet, .. } | Start::Entry { tet, .. } => tet,
+    };
+    tet_scale(mesh, ray, tet)
+}
+
+/// [`walk_scale`] of the largest `|P − o|∞` over the vertices of `tet`.
+fn tet_scale(mesh: &TetMesh, ray: &Ray, tet: u32) -> f32 {
+    let Some(v) = mesh.tets.get(tet as usize) else {
+        return 1.0;
+    };
+    let o = ray.origin.as_dvec3();
+    let m = v
+        .iter()
+        .filter_map(|&i| mesh.points.get(i as usize))
+        .map(|p| (p.as_dvec3() - o).abs().max_element())
+        .fold(0.0f64, f64::max);
+    walk_scale(m)
 }
 
 /// [`begin`] of a valid ray whose projection `proj` is set up.
