@@ -1,0 +1,98 @@
+//! Read-only views of the built strips, for tests and diagnostics: what
+//! traversal reads, decoded.
+
+use glam::Vec3;
+
+use crate::layout::{BlockLayout, LEAF, PERMUTATION_BITS, PERMUTATIONS, StripData, split_counts};
+
+/// One node of a strip hierarchy, decoded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StripNode {
+    /// Split axis (0 = x, 1 = y, 2 = z).
+    pub axis: usize,
+    /// Largest coordinate of the lower child along `axis` (paper: split1).
+    pub lo: f32,
+    /// Smallest coordinate of the upper child along `axis` (paper: split2).
+    pub hi: f32,
+    /// Whether the lower child is the second part in strip order.
+    pub reverse: bool,
+    /// First part: first triangle and triangle count.
+    pub first: (u32, u32),
+    /// Second part: first triangle and triangle count.
+    pub second: (u32, u32),
+}
+
+/// One strip (one high-level BVH leaf), decoded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StripView {
+    /// Box of the BVH leaf holding the strip.
+    pub bounds: (Vec3, Vec3),
+    /// The `n + 2` strip vertex positions.
+    pub vertices: Vec<Vec3>,
+    /// Input triangle index of each strip triangle, in strip order.
+    pub triangles: Vec<u32>,
+    /// For each strip triangle, the strip position (0, 1 or 2 within
+    /// `vertices[j..j + 3]`) of input vertex 0, 1 and 2.
+    pub input_order: Vec<[u8; 3]>,
+    /// The hierarchy nodes in preorder.
+    pub nodes: Vec<StripNode>,
+    /// Size of the strip's block in bytes.
+    pub block_bytes: usize,
+}
+
+/// Decodes every strip, in BVH leaf order.
+pub(crate) fn strips(data: &StripData) -> Vec<StripView> {
+    data.nodes
+        .iter()
+        .filter(|n| n.b == LEAF)
+        .map(|leaf| {
+            let start = leaf.a as usize;
+            let layout = BlockLayout::new(start, data.words[start]);
+            let n = layout.n as usize;
+            let vertices = data.words[layout.indices..layout.indices + n + 2]
+                .iter()
+                .map(|&v| Vec3::from(data.vertices[v as usize]))
+                .collect();
+            let words = &data.words[layout.triangles..layout.triangles + n];
+            let mut nodes = Vec::new();
+            collect(data, &layout, 0, 0, layout.n, &mut nodes);
+            StripView {
+                bounds: (Vec3::from(leaf.min), Vec3::from(leaf.max)),
+                vertices,
+                triangles: words.iter().map(|w| w >> PERMUTATION_BITS).collect(),
+                input_order: words
+                    .iter()
+                    .map(|w| PERMUTATIONS[(w & ((1 << PERMUTATION_BITS) - 1)) as usize])
+                    .collect(),
+                nodes,
+                block_bytes: 4 * (layout.triangles + n - start),
+            }
+        })
+        .collect()
+}
+
+fn collect(
+    data: &StripData,
+    layout: &BlockLayout,
+    i: u32,
+    t0: u32,
+    m: u32,
+    out: &mut Vec<StripNode>,
+) {
+    if m <= 3 {
+        return;
+    }
+    let (lo, hi, axis, reverse) = layout.node(&data.words, i as usize);
+    let (first, second, first_pairs) = split_counts(m);
+    debug_assert_eq!(out.len(), i as usize, "preorder");
+    out.push(StripNode {
+        axis,
+        lo,
+        hi,
+        reverse,
+        first: (t0, first),
+        second: (t0 + first, second),
+    });
+    collect(data, layout, i + 1, t0, first, out);
+    collect(data, layout, i + first_pairs, t0 + first, second, out);
+}

@@ -1,0 +1,206 @@
+//! Ray-Strips: Lauterbach, Yoon and Manocha, "Ray-Strips: A Compact Mesh
+//! Representation for Interactive Ray Tracing" (IEEE RT 2007; seed 002).
+//!
+//! A two-level structure (paper §3.3): a high-level BVH built with the
+//! surface-area heuristic down to chunks of at most
+//! [`BuildOptions::chunk_triangles`] triangles; each chunk is cut into
+//! triangle strips, and each strip — one BVH leaf — carries a balanced,
+//! pointer-free strip hierarchy (a spatial kd-tree whose nodes store two
+//! split coordinates, an axis and a reverse flag, §4.1). Traversal follows
+//! Algorithm 1 for single rays and runs 2×2 packets that fall back to single
+//! rays when few stay active (§5); the triangle test is watertight.
+//!
+//! | paper | module |
+//! |---|---|
+//! | §3.3.1 high-level BVH, §4.2 chunks and strips | `build` (private): `sah`, `stripify`, `strip_hierarchy` |
+//! | §4.1 strip hierarchy, Fig. 5 layout | [`layout`] |
+//! | §5.1 Algorithm 1 | `traverse::single` |
+//! | §5.2 intersection (edge sharing) | `traverse::triangle` |
+//! | §5.3 ray packets | `traverse::packet` |
+//!
+//! # Memory
+//!
+//! Geometry: the global vertex list (12 bytes per vertex, `f32`), one
+//! 4-byte vertex index per strip vertex (`n + 2` per strip of `n`
+//! triangles) and one 4-byte word per triangle (input triangle index and
+//! vertex permutation, needed to report [`Hit::triangle`] and input-order
+//! barycentrics). For a closed mesh (about half as many vertices as
+//! triangles) and strips of mean length `s` that is about
+//! `6 + 4 (1 + 2/s) + 4` bytes per triangle. Hierarchy: a 4-byte header
+//! per strip and about 9 bytes per two triangles
+//! ([`layout::strip_words`] gives the exact size of a strip from `n`).
+//! Top level: 32 bytes per BVH node, about two nodes per strip.
+//! [`RayStrips::bytes`] reports the exact totals.
+//!
+//! # Input
+//!
+//! Indices out of range and non-finite vertex coordinates (of any vertex,
+//! used or not) are [`BuildError`]s. Triangles with two equal vertex
+//! indices are skipped (counted in [`Stats::skipped_triangles`]); other
+//! zero-area triangles are kept and never reported as hit (the watertight
+//! test rejects a zero determinant). Duplicate triangles and non-manifold
+//! edges are stored like any other triangle; on equal distances the hit
+//! with the smaller input index is reported.
+
+#![deny(missing_docs)]
+#![forbid(unsafe_code)]
+
+mod build;
+mod error;
+pub mod inspect;
+pub mod layout;
+mod options;
+mod ray;
+mod stats;
+mod traverse;
+
+use glam::Vec3;
+
+pub use error::BuildError;
+pub use options::BuildOptions;
+pub use ray::{Hit, Ray};
+pub use stats::{Bytes, Stats};
+
+use layout::{PERMUTATION_BITS, StripData, strip_hierarchy_words};
+use traverse::packet::{LANES, coherent, trace_packet};
+use traverse::prepared::{Best, Prepared};
+use traverse::single::trace_from;
+
+/// A built Ray-Strips structure over one triangle mesh; immutable and
+/// shareable between threads.
+#[derive(Clone, Debug)]
+pub struct RayStrips {
+    data: StripData,
+    stats: Stats,
+    bytes: Bytes,
+}
+
+impl RayStrips {
+    /// Builds the structure over `triangles` (indices into `positions`).
+    ///
+    /// # Errors
+    /// [`BuildError`] for an index out of range, a non-finite coordinate,
+    /// more than [`layout::MAX_TRIANGLES`] triangles or a zero
+    /// `chunk_triangles`.
+    pub fn build(
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        options: &BuildOptions,
+    ) -> Result<RayStrips, BuildError> {
+        let (data, stats) = build::build(positions, triangles, options)?;
+        let bytes = measure(&data);
+        Ok(Self { data, stats, bytes })
+    }
+
+    /// The closest hit with `t` in `[t_min, t_max]`, if any.
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let pre = Prepared::new(ray)?;
+        let mut best = Best::new(ray.t_max);
+        if !self.data.nodes.is_empty() {
+            trace_from(&self.data, 0, &pre, &mut best, false);
+        }
+        hit(&best)
+    }
+
+    /// Whether anything is hit with `t` in `[t_min, t_max]`.
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        let Some(pre) = Prepared::new(ray) else {
+            return false;
+        };
+        let mut best = Best::new(ray.t_max);
+        !self.data.nodes.is_empty() && trace_from(&self.data, 0, &pre, &mut best, true)
+    }
+
+    /// Closest hits of many rays: `out[i]` is exactly `self.intersect(&rays[i])`.
+    /// Consecutive groups of four rays travel as 2×2 packets when their
+    /// directions share signs on all axes (pass the four rays of a 2×2
+    /// pixel block together for coherence), otherwise as single rays.
+    ///
+    /// # Panics
+    /// If `out.len() != rays.len()`.
+    pub fn intersect_packet(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        assert_eq!(
+            rays.len(),
+            out.len(),
+            "intersect_packet needs one output slot per ray"
+        );
+        for (rays, out) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
+            let mut pre = [None; LANES];
+            let mut mask = 0u8;
+            for (l, r) in rays.iter().enumerate() {
+                pre[l] = Prepared::new(r);
+                if pre[l].is_some() {
+                    mask |= 1 << l;
+                }
+            }
+            let fill = pre.iter().flatten().next().copied();
+            let (Some(fill), false) = (fill, self.data.nodes.is_empty()) else {
+                out.fill(None);
+                continue;
+            };
+            let pre = pre.map(|p| p.unwrap_or(fill));
+            let mut best: [Best; LANES] =
+                std::array::from_fn(|l| Best::new(rays.get(l).map_or(0.0, |r| r.t_max)));
+            if coherent(&pre, mask) {
+                trace_packet(&self.data, &pre, mask, &mut best);
+            } else {
+                for l in (0..LANES).filter(|l| mask & (1 << l) != 0) {
+                    trace_from(&self.data, 0, &pre[l], &mut best[l], false);
+                }
+            }
+            for (l, o) in out.iter_mut().enumerate() {
+                *o = if mask & (1 << l) != 0 {
+                    hit(&best[l])
+                } else {
+                    None
+                };
+            }
+        }
+    }
+
+    /// Exact heap bytes of what traversal reads.
+    pub fn bytes(&self) -> Bytes {
+        self.bytes
+    }
+
+    /// Counts: triangles, strips, chunks, nodes.
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    /// Every strip decoded (positions, input triangles, hierarchy nodes),
+    /// in BVH leaf order: for tests and diagnostics, not for speed.
+    pub fn strips(&self) -> Vec<inspect::StripView> {
+        inspect::strips(&self.data)
+    }
+}
+
+fn hit(best: &Best) -> Option<Hit> {
+    (best.word != u32::MAX).then(|| Hit {
+        triangle: best.word >> PERMUTATION_BITS,
+        t: best.t,
+        u: best.u,
+        v: best.v,
+    })
+}
+
+/// Splits the heap bytes by walking the BVH leaves' strip headers.
+fn measure(data: &StripData) -> Bytes {
+    let hierarchy_words: usize = data
+        .nodes
+        .iter()
+        .filter(|n| n.b == layout::LEAF)
+        .map(|n| strip_hierarchy_words(data.words[n.a as usize] as usize))
+        .sum();
+    let hierarchy = 4 * hierarchy_words;
+    let geometry = std::mem::size_of_val(data.vertices.as_slice())
+        + std::mem::size_of_val(data.words.as_slice())
+        - hierarchy;
+    let top_level = std::mem::size_of_val(data.nodes.as_slice());
+    Bytes {
+        geometry,
+        hierarchy,
+        top_level,
+        total: geometry + hierarchy + top_level,
+    }
+}
