@@ -64,7 +64,7 @@ pub use stats::{Bytes, Stats};
 use layout::{PERMUTATION_BITS, StripData, strip_hierarchy_words};
 use traverse::packet::{LANES, coherent, trace_packet};
 use traverse::prepared::{Best, Prepared};
-use traverse::single::trace_from;
+use traverse::single::{Stacks, trace_from};
 
 /// A built Ray-Strips structure over one triangle mesh; immutable and
 /// shareable between threads.
@@ -97,7 +97,7 @@ impl RayStrips {
         let pre = Prepared::new(ray)?;
         let mut best = Best::new(ray.t_max);
         if !self.data.nodes.is_empty() {
-            trace_from(&self.data, 0, &pre, &mut best, false);
+            trace_from(&self.data, 0, &pre, &mut best, false, &mut Stacks::new());
         }
         hit(&best)
     }
@@ -108,7 +108,8 @@ impl RayStrips {
             return false;
         };
         let mut best = Best::new(ray.t_max);
-        !self.data.nodes.is_empty() && trace_from(&self.data, 0, &pre, &mut best, true)
+        !self.data.nodes.is_empty()
+            && trace_from(&self.data, 0, &pre, &mut best, true, &mut Stacks::new())
     }
 
     /// Closest hits of many rays: `out[i]` is exactly `self.intersect(&rays[i])`.
@@ -144,8 +145,9 @@ impl RayStrips {
             if coherent(&pre, mask) {
                 trace_packet(&self.data, &pre, mask, &mut best);
             } else {
+                let mut stacks = Stacks::new();
                 for l in (0..LANES).filter(|l| mask & (1 << l) != 0) {
-                    trace_from(&self.data, 0, &pre[l], &mut best[l], false);
+                    trace_from(&self.data, 0, &pre[l], &mut best[l], false, &mut stacks);
                 }
             }
             for (l, o) in out.iter_mut().enumerate() {

@@ -12,7 +12,7 @@
 use crate::layout::{BlockLayout, LEAF, StripData};
 use crate::traverse::prepared::{Best, Prepared};
 use crate::traverse::single::{
-    BVH_STACK, Part, STRIP_STACK, child_intervals, node_children, strip_from, trace_from,
+    BVH_STACK, Part, STRIP_STACK, Stacks, child_intervals, node_children, strip_from, trace_from,
 };
 use crate::traverse::triangle::intersect_leaf;
 
@@ -47,6 +47,14 @@ pub(crate) fn trace_packet(
         return;
     };
     let forward = |a: usize| rays[lead].forward(a);
+    let mut singles = Stacks::new();
+    let root = Part {
+        node: 0,
+        t0: 0,
+        m: 0,
+    };
+    let mut strip_stack: [Entry; STRIP_STACK] =
+        [(root, 0, [0.0; LANES], [0.0; LANES]); STRIP_STACK];
     let mut stack = [(0u32, 0u8); BVH_STACK];
     stack[0] = (0, mask);
     let mut sp = 1;
@@ -69,13 +77,21 @@ pub(crate) fn trace_packet(
         }
         if active.count_ones() <= SINGLE_BELOW {
             for l in lanes(active) {
-                trace_from(data, i, &rays[l], &mut best[l], false);
+                trace_from(data, i, &rays[l], &mut best[l], false, &mut singles);
             }
             continue;
         }
         if node.b == LEAF {
             let layout = BlockLayout::new(node.a as usize, data.words[node.a as usize]);
-            strip_packet(data, &layout, active, dmin, dmax, rays, best, &forward);
+            strip_packet(
+                data,
+                &layout,
+                (active, dmin, dmax),
+                rays,
+                best,
+                &forward,
+                (&mut strip_stack, &mut singles),
+            );
         } else {
             let (first, second) = (i + 1, node.a);
             let (near, far) = if forward(node.b as usize) {
@@ -99,19 +115,17 @@ type Entry = (Part, u8, [f32; LANES], [f32; LANES]);
 fn strip_packet(
     data: &StripData,
     layout: &BlockLayout,
-    mask: u8,
-    dmin: [f32; LANES],
-    dmax: [f32; LANES],
+    (mask, dmin, dmax): (u8, [f32; LANES], [f32; LANES]),
     rays: &[Prepared; LANES],
     best: &mut [Best; LANES],
     forward: &impl Fn(usize) -> bool,
+    (stack, singles): (&mut [Entry; STRIP_STACK], &mut Stacks),
 ) {
     let root = Part {
         node: 0,
         t0: 0,
         m: layout.n,
     };
-    let mut stack: [Entry; STRIP_STACK] = [(root, 0, [0.0; LANES], [0.0; LANES]); STRIP_STACK];
     let mut sp = 0;
     let mut cur: Entry = (root, mask, dmin, dmax);
     loop {
@@ -134,6 +148,7 @@ fn strip_packet(
                         &rays[l],
                         &mut best[l],
                         false,
+                        &mut singles.strip,
                     );
                 }
             } else if part.m <= 3 {

@@ -28,6 +28,28 @@ pub(crate) const BVH_STACK: usize = 128;
 /// Traversal stack depth of a strip hierarchy (`log2` of the largest strip).
 pub(crate) const STRIP_STACK: usize = 32;
 
+/// The stacks of one single-ray traversal, allocated once per ray (or
+/// once per packet for its single-ray fallbacks).
+pub(crate) struct Stacks {
+    bvh: [u32; BVH_STACK],
+    pub(crate) strip: [(Part, f32, f32); STRIP_STACK],
+}
+
+impl Stacks {
+    /// Empty stacks.
+    pub fn new() -> Self {
+        let part = Part {
+            node: 0,
+            t0: 0,
+            m: 0,
+        };
+        Self {
+            bvh: [0; BVH_STACK],
+            strip: [(part, 0.0, 0.0); STRIP_STACK],
+        }
+    }
+}
+
 /// A strip-hierarchy node to visit: preorder index, first triangle,
 /// triangle count.
 #[derive(Clone, Copy, Debug)]
@@ -108,8 +130,9 @@ pub(crate) fn trace_from(
     ray: &Prepared,
     best: &mut Best,
     any: bool,
+    stacks: &mut Stacks,
 ) -> bool {
-    let mut stack = [0u32; BVH_STACK];
+    let Stacks { bvh: stack, strip } = stacks;
     stack[0] = root;
     let mut sp = 1;
     while sp > 0 {
@@ -126,7 +149,7 @@ pub(crate) fn trace_from(
                 t0: 0,
                 m: layout.n,
             };
-            if strip_from(data, &layout, root, tn, tf, ray, best, any) && any {
+            if strip_from(data, &layout, root, tn, tf, ray, best, any, strip) && any {
                 return true;
             }
         } else {
@@ -156,8 +179,8 @@ pub(crate) fn strip_from(
     ray: &Prepared,
     best: &mut Best,
     any: bool,
+    stack: &mut [(Part, f32, f32); STRIP_STACK],
 ) -> bool {
-    let mut stack = [(part, 0.0f32, 0.0f32); STRIP_STACK];
     let mut sp = 0;
     let mut cur = (part, dmin, dmax);
     let mut hit = false;
