@@ -3,7 +3,9 @@
 
 use glam::Vec3;
 
-use crate::layout::{BlockLayout, LEAF, PERMUTATION_BITS, PERMUTATIONS, StripData, split_counts};
+use crate::layout::{
+    BlockLayout, LEAF, PERMUTATION_BITS, PERMUTATIONS, SWAP_WORD, StripData, split_counts,
+};
 
 /// One node of a strip hierarchy, decoded.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,11 +31,13 @@ pub struct StripView {
     pub bounds: (Vec3, Vec3),
     /// The `n + 2` strip vertex positions.
     pub vertices: Vec<Vec3>,
-    /// Input triangle index of each strip triangle, in strip order.
-    pub triangles: Vec<u32>,
+    /// Input triangle index of each strip triangle, in strip order (`None`
+    /// for a swap slot, which repeats a neighbouring triangle).
+    pub triangles: Vec<Option<u32>>,
     /// For each strip triangle, the strip position (0, 1 or 2 within
-    /// `vertices[j..j + 3]`) of input vertex 0, 1 and 2.
-    pub input_order: Vec<[u8; 3]>,
+    /// `vertices[j..j + 3]`) of input vertex 0, 1 and 2 (`None` for a swap
+    /// slot).
+    pub input_order: Vec<Option<[u8; 3]>>,
     /// The hierarchy nodes in preorder.
     pub nodes: Vec<StripNode>,
     /// Size of the strip's block in bytes.
@@ -59,10 +63,16 @@ pub(crate) fn strips(data: &StripData) -> Vec<StripView> {
             StripView {
                 bounds: (Vec3::from(leaf.min), Vec3::from(leaf.max)),
                 vertices,
-                triangles: words.iter().map(|w| w >> PERMUTATION_BITS).collect(),
+                triangles: words
+                    .iter()
+                    .map(|&w| (w != SWAP_WORD).then_some(w >> PERMUTATION_BITS))
+                    .collect(),
                 input_order: words
                     .iter()
-                    .map(|w| PERMUTATIONS[(w & ((1 << PERMUTATION_BITS) - 1)) as usize])
+                    .map(|&w| {
+                        (w != SWAP_WORD)
+                            .then(|| PERMUTATIONS[(w & ((1 << PERMUTATION_BITS) - 1)) as usize])
+                    })
                     .collect(),
                 nodes,
                 block_bytes: 4 * (layout.triangles + n - start),

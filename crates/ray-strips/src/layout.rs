@@ -14,9 +14,10 @@
 //! | `2K` | nodes in preorder: `lo`, `hi` split coordinates (`f32` bits) |
 //! | `⌈K/4⌉` | node flags, one byte per node, four per word (little end first): bits 0–1 axis, bit 2 reverse |
 //! | `n + 2` | strip vertex indices into the global vertex list |
-//! | `n` | per-triangle word: `input_triangle << 3 \| permutation` |
+//! | `n` | per-triangle word: `input_triangle << 3 \| permutation` (permutation 7: swap slot) |
 //!
-//! with `K = max(⌊n/2⌋ − 1, 0)` ([`hierarchy_nodes`]). Hence the size is
+//! with `K = max(⌊n/2⌋ − 1, 0)` ([`hierarchy_nodes`]), `n` counting swap
+//! slots (see the stripifier) as triangles. Hence the size is
 //! known from `n` alone:
 //!
 //! `strip_words(n) = 1 + 2K + ⌈K/4⌉ + (n + 2) + n`.
@@ -59,6 +60,10 @@ pub(crate) const REVERSE: u8 = 4;
 
 /// Per-triangle word: bits above this hold the input triangle index.
 pub(crate) const PERMUTATION_BITS: u32 = 3;
+
+/// Per-triangle word of a swap slot (permutation field 7): a copy of a
+/// neighbouring triangle that the strip needs to turn, never tested.
+pub(crate) const SWAP_WORD: u32 = 7;
 
 /// Largest input triangle count a per-triangle word can name.
 pub const MAX_TRIANGLES: usize = 1 << (32 - PERMUTATION_BITS);

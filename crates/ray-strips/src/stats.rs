@@ -30,9 +30,13 @@ pub struct Stats {
     pub vertices: usize,
     /// Number of triangle strips.
     pub strips: usize,
-    /// `triangles / strips` (0 for an empty mesh).
+    /// Swap slots: copies of a neighbouring triangle that let a strip
+    /// turn; they take a triangle's place in the strip and its hierarchy
+    /// but are never tested.
+    pub swap_slots: usize,
+    /// `triangles / strips` (0 for an empty mesh), swap slots not counted.
     pub mean_strip_triangles: f64,
-    /// Longest strip, in triangles.
+    /// Longest strip, in triangles and swap slots.
     pub max_strip_triangles: usize,
     /// Leaves of the SAH stage (groups of at most `chunk_triangles`).
     pub chunks: usize,

@@ -52,9 +52,23 @@ fn every_triangle_is_in_exactly_one_strip_with_its_vertices_in_input_order() {
             let mut seen = vec![0u32; triangles.len()];
             for s in rs.strips() {
                 assert_eq!(s.vertices.len(), s.triangles.len() + 2);
+                let set = |j: usize| {
+                    let mut a =
+                        [s.vertices[j], s.vertices[j + 1], s.vertices[j + 2]].map(|p| p.to_array());
+                    a.sort_by(|x, y| x.partial_cmp(y).unwrap());
+                    a
+                };
                 for (j, &t) in s.triangles.iter().enumerate() {
+                    let Some(t) = t else {
+                        // A swap slot repeats a neighbouring triangle.
+                        assert!(s.input_order[j].is_none());
+                        let prev = j > 0 && set(j) == set(j - 1);
+                        let next = j + 1 < s.triangles.len() && set(j) == set(j + 1);
+                        assert!(prev || next, "swap slot {j} repeats no neighbour");
+                        continue;
+                    };
                     seen[t as usize] += 1;
-                    let order = s.input_order[j];
+                    let order = s.input_order[j].unwrap();
                     for k in 0..3 {
                         let input = positions[triangles[t as usize][k] as usize];
                         let stored = s.vertices[j + order[k] as usize];
@@ -65,8 +79,15 @@ fn every_triangle_is_in_exactly_one_strip_with_its_vertices_in_input_order() {
             assert!(seen.iter().all(|&c| c == 1), "chunk {chunk}: coverage");
             let stats = rs.stats();
             assert_eq!(stats.triangles, triangles.len());
+            let slots: usize = rs.strips().iter().map(|s| s.triangles.len()).sum();
+            assert_eq!(slots, stats.triangles + stats.swap_slots);
             assert!(stats.chunks >= triangles.len().div_ceil(chunk));
-            let longest = rs.strips().iter().map(|s| s.triangles.len()).max().unwrap();
+            let longest = rs
+                .strips()
+                .iter()
+                .map(|s| s.triangles.iter().flatten().count())
+                .max()
+                .unwrap();
             assert!(longest <= chunk);
         }
     }

@@ -16,12 +16,13 @@ use glam::Vec3;
 
 use crate::error::BuildError;
 use crate::layout::{
-    BvhNode, LEAF, MAX_TRIANGLES, PERMUTATION_BITS, PERMUTATIONS, StripData, hierarchy_nodes,
+    BvhNode, LEAF, MAX_TRIANGLES, PERMUTATION_BITS, PERMUTATIONS, SWAP_WORD, StripData,
+    hierarchy_nodes,
 };
 use crate::options::BuildOptions;
 use crate::stats::Stats;
 use sah::{Item, bounds, median, split};
-use stripify::{Strip, stripify};
+use stripify::{SWAP, Strip, stripify};
 
 /// Depth from which the SAH gives way to count-median splits, which keeps
 /// the tree (and the traversal stacks) shallow on any input.
@@ -194,6 +195,9 @@ impl Builder<'_> {
             .iter()
             .enumerate()
             .map(|(j, &local)| {
+                if local == SWAP {
+                    return SWAP_WORD;
+                }
                 let input = ids[local as usize];
                 let tri = self.triangles[input as usize];
                 let at = &strip.vertices[j..j + 3];
@@ -221,6 +225,7 @@ impl Builder<'_> {
             b: LEAF,
         });
         self.stats.strips += 1;
+        self.stats.swap_slots += strip.triangles.iter().filter(|&&t| t == SWAP).count();
         self.stats.max_strip_triangles = self.stats.max_strip_triangles.max(n);
         self.stats.hierarchy_nodes += hierarchy_nodes(n);
     }

@@ -3,9 +3,13 @@
 //!
 //! A strip is a vertex sequence `s₀ s₁ … s₍ₙ₊₁₎` whose triangle `j` is
 //! `{s_j, s_{j+1}, s_{j+2}}`; consecutive triangles share the edge
-//! `(s_{j+1}, s_{j+2})`. No swaps and no degenerate (repeated-vertex)
-//! triangles are inserted, so a strip can only turn left and right in
-//! alternation; where the mesh does not allow that, a new strip starts.
+//! `(s_{j+1}, s_{j+2})`, so a plain strip can only turn left and right in
+//! alternation. Where the mesh does not allow that, the strip *swaps*: after
+//! `… o p q` it continues across edge `(o, q)` instead of `(p, q)` by
+//! repeating `o` (`… o p q o r`). The slot `(p, q, o)` this creates is a
+//! copy of the triangle before it, marked [`SWAP`] and never tested; it
+//! costs one vertex index and one per-triangle word, far less than the
+//! header, two BVH nodes and two extra indices of a new strip.
 //!
 //! The algorithm, in the spirit of Stripe's and of the classic SGI
 //! stripifier:
@@ -25,12 +29,16 @@
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, VecDeque};
 
+/// Entry of [`Strip::triangles`] for a swap slot.
+pub(crate) const SWAP: u32 = u32::MAX;
+
 /// One strip over a chunk's local triangles.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(crate) struct Strip {
     /// The `n + 2` vertex indices.
     pub vertices: Vec<u32>,
-    /// The `n` local triangle indices, in strip order.
+    /// The `n` local triangle indices, in strip order ([`SWAP`] for swap
+    /// slots).
     pub triangles: Vec<u32>,
 }
 
@@ -111,15 +119,15 @@ pub(crate) fn stripify(triangles: &[[u32; 3]]) -> Vec<Strip> {
         for rotation in 0..3 {
             stamp += 1;
             let grown = grow(&adj, start, rotation, &used, &degree, &mut mark, stamp);
-            if best.as_ref().is_none_or(|b| grown.1.len() > b.1.len()) {
+            if best.as_ref().is_none_or(|b| real(&grown.1) > real(&b.1)) {
                 best = Some(grown);
             }
         }
         let (vertices, tris) = best.expect("three rotations tried");
-        for &t in &tris {
+        for &t in tris.iter().filter(|&&t| t != SWAP) {
             used[t as usize] = true;
         }
-        for &t in &tris {
+        for &t in tris.iter().filter(|&&t| t != SWAP) {
             for o in adj.neighbours(t) {
                 if !used[o as usize] {
                     degree[o as usize] -= 1;
@@ -133,6 +141,11 @@ pub(crate) fn stripify(triangles: &[[u32; 3]]) -> Vec<Strip> {
         });
     }
     strips
+}
+
+/// Triangles of a strip that are not swap slots.
+fn real(tris: &VecDeque<u32>) -> usize {
+    tris.iter().filter(|&&t| t != SWAP).count()
 }
 
 /// Grows a strip from `start` (its vertices rotated by `rotation`) in both
@@ -156,18 +169,38 @@ fn grow(
             .min_by_key(|&o| (degree[o as usize], o))
     };
     loop {
-        let (p, q) = (vertices[vertices.len() - 2], vertices[vertices.len() - 1]);
-        let Some(t) = next(p, q, mark) else { break };
-        mark[t as usize] = stamp;
-        vertices.push_back(adj.third(t, p, q));
-        tris.push_back(t);
+        let len = vertices.len();
+        let (o, p, q) = (vertices[len - 3], vertices[len - 2], vertices[len - 1]);
+        if let Some(t) = next(p, q, mark) {
+            mark[t as usize] = stamp;
+            vertices.push_back(adj.third(t, p, q));
+            tris.push_back(t);
+        } else if let Some(t) = next(o, q, mark) {
+            mark[t as usize] = stamp;
+            vertices.push_back(o);
+            tris.push_back(SWAP);
+            vertices.push_back(adj.third(t, o, q));
+            tris.push_back(t);
+        } else {
+            break;
+        }
     }
     loop {
-        let (p, q) = (vertices[0], vertices[1]);
-        let Some(t) = next(p, q, mark) else { break };
-        mark[t as usize] = stamp;
-        vertices.push_front(adj.third(t, p, q));
-        tris.push_front(t);
+        let (p, q, r) = (vertices[0], vertices[1], vertices[2]);
+        if let Some(t) = next(p, q, mark) {
+            mark[t as usize] = stamp;
+            vertices.push_front(adj.third(t, p, q));
+            tris.push_front(t);
+        } else if let Some(t) = next(r, p, mark) {
+            // `r p q …` becomes `x r p q …` after the swap slot `(r, p, q)`.
+            mark[t as usize] = stamp;
+            vertices.push_front(r);
+            tris.push_front(SWAP);
+            vertices.push_front(adj.third(t, r, p));
+            tris.push_front(t);
+        } else {
+            break;
+        }
     }
     (vertices, tris)
 }
@@ -193,13 +226,22 @@ mod tests {
         let mut seen = vec![0; tris.len()];
         for s in strips {
             assert_eq!(s.vertices.len(), s.triangles.len() + 2);
-            for (j, &t) in s.triangles.iter().enumerate() {
-                seen[t as usize] += 1;
+            let set = |j: usize| {
                 let mut a = [s.vertices[j], s.vertices[j + 1], s.vertices[j + 2]];
-                let mut b = tris[t as usize];
                 a.sort();
+                a
+            };
+            for (j, &t) in s.triangles.iter().enumerate() {
+                if t == SWAP {
+                    let prev = j > 0 && set(j) == set(j - 1);
+                    let next = j + 1 < s.triangles.len() && set(j) == set(j + 1);
+                    assert!(prev || next, "swap slot {j} repeats a neighbour");
+                    continue;
+                }
+                seen[t as usize] += 1;
+                let mut b = tris[t as usize];
                 b.sort();
-                assert_eq!(a, b, "strip triangle {j} is not input triangle {t}");
+                assert_eq!(set(j), b, "strip triangle {j} is not input triangle {t}");
             }
         }
         assert!(seen.iter().all(|&c| c == 1), "coverage {seen:?}");
@@ -222,6 +264,16 @@ mod tests {
         let mut fan: Vec<[u32; 3]> = (1..9).map(|i| [0, i, i + 1]).collect();
         fan.push([0, 1, 2]);
         fan.push([0, 1, 20]);
-        check_cover(&fan, &stripify(&fan));
+        let strips = stripify(&fan);
+        check_cover(&fan, &strips);
+    }
+
+    #[test]
+    fn a_fan_is_one_strip_with_swaps() {
+        let fan: Vec<[u32; 3]> = (1..9).map(|i| [0, i, i + 1]).collect();
+        let strips = stripify(&fan);
+        check_cover(&fan, &strips);
+        assert_eq!(strips.len(), 1, "{strips:?}");
+        assert!(strips[0].triangles.contains(&SWAP));
     }
 }

@@ -17,11 +17,13 @@
 //! zero all three are recomputed in `f64`, where the products of `f32`
 //! values are exact, as Woop et al. do.
 //!
+//! Swap slots (copies of a neighbour that let a strip turn) are skipped.
+//!
 //! A hit replaces the best one when it is closer, or equally close with a
 //! smaller input triangle index, so the result does not depend on the order
 //! in which triangles are tested.
 
-use crate::layout::{BlockLayout, PERMUTATION_BITS, PERMUTATIONS, StripData};
+use crate::layout::{BlockLayout, PERMUTATION_BITS, PERMUTATIONS, SWAP_WORD, StripData};
 use crate::traverse::prepared::{Best, Prepared};
 
 /// Largest leaf (in triangles) of a strip hierarchy.
@@ -82,7 +84,7 @@ pub(crate) fn intersect_leaf(
             continue;
         }
         let word = data.words[layout.triangles + t0 as usize + j];
-        if t == best.t && word >= best.word {
+        if word == SWAP_WORD || (t == best.t && word >= best.word) {
             continue;
         }
         let weights = [u / det, v / det, w / det];
