@@ -134,6 +134,7 @@ fn measure(name: &str, positions: &[Vec3], triangles: &[[u32; 3]]) {
     for chunk in [1, 16, 64, 128, 256, 512, 1024, 4096] {
         let options = BuildOptions {
             chunk_triangles: chunk,
+            ..BuildOptions::default()
         };
         let (build_s, rs) = best_of(3, || {
             RayStrips::build(positions, triangles, &options).expect("valid mesh")

@@ -38,4 +38,7 @@ pub enum BuildError {
     /// `BuildOptions::chunk_triangles` is zero.
     #[error("chunk_triangles must be at least 1")]
     ZeroChunkTriangles,
+    /// `BuildOptions::strips_per_leaf` is zero.
+    #[error("strips_per_leaf must be at least 1")]
+    ZeroStripsPerLeaf,
 }

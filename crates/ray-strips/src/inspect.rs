@@ -4,7 +4,8 @@
 use glam::Vec3;
 
 use crate::layout::{
-    BlockLayout, LEAF, PERMUTATION_BITS, PERMUTATIONS, SWAP_WORD, StripData, split_counts,
+    BlockLayout, PERMUTATION_BITS, PERMUTATIONS, SWAP_WORD, StripData, is_leaf, leaf_blocks,
+    split_counts, strip_words,
 };
 
 /// One node of a strip hierarchy, decoded.
@@ -27,7 +28,8 @@ pub struct StripNode {
 /// One strip (one high-level BVH leaf), decoded.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StripView {
-    /// Box of the BVH leaf holding the strip.
+    /// Box of the BVH leaf holding the strip (shared by the strips of a
+    /// leaf when `strips_per_leaf > 1`).
     pub bounds: (Vec3, Vec3),
     /// The `n + 2` strip vertex positions.
     pub vertices: Vec<Vec3>,
@@ -48,9 +50,16 @@ pub struct StripView {
 pub(crate) fn strips(data: &StripData) -> Vec<StripView> {
     data.nodes
         .iter()
-        .filter(|n| n.b == LEAF)
-        .map(|leaf| {
-            let start = leaf.a as usize;
+        .filter(|n| is_leaf(n))
+        .flat_map(|leaf| {
+            let (first, count) = leaf_blocks(leaf);
+            (0..count).scan(first, move |offset, _| {
+                let start = *offset;
+                *offset += strip_words(data.words[start] as usize);
+                Some((leaf, start))
+            })
+        })
+        .map(|(leaf, start)| {
             let layout = BlockLayout::new(start, data.words[start]);
             let n = layout.n as usize;
             let vertices = data.words[layout.indices..layout.indices + n + 2]

@@ -158,7 +158,8 @@ pub(crate) const LEAF: u32 = 1 << 31;
 /// A high-level BVH node (32 bytes). Inner: first child at `self + 1`,
 /// second child at `a`, `b` = split axis (children are visited first-child
 /// first when the ray's direction along that axis is `≥ 0`). Leaf:
-/// `a` = word offset of its strip block, `b = LEAF`.
+/// `a` = word offset of its first strip block, `b = LEAF | count` for
+/// `count` consecutive blocks.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct BvhNode {
     /// Box minimum.
@@ -169,6 +170,19 @@ pub(crate) struct BvhNode {
     pub a: u32,
     /// Split axis (inner) or [`LEAF`].
     pub b: u32,
+}
+
+/// The strip blocks of a leaf node: `(offset, count)` (meaningful only
+/// for leaves).
+#[inline(always)]
+pub(crate) fn leaf_blocks(node: &BvhNode) -> (usize, u32) {
+    (node.a as usize, node.b & !LEAF)
+}
+
+/// Whether a BVH node is a leaf.
+#[inline(always)]
+pub(crate) fn is_leaf(node: &BvhNode) -> bool {
+    node.b & LEAF != 0
 }
 
 /// Everything traversal reads.

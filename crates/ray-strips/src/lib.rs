@@ -188,12 +188,13 @@ fn hit(best: &Best) -> Option<Hit> {
 
 /// Splits the heap bytes by walking the BVH leaves' strip headers.
 fn measure(data: &StripData) -> Bytes {
-    let hierarchy_words: usize = data
-        .nodes
-        .iter()
-        .filter(|n| n.b == layout::LEAF)
-        .map(|n| strip_hierarchy_words(data.words[n.a as usize] as usize))
-        .sum();
+    let mut hierarchy_words = 0;
+    let mut offset = 0;
+    while offset < data.words.len() {
+        let n = data.words[offset] as usize;
+        hierarchy_words += strip_hierarchy_words(n);
+        offset += layout::strip_words(n);
+    }
     let hierarchy = 4 * hierarchy_words;
     let geometry = std::mem::size_of_val(data.vertices.as_slice())
         + std::mem::size_of_val(data.words.as_slice())

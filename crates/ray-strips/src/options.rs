@@ -9,6 +9,14 @@ pub struct BuildOptions {
     /// strip hierarchy. Larger chunks allow longer strips (less memory) at
     /// the cost of a less SAH-shaped lower hierarchy. Must be at least 1.
     pub chunk_triangles: usize,
+    /// High-level BVH leaves hold up to this many strips of one chunk
+    /// (consecutive blocks sharing the leaf's box as the root box of their
+    /// hierarchies). The paper gives every strip its own leaf (`1`); larger
+    /// values save about 64 bytes per strip of top-level nodes at the cost
+    /// of looser root boxes. Must be at least 1.
+    pub strips_per_leaf: usize,
+    /// Let strips turn through swap slots (see the stripifier's docs).
+    pub strip_swaps: bool,
 }
 
 impl Default for BuildOptions {
@@ -19,6 +27,8 @@ impl Default for BuildOptions {
     fn default() -> Self {
         Self {
             chunk_triangles: 256,
+            strips_per_leaf: 1,
+            strip_swaps: false,
         }
     }
 }

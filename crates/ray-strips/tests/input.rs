@@ -46,8 +46,15 @@ fn a_non_finite_coordinate_names_the_vertex() {
 
 #[test]
 fn zero_chunk_size_is_an_error() {
-    let err =
-        RayStrips::build(&quad(), &[[0, 1, 2]], &BuildOptions { chunk_triangles: 0 }).unwrap_err();
+    let err = RayStrips::build(
+        &quad(),
+        &[[0, 1, 2]],
+        &BuildOptions {
+            chunk_triangles: 0,
+            ..BuildOptions::default()
+        },
+    )
+    .unwrap_err();
     assert_eq!(err, BuildError::ZeroChunkTriangles);
 }
 

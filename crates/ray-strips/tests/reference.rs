@@ -149,8 +149,10 @@ proptest! {
         (positions, triangles) in mesh(),
         rays in rays(),
         chunk in prop_oneof![Just(1usize), Just(4), Just(16), Just(256)],
+        strips_per_leaf in 1usize..4,
+        strip_swaps in any::<bool>(),
     ) {
-        let rs = RayStrips::build(&positions, &triangles, &BuildOptions { chunk_triangles: chunk })
+        let rs = RayStrips::build(&positions, &triangles, &BuildOptions { chunk_triangles: chunk, strips_per_leaf, strip_swaps })
             .unwrap();
         for ray in &rays {
             check_against_reference(&positions, &triangles, &rs, ray);
@@ -164,8 +166,10 @@ proptest! {
         eye in unit(),
         dist in 1.5f32..6.0,
         chunk in prop_oneof![Just(2usize), Just(32), Just(256)],
+        strips_per_leaf in 1usize..4,
+        strip_swaps in any::<bool>(),
     ) {
-        let rs = RayStrips::build(&positions, &triangles, &BuildOptions { chunk_triangles: chunk })
+        let rs = RayStrips::build(&positions, &triangles, &BuildOptions { chunk_triangles: chunk, strips_per_leaf, strip_swaps })
             .unwrap();
         let rays = camera_rays(eye.normalize() * dist, 6);
         check_packets(&rs, &rays);

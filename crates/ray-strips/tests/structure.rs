@@ -43,10 +43,19 @@ fn node_count_and_block_size_follow_the_formulas() {
 
 #[test]
 fn every_triangle_is_in_exactly_one_strip_with_its_vertices_in_input_order() {
-    for chunk in [1, 7, 64, 256, 100_000] {
+    for (chunk, strips_per_leaf, strip_swaps) in [
+        (1, 1, false),
+        (7, 1, true),
+        (64, 3, false),
+        (256, 1, false),
+        (256, 8, true),
+        (100_000, 1, true),
+    ] {
         for (positions, triangles) in meshes() {
             let options = BuildOptions {
                 chunk_triangles: chunk,
+                strips_per_leaf,
+                strip_swaps,
             };
             let rs = RayStrips::build(&positions, &triangles, &options).unwrap();
             let mut seen = vec![0u32; triangles.len()];
@@ -101,6 +110,7 @@ fn hierarchy_planes_bound_their_children_and_the_leaf_box_bounds_the_strip() {
             &triangles,
             &BuildOptions {
                 chunk_triangles: 512,
+                ..BuildOptions::default()
             },
         )
         .unwrap();
@@ -141,28 +151,42 @@ fn hierarchy_planes_bound_their_children_and_the_leaf_box_bounds_the_strip() {
 #[test]
 fn bytes_add_up_from_the_block_formula() {
     for (positions, triangles) in meshes() {
-        let rs = RayStrips::build(&positions, &triangles, &BuildOptions::default()).unwrap();
-        let strips = rs.strips();
-        let stats = rs.stats();
-        let blocks: usize = strips
-            .iter()
-            .map(|s| 4 * layout::strip_words(s.triangles.len()))
-            .sum();
-        assert_eq!(strips.iter().map(|s| s.block_bytes).sum::<usize>(), blocks);
-        let hierarchy: usize = strips
-            .iter()
-            .map(|s| {
-                let k = layout::hierarchy_nodes(s.triangles.len());
-                4 + 8 * k + 4 * k.div_ceil(4)
-            })
-            .sum();
-        let b = rs.bytes();
-        assert_eq!(b.hierarchy, hierarchy);
-        assert_eq!(b.geometry, blocks - hierarchy + 12 * stats.vertices);
-        assert_eq!(b.top_level, 32 * stats.top_level_nodes);
-        assert_eq!(b.total, b.geometry + b.hierarchy + b.top_level);
-        // A BVH with one strip per leaf: 2 · strips − 1 nodes.
-        assert_eq!(stats.top_level_nodes, 2 * stats.strips - 1);
-        assert_eq!(stats.vertices, positions.len());
+        for options in [
+            BuildOptions::default(),
+            BuildOptions {
+                strips_per_leaf: 4,
+                strip_swaps: true,
+                ..BuildOptions::default()
+            },
+        ] {
+            let rs = RayStrips::build(&positions, &triangles, &options).unwrap();
+            let strips = rs.strips();
+            let stats = rs.stats();
+            let blocks: usize = strips
+                .iter()
+                .map(|s| 4 * layout::strip_words(s.triangles.len()))
+                .sum();
+            assert_eq!(strips.iter().map(|s| s.block_bytes).sum::<usize>(), blocks);
+            let hierarchy: usize = strips
+                .iter()
+                .map(|s| {
+                    let k = layout::hierarchy_nodes(s.triangles.len());
+                    4 + 8 * k + 4 * k.div_ceil(4)
+                })
+                .sum();
+            let b = rs.bytes();
+            assert_eq!(b.hierarchy, hierarchy);
+            assert_eq!(b.geometry, blocks - hierarchy + 12 * stats.vertices);
+            assert_eq!(b.top_level, 32 * stats.top_level_nodes);
+            assert_eq!(b.total, b.geometry + b.hierarchy + b.top_level);
+            // A binary BVH over its leaves: 2 · leaves − 1 nodes; with one
+            // strip per leaf, one leaf per strip.
+            if options.strips_per_leaf == 1 {
+                assert_eq!(stats.top_level_nodes, 2 * stats.strips - 1);
+            } else {
+                assert!(stats.top_level_nodes < 2 * stats.strips - 1);
+            }
+            assert_eq!(stats.vertices, positions.len());
+        }
     }
 }

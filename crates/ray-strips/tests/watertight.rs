@@ -62,15 +62,13 @@ fn check_closed(
     far: f32,
 ) {
     let dirs = directions(257);
-    for chunk in [3, 256] {
-        let rs = RayStrips::build(
-            positions,
-            triangles,
-            &BuildOptions {
-                chunk_triangles: chunk,
-            },
-        )
-        .unwrap();
+    for (chunk, strips_per_leaf, strip_swaps) in [(3, 1, false), (256, 1, false), (64, 4, true)] {
+        let options = BuildOptions {
+            chunk_triangles: chunk,
+            strips_per_leaf,
+            strip_swaps,
+        };
+        let rs = RayStrips::build(positions, triangles, &options).unwrap();
         let mut rays = Vec::new();
         for (k, target) in targets(positions, triangles).into_iter().enumerate() {
             for j in 0..3 {

@@ -37,6 +37,9 @@ pub(crate) fn build(
     if options.chunk_triangles == 0 {
         return Err(BuildError::ZeroChunkTriangles);
     }
+    if options.strips_per_leaf == 0 {
+        return Err(BuildError::ZeroStripsPerLeaf);
+    }
     if triangles.len() > MAX_TRIANGLES {
         return Err(BuildError::TooManyTriangles {
             count: triangles.len(),
@@ -71,7 +74,7 @@ pub(crate) fn build(
     let mut builder = Builder {
         positions,
         triangles,
-        chunk: options.chunk_triangles,
+        options: *options,
         remap: vec![u32::MAX; positions.len()],
         data: StripData::default(),
         stats: Stats {
@@ -101,7 +104,7 @@ pub(crate) fn build(
 struct Builder<'a> {
     positions: &'a [Vec3],
     triangles: &'a [[u32; 3]],
-    chunk: usize,
+    options: BuildOptions,
     /// Input vertex → compact vertex (`u32::MAX`: not yet used).
     remap: Vec<u32>,
     data: StripData,
@@ -111,7 +114,7 @@ struct Builder<'a> {
 impl Builder<'_> {
     /// Splits triangles by SAH down to chunks.
     fn triangle_node(&mut self, items: &mut [Item], depth: usize) {
-        if items.len() <= self.chunk {
+        if items.len() <= self.options.chunk_triangles {
             self.chunk_node(items, depth);
             return;
         }
@@ -153,7 +156,7 @@ impl Builder<'_> {
             .iter()
             .map(|it| self.triangles[it.id as usize])
             .collect();
-        let strips = stripify(&local);
+        let strips = stripify(&local, self.options.strip_swaps);
         let mut strip_items: Vec<Item> = strips
             .iter()
             .enumerate()
@@ -176,10 +179,22 @@ impl Builder<'_> {
         self.strip_node(&mut strip_items, &strips, &ids, depth);
     }
 
-    /// SAH subtree over a chunk's strips, one strip per leaf.
+    /// SAH subtree over a chunk's strips, down to `strips_per_leaf`.
     fn strip_node(&mut self, items: &mut [Item], strips: &[Strip], ids: &[u32], depth: usize) {
-        if items.len() == 1 {
-            self.leaf(&strips[items[0].id as usize], ids);
+        if items.len() <= self.options.strips_per_leaf {
+            let offset = self.data.words.len() as u32;
+            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+            for it in items.iter() {
+                let (a, b) = self.block(&strips[it.id as usize], ids);
+                lo = lo.min(a);
+                hi = hi.max(b);
+            }
+            self.data.nodes.push(BvhNode {
+                min: lo.to_array(),
+                max: hi.to_array(),
+                a: offset,
+                b: LEAF | items.len() as u32,
+            });
             return;
         }
         self.inner(items, depth, |b, part, d| {
@@ -187,8 +202,8 @@ impl Builder<'_> {
         });
     }
 
-    /// Writes one strip's block and its BVH leaf.
-    fn leaf(&mut self, strip: &Strip, ids: &[u32]) {
+    /// Writes one strip's block and returns its box.
+    fn block(&mut self, strip: &Strip, ids: &[u32]) -> (Vec3, Vec3) {
         let n = strip.triangles.len();
         let words: Vec<u32> = strip
             .triangles
@@ -211,23 +226,17 @@ impl Builder<'_> {
             })
             .collect();
         let vertices: Vec<u32> = strip.vertices.iter().map(|&v| self.compact(v)).collect();
-        let offset = self.data.words.len() as u32;
-        let (lo, hi) = strip_hierarchy::write_block(
+        let bounds = strip_hierarchy::write_block(
             &self.data.vertices,
             &vertices,
             &words,
             &mut self.data.words,
         );
-        self.data.nodes.push(BvhNode {
-            min: lo.to_array(),
-            max: hi.to_array(),
-            a: offset,
-            b: LEAF,
-        });
         self.stats.strips += 1;
         self.stats.swap_slots += strip.triangles.iter().filter(|&&t| t == SWAP).count();
         self.stats.max_strip_triangles = self.stats.max_strip_triangles.max(n);
         self.stats.hierarchy_nodes += hierarchy_nodes(n);
+        bounds
     }
 
     /// The compact index of input vertex `v`, assigned on first use.

@@ -9,7 +9,7 @@
 //! triangle sequence of single-ray traversal, with the same per-ray
 //! arithmetic, and its result is bit for bit the single-ray result.
 
-use crate::layout::{BlockLayout, LEAF, StripData};
+use crate::layout::{BlockLayout, StripData, is_leaf, leaf_blocks, strip_words};
 use crate::traverse::prepared::{Best, Prepared};
 use crate::traverse::single::{
     BVH_STACK, Part, STRIP_STACK, Stacks, child_intervals, node_children, strip_from, trace_from,
@@ -81,17 +81,21 @@ pub(crate) fn trace_packet(
             }
             continue;
         }
-        if node.b == LEAF {
-            let layout = BlockLayout::new(node.a as usize, data.words[node.a as usize]);
-            strip_packet(
-                data,
-                &layout,
-                (active, dmin, dmax),
-                rays,
-                best,
-                &forward,
-                (&mut strip_stack, &mut singles),
-            );
+        if is_leaf(node) {
+            let (mut offset, count) = leaf_blocks(node);
+            for _ in 0..count {
+                let layout = BlockLayout::new(offset, data.words[offset]);
+                strip_packet(
+                    data,
+                    &layout,
+                    (active, dmin, dmax),
+                    rays,
+                    best,
+                    &forward,
+                    (&mut strip_stack, &mut singles),
+                );
+                offset += strip_words(layout.n as usize);
+            }
         } else {
             let (first, second) = (i + 1, node.a);
             let (near, far) = if forward(node.b as usize) {

@@ -18,7 +18,7 @@
 //! ([`crate::traverse::prepared::SLACK`]) so that rounding never culls a
 //! ray aimed at a vertex or edge on a splitting plane.
 
-use crate::layout::{BlockLayout, LEAF, StripData, split_counts};
+use crate::layout::{BlockLayout, StripData, is_leaf, leaf_blocks, split_counts, strip_words};
 use crate::traverse::prepared::{Best, Prepared, down, up};
 use crate::traverse::triangle::intersect_leaf;
 
@@ -142,15 +142,19 @@ pub(crate) fn trace_from(
         let Some((tn, tf)) = ray.box_interval(&node.min, &node.max, best.t) else {
             continue;
         };
-        if node.b == LEAF {
-            let layout = BlockLayout::new(node.a as usize, data.words[node.a as usize]);
-            let root = Part {
-                node: 0,
-                t0: 0,
-                m: layout.n,
-            };
-            if strip_from(data, &layout, root, tn, tf, ray, best, any, strip) && any {
-                return true;
+        if is_leaf(node) {
+            let (mut offset, count) = leaf_blocks(node);
+            for _ in 0..count {
+                let layout = BlockLayout::new(offset, data.words[offset]);
+                let root = Part {
+                    node: 0,
+                    t0: 0,
+                    m: layout.n,
+                };
+                if strip_from(data, &layout, root, tn, tf, ray, best, any, strip) && any {
+                    return true;
+                }
+                offset += strip_words(layout.n as usize);
             }
         } else {
             let (first, second) = (i as u32 + 1, node.a);
