@@ -178,7 +178,7 @@ impl RayStrips {
 }
 
 fn hit(best: &Best) -> Option<Hit> {
-    (best.word != u32::MAX).then(|| Hit {
+    (best.word != u32::MAX).then_some(Hit {
         triangle: best.word >> PERMUTATION_BITS,
         t: best.t,
         u: best.u,

@@ -50,7 +50,7 @@ pub(crate) fn split(items: &mut [Item]) -> (usize, usize) {
     let extent = chi - clo;
     let mut best: Option<(f32, usize, usize)> = None; // cost, axis, bins left of the split
     for axis in 0..3 {
-        if !(extent[axis] > 0.0) {
+        if extent[axis] <= 0.0 {
             continue;
         }
         let scale = BINS as f32 / extent[axis];

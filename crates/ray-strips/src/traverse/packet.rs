@@ -136,7 +136,7 @@ fn strip_packet(
         let (part, mut mask, dmin, mut dmax) = cur;
         for l in lanes(mask) {
             dmax[l] = dmax[l].min(best[l].t);
-            if !(dmin[l] <= dmax[l]) {
+            if dmin[l] > dmax[l] {
                 mask &= !(1 << l);
             }
         }
