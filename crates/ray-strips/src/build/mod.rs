@@ -25,8 +25,9 @@ use sah::{Item, bounds, median, split};
 use stripify::{SWAP, Strip, stripify};
 
 /// Depth from which the SAH gives way to count-median splits, which keeps
-/// the tree (and the traversal stacks) shallow on any input.
-const SAH_MAX_DEPTH: usize = 64;
+/// the tree shallow on any input: at most `32 + log2(triangles) < 62`
+/// levels, within the traversal stack of 64.
+const SAH_MAX_DEPTH: usize = 32;
 
 /// Builds the traversal data and its statistics.
 pub(crate) fn build(

@@ -22,9 +22,9 @@ use crate::layout::{BlockLayout, StripData, is_leaf, leaf_blocks, split_counts, 
 use crate::traverse::prepared::{Best, Prepared, down, up};
 use crate::traverse::triangle::intersect_leaf;
 
-/// Traversal stack depth of the high-level BVH (the builder caps its depth
-/// well below this).
-pub(crate) const BVH_STACK: usize = 128;
+/// Traversal stack depth of the high-level BVH (the builder caps the tree's
+/// depth below this).
+pub(crate) const BVH_STACK: usize = 64;
 /// Traversal stack depth of a strip hierarchy (`log2` of the largest strip).
 pub(crate) const STRIP_STACK: usize = 32;
 
