@@ -62,7 +62,7 @@ pub use ray::{Hit, Ray};
 pub use stats::{Bytes, Stats};
 
 use layout::{PERMUTATION_BITS, StripData, strip_hierarchy_words};
-use traverse::packet::{LANES, coherent, trace_packet};
+use traverse::packet::{LANES, PacketStacks, coherent, trace_packet};
 use traverse::prepared::{Best, Prepared};
 use traverse::single::{Stacks, trace_from};
 
@@ -125,6 +125,8 @@ impl RayStrips {
             out.len(),
             "intersect_packet needs one output slot per ray"
         );
+        let mut stacks = PacketStacks::new();
+        let mut singles = Stacks::new();
         for (rays, out) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
             let mut pre = [None; LANES];
             let mut mask = 0u8;
@@ -143,11 +145,10 @@ impl RayStrips {
             let mut best: [Best; LANES] =
                 std::array::from_fn(|l| Best::new(rays.get(l).map_or(0.0, |r| r.t_max)));
             if coherent(&pre, mask) {
-                trace_packet(&self.data, &pre, mask, &mut best);
+                trace_packet(&self.data, &pre, mask, &mut best, &mut stacks);
             } else {
-                let mut stacks = Stacks::new();
                 for l in (0..LANES).filter(|l| mask & (1 << l) != 0) {
-                    trace_from(&self.data, 0, &pre[l], &mut best[l], false, &mut stacks);
+                    trace_from(&self.data, 0, &pre[l], &mut best[l], false, &mut singles);
                 }
             }
             for (l, o) in out.iter_mut().enumerate() {

@@ -36,26 +36,47 @@ fn lanes(mask: u8) -> impl Iterator<Item = usize> {
     (0..LANES).filter(move |l| mask & (1 << l) != 0)
 }
 
+/// The stacks of packet traversal (and of its single-ray fallbacks),
+/// allocated once per batch of packets.
+pub(crate) struct PacketStacks {
+    bvh: [(u32, u8); BVH_STACK],
+    strip: [Entry; STRIP_STACK],
+    singles: Stacks,
+}
+
+impl PacketStacks {
+    /// Empty stacks.
+    pub fn new() -> Self {
+        let part = Part {
+            node: 0,
+            t0: 0,
+            m: 0,
+        };
+        Self {
+            bvh: [(0, 0); BVH_STACK],
+            strip: [(part, 0, [0.0; LANES], [0.0; LANES]); STRIP_STACK],
+            singles: Stacks::new(),
+        }
+    }
+}
+
 /// Closest hits of the rays in `mask` (a coherent packet).
 pub(crate) fn trace_packet(
     data: &StripData,
     rays: &[Prepared; LANES],
     mask: u8,
     best: &mut [Best; LANES],
+    stacks: &mut PacketStacks,
 ) {
     let Some(lead) = lanes(mask).next() else {
         return;
     };
     let forward = |a: usize| rays[lead].forward(a);
-    let mut singles = Stacks::new();
-    let root = Part {
-        node: 0,
-        t0: 0,
-        m: 0,
-    };
-    let mut strip_stack: [Entry; STRIP_STACK] =
-        [(root, 0, [0.0; LANES], [0.0; LANES]); STRIP_STACK];
-    let mut stack = [(0u32, 0u8); BVH_STACK];
+    let PacketStacks {
+        bvh: stack,
+        strip: strip_stack,
+        singles,
+    } = stacks;
     stack[0] = (0, mask);
     let mut sp = 1;
     while sp > 0 {
@@ -77,7 +98,7 @@ pub(crate) fn trace_packet(
         }
         if active.count_ones() <= SINGLE_BELOW {
             for l in lanes(active) {
-                trace_from(data, i, &rays[l], &mut best[l], false, &mut singles);
+                trace_from(data, i, &rays[l], &mut best[l], false, singles);
             }
             continue;
         }
@@ -92,7 +113,7 @@ pub(crate) fn trace_packet(
                     rays,
                     best,
                     &forward,
-                    (&mut strip_stack, &mut singles),
+                    (strip_stack, singles),
                 );
                 offset += strip_words(layout.n as usize);
             }
