@@ -146,3 +146,29 @@ fn a_fan_of_rays_through_one_vertex_always_hits() {
         }
     }
 }
+
+/// The same on an 82 k-triangle sphere with the default options, every
+/// vertex from three directions, singles and packets (release: a few
+/// seconds; `cargo test --release -- --ignored`).
+#[test]
+#[ignore]
+fn a_large_sphere_does_not_leak() {
+    let centre = Vec3::new(3.7, 1.1, -0.4);
+    let (positions, triangles) = common::icosphere(6, centre, 2.5);
+    let rs = RayStrips::build(&positions, &triangles, &BuildOptions::default()).unwrap();
+    let dirs = directions(257);
+    let mut rays = Vec::new();
+    for (k, target) in positions.iter().enumerate() {
+        for j in 0..3 {
+            let origin = *target + outward(&dirs, (*target - centre).normalize(), 3 * k + j) * 7.0;
+            rays.push(Ray::new(origin, *target - origin));
+        }
+    }
+    let mut out = vec![None; rays.len()];
+    rs.intersect_packet(&rays, &mut out);
+    for (ray, p) in rays.iter().zip(&out) {
+        let h = rs.intersect(ray).expect("no leak");
+        assert!(h.t <= 1.0 + 1e-5);
+        assert_eq!(*p, Some(h));
+    }
+}
