@@ -1,0 +1,117 @@
+//! A ray prepared once for traversal: reciprocal direction for the box and
+//! plane distances, and the shear of Woop et al.'s watertight test.
+
+use crate::ray::Ray;
+
+/// Relative slack applied to every computed box or plane distance so that
+/// culling is conservative: `(c − o) · (1/d)` is within three roundings of
+/// the exact value (Ize, "Robust BVH ray traversal"), and the slack is
+/// twice that. A ray aimed exactly at a vertex or edge on a box face is
+/// therefore never culled by rounding.
+pub(crate) const SLACK: f32 = 3.0 * f32::EPSILON;
+
+/// `x` moved towards −∞ by the slack.
+#[inline(always)]
+pub(crate) fn down(x: f32) -> f32 {
+    x - x.abs() * SLACK
+}
+
+/// `x` moved towards +∞ by the slack.
+#[inline(always)]
+pub(crate) fn up(x: f32) -> f32 {
+    x + x.abs() * SLACK
+}
+
+/// A traceable ray with its precomputed values.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Prepared {
+    /// Origin.
+    pub org: [f32; 3],
+    /// Direction.
+    pub dir: [f32; 3],
+    /// `1 / dir` per axis (unused on axes where `dir` is zero).
+    pub inv: [f32; 3],
+    /// Lower end of the accepted range.
+    pub t_min: f32,
+    /// Woop's axis permutation: `kz` is the largest direction component.
+    pub k: [usize; 3],
+    /// Woop's shear constants `Sx, Sy, Sz`.
+    pub shear: [f32; 3],
+}
+
+impl Prepared {
+    /// `None` for rays that cannot hit anything.
+    pub fn new(ray: &Ray) -> Option<Self> {
+        if !ray.is_traceable() {
+            return None;
+        }
+        let dir = ray.direction.to_array();
+        let kz = ray.direction.abs().max_position();
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if dir[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        Some(Self {
+            org: ray.origin.to_array(),
+            dir,
+            inv: dir.map(|d| 1.0 / d),
+            t_min: ray.t_min,
+            k: [kx, ky, kz],
+            shear: [dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]],
+        })
+    }
+
+    /// Whether traversal visits a node's first child first on `axis`
+    /// (direction `≥ 0`, so `-0.0` and `0.0` agree).
+    #[inline(always)]
+    pub fn forward(&self, axis: usize) -> bool {
+        self.dir[axis] >= 0.0
+    }
+
+    /// Conservative `[t_near, t_far]` of the box within `[t_min, t_max]`,
+    /// `None` when empty.
+    #[inline(always)]
+    pub fn box_interval(&self, min: &[f32; 3], max: &[f32; 3], t_max: f32) -> Option<(f32, f32)> {
+        let mut tn = self.t_min;
+        let mut tf = t_max;
+        for a in 0..3 {
+            if self.dir[a] == 0.0 {
+                if self.org[a] < min[a] || self.org[a] > max[a] {
+                    return None;
+                }
+            } else {
+                let t0 = (min[a] - self.org[a]) * self.inv[a];
+                let t1 = (max[a] - self.org[a]) * self.inv[a];
+                tn = tn.max(down(t0.min(t1)));
+                tf = tf.min(up(t0.max(t1)));
+            }
+        }
+        (tn <= tf).then_some((tn, tf))
+    }
+}
+
+/// The closest hit found so far.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Best {
+    /// Its distance (the ray's `t_max` while nothing is hit).
+    pub t: f32,
+    /// Per-triangle word of the hit triangle (`u32::MAX`: none).
+    pub word: u32,
+    /// Barycentric weights in input order of vertices 1 and 2.
+    pub u: f32,
+    /// See `u`.
+    pub v: f32,
+}
+
+impl Best {
+    /// Nothing hit yet within `[.., t_max]`.
+    pub fn new(t_max: f32) -> Self {
+        Self {
+            t: t_max,
+            word: u32::MAX,
+            u: 0.0,
+            v: 0.0,
+        }
+    }
+}

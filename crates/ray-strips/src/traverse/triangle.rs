@@ -1,0 +1,101 @@
+//! Watertight intersection of a ray with the triangles of a strip leaf
+//! (paper §5.2, with Woop, Benthin and Wald's watertight test, JCGT 2013,
+//! in place of the paper's Plücker edge tests).
+//!
+//! Each leaf vertex is moved into ray space once (translate to the origin,
+//! permute so the ray runs along `kz`, shear so it becomes the `z` axis).
+//! The edge function of a directed edge `P → Q` is
+//! `f(P, Q) = Q.x · P.y − Q.y · P.x`; it depends only on the two vertices,
+//! and `f(Q, P) = −f(P, Q)` exactly in floating point. As in the paper,
+//! edges are shared along the strip: triangle `j = (s_j, s_{j+1},
+//! s_{j+2})` uses the "rung" edges `s_j → s_{j+1}` and `s_{j+1} → s_{j+2}`
+//! (the second is the first rung of triangle `j + 1`) and the "rail" edge
+//! `s_{j+2} → s_j`. Because every triangle sharing an edge sees the same
+//! value up to sign, a ray through a shared edge or vertex is inside
+//! (all three functions of one sign, zeros counting as either) in at least
+//! one of the triangles around it: no leaks. When a function is exactly
+//! zero all three are recomputed in `f64`, where the products of `f32`
+//! values are exact, as Woop et al. do.
+//!
+//! Swap slots (copies of a neighbour that let a strip turn) are skipped.
+//!
+//! A hit replaces the best one when it is closer, or equally close with a
+//! smaller input triangle index, so the result does not depend on the order
+//! in which triangles are tested.
+
+use crate::layout::{BlockLayout, PERMUTATION_BITS, PERMUTATIONS, SWAP_WORD, StripData};
+use crate::traverse::prepared::{Best, Prepared};
+
+/// Largest leaf (in triangles) of a strip hierarchy.
+const MAX_LEAF: usize = 3;
+
+/// Tests triangles `[t0, t0 + m)` (`m ≤ 3`) of a strip; returns whether
+/// `best` changed.
+#[inline(always)]
+pub(crate) fn intersect_leaf(
+    data: &StripData,
+    layout: &BlockLayout,
+    t0: u32,
+    m: u32,
+    ray: &Prepared,
+    best: &mut Best,
+) -> bool {
+    let m = m as usize;
+    debug_assert!(m <= MAX_LEAF);
+    let [kx, ky, kz] = ray.k;
+    let [sx, sy, sz] = ray.shear;
+    let mut x = [0.0f32; MAX_LEAF + 2];
+    let mut y = [0.0f32; MAX_LEAF + 2];
+    let mut z = [0.0f32; MAX_LEAF + 2];
+    let first = layout.indices + t0 as usize;
+    for j in 0..m + 2 {
+        let v = data.vertices[data.words[first + j] as usize];
+        let p = [v[0] - ray.org[0], v[1] - ray.org[1], v[2] - ray.org[2]];
+        x[j] = p[kx] - sx * p[kz];
+        y[j] = p[ky] - sy * p[kz];
+        z[j] = sz * p[kz];
+    }
+    let edge = |p: usize, q: usize| x[q] * y[p] - y[q] * x[p];
+    let edge64 = |p: usize, q: usize| {
+        (f64::from(x[q]) * f64::from(y[p]) - f64::from(y[q]) * f64::from(x[p])) as f32
+    };
+    let mut rung = [0.0f32; MAX_LEAF + 1];
+    for (j, r) in rung.iter_mut().enumerate().take(m + 1) {
+        *r = edge(j, j + 1);
+    }
+    let mut changed = false;
+    for j in 0..m {
+        // U, V, W: weights of A = s_j, B = s_{j+1}, C = s_{j+2}.
+        let (mut u, mut v, mut w) = (rung[j + 1], edge(j + 2, j), rung[j]);
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            u = edge64(j + 1, j + 2);
+            v = edge64(j + 2, j);
+            w = edge64(j, j + 1);
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            continue;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            continue;
+        }
+        let t = (u * z[j] + v * z[j + 1] + w * z[j + 2]) / det;
+        if !(t >= ray.t_min && t <= best.t) {
+            continue;
+        }
+        let word = data.words[layout.triangles + t0 as usize + j];
+        if word == SWAP_WORD || (t == best.t && word >= best.word) {
+            continue;
+        }
+        let weights = [u / det, v / det, w / det];
+        let order = PERMUTATIONS[(word & ((1 << PERMUTATION_BITS) - 1)) as usize];
+        *best = Best {
+            t,
+            word,
+            u: weights[order[1] as usize],
+            v: weights[order[2] as usize],
+        };
+        changed = true;
+    }
+    changed
+}
