@@ -92,6 +92,17 @@ impl<'m> BvhTracer<'m> {
         self.bvh.nodes.len()
     }
 
+    /// Heap bytes traversal reads: `(hierarchy, geometry)` = the BVH
+    /// nodes, and the precomputed intersection triangles with their face
+    /// ids (the optimised triangle representation of Ray-Strips' Table 1).
+    pub fn bytes(&self) -> (usize, usize) {
+        (
+            std::mem::size_of_val(self.bvh.nodes.as_slice()),
+            std::mem::size_of_val(self.tris.as_slice())
+                + std::mem::size_of_val(self.faces.as_slice()),
+        )
+    }
+
     /// Closest hit `(primitive in BVH order, t)` and the number of nodes
     /// whose box was tested, by obvhs's stack traversal
     /// (`Bvh2::ray_traverse_dynamic`) re-written with a counter: the two
@@ -184,8 +195,9 @@ pub fn face_hit(mesh: &TetMesh, ray: &Ray, face: u32, t: f32) -> Hit {
     let n = (p1 - p0).cross(p2 - p0);
     let p = ray.at(t);
     let area = n.length_squared().max(f32::MIN_POSITIVE);
-    let b1 = (p0 - p).cross(p2 - p).dot(n) / area;
-    let b2 = (p1 - p).cross(p0 - p).dot(n) / area;
+    // Signed areas of the sub-triangles opposite vertices 1 and 2.
+    let b1 = (p - p0).cross(p2 - p0).dot(n) / area;
+    let b2 = (p1 - p0).cross(p - p0).dot(n) / area;
     let from_front = ray.direction.dot(n) < 0.0;
     let (near, far) = if from_front {
         (cf.front.tet, cf.back.tet)
@@ -316,5 +328,48 @@ mod tests {
             hits > 500,
             "many random rays hit a constrained face: {hits}"
         );
+    }
+}
+
+#[cfg(test)]
+mod face_hit_tests {
+    use super::*;
+    use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
+    use tet_trace_cpu::reference::{Aim, closest_hit, random_ray};
+
+    /// The BVH's hit record has the f64 brute force's face, `t` and
+    /// barycentrics (in the constrained face's vertex order).
+    #[test]
+    fn hit_records_match_the_brute_force() {
+        let mesh = kuhn_grid(&GridSpec {
+            cells: [5; 3],
+            jitter: 0.1,
+            constrained_fraction: 0.1,
+            seed: 9,
+            ..Default::default()
+        });
+        let bvh = BvhTracer::new(&mesh);
+        let mut rng = SplitMix64(4);
+        let mut checked = 0;
+        for _ in 0..1000 {
+            let (ray, tet) = random_ray(&mesh, &mut rng, Aim::Random);
+            let (Some(r), TraceOutcome::Hit(h)) =
+                (closest_hit(&mesh, &ray), bvh.trace(&ray, Start::Tet(tet)))
+            else {
+                continue;
+            };
+            if r.edge_distance < 1e-3 {
+                continue;
+            }
+            assert_eq!(h.face, r.face);
+            for k in 0..3 {
+                assert!(
+                    (h.barycentrics[k] as f64 - r.barycentrics[k]).abs() < 1e-4,
+                    "{h:?} vs {r:?}"
+                );
+            }
+            checked += 1;
+        }
+        assert!(checked > 300, "{checked}");
     }
 }

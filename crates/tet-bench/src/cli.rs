@@ -141,6 +141,11 @@ pub enum Method {
     Tet16,
     /// BVH baseline (obvhs, BVH2).
     Obvhs,
+    /// Ray-Strips (Lauterbach et al.): strip hierarchies under an SAH BVH,
+    /// one ray at a time.
+    Strips,
+    /// Ray-Strips with 2×2 ray packets (groups of four consecutive rays).
+    StripsPackets,
     /// Embree 3, one `rtcIntersect1` per ray (needs the `embree` feature).
     Embree,
     /// Embree 3, `rtcIntersect8` on packets of 8 rays (needs the `embree` feature).
@@ -171,6 +176,8 @@ impl Method {
             Method::Tet20 => "tet20",
             Method::Tet16 => "tet16",
             Method::Obvhs => "obvhs",
+            Method::Strips => "strips",
+            Method::StripsPackets => "strips-packets",
             Method::Embree => "embree",
             Method::Embree8 => "embree8",
             Method::Brute => "brute",

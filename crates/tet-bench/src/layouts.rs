@@ -9,11 +9,14 @@ use tet_core::memory::MemoryReport;
 use tet_core::regions::{compute_regions, locate_brute, locate_seeds_brute, prune_unreachable};
 
 use crate::load::{BuildSummary, Loaded};
+use crate::strips::StripsTracer;
 
 /// Bytes of one layout (JSON `layouts[]`).
 #[derive(Clone, Debug, Serialize)]
 pub struct LayoutBytes {
-    /// `baseline32`, `tet32`, `tet20`, `tet16` or `tet80`.
+    /// `baseline32`, `tet32`, `tet20`, `tet16`, `tet80` or, in the `info`
+    /// document and the memory table, `ray-strips` (whose bytes are all
+    /// hot: geometry, strip hierarchies and the BVH above them).
     pub name: &'static str,
     /// Hot data: tet records + point positions read by the walk.
     pub hot_bytes: usize,
@@ -35,6 +38,18 @@ pub struct LayoutBytes {
     pub reconstruction_bytes: usize,
     /// Hot bytes per tet.
     pub hot_bytes_per_tet: f64,
+    /// Total bytes per scene triangle (the unit Ray-Strips and BVHs are
+    /// compared in).
+    pub total_bytes_per_triangle: f64,
+    /// Ray-Strips only: vertices, strip indices and per-triangle words.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub geometry_bytes: Option<usize>,
+    /// Ray-Strips only: the strip hierarchies.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hierarchy_bytes: Option<usize>,
+    /// Ray-Strips only: the BVH over the strips.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub top_level_bytes: Option<usize>,
 }
 
 /// Region summary (JSON `regions`).
@@ -98,6 +113,7 @@ pub struct Info {
 pub fn layout_bytes(mesh: &TetMesh) -> (MemoryReport, Vec<LayoutBytes>) {
     let report = MemoryReport::for_mesh(mesh);
     let tets = mesh.tets.len().max(1) as f64;
+    let triangles = mesh.constrained.len().max(1) as f64;
     let layouts = report
         .layouts
         .iter()
@@ -113,15 +129,45 @@ pub fn layout_bytes(mesh: &TetMesh) -> (MemoryReport, Vec<LayoutBytes>) {
             anchors_bytes: l.anchors,
             reconstruction_bytes: l.reconstruction,
             hot_bytes_per_tet: l.hot() as f64 / tets,
+            total_bytes_per_triangle: l.total() as f64 / triangles,
+            geometry_bytes: None,
+            hierarchy_bytes: None,
+            top_level_bytes: None,
         })
         .collect();
     (report, layouts)
 }
 
+/// The bytes of Ray-Strips built over the mesh's constrained faces, as a
+/// layout entry (everything hot; no tet records).
+pub fn strips_bytes(mesh: &TetMesh) -> Result<LayoutBytes> {
+    let b = StripsTracer::new(mesh, false)?.strips().bytes();
+    Ok(LayoutBytes {
+        name: "ray-strips",
+        hot_bytes: b.total,
+        cold_bytes: 0,
+        total_bytes: b.total,
+        tets_bytes: 0,
+        points_bytes: 0,
+        constrained_bytes: 0,
+        attributes_bytes: 0,
+        anchors_bytes: 0,
+        reconstruction_bytes: 0,
+        hot_bytes_per_tet: b.total as f64 / mesh.tets.len().max(1) as f64,
+        total_bytes_per_triangle: b.total as f64 / mesh.constrained.len().max(1) as f64,
+        geometry_bytes: Some(b.geometry),
+        hierarchy_bytes: Some(b.hierarchy),
+        top_level_bytes: Some(b.top_level),
+    })
+}
+
 /// Computes the `info` document of a loaded mesh.
 pub fn info(loaded: &Loaded, prune: bool) -> Result<Info> {
     let mesh = &loaded.mesh;
-    let (report, layouts) = layout_bytes(mesh);
+    let (report, mut layouts) = layout_bytes(mesh);
+    if !mesh.constrained.is_empty() {
+        layouts.push(strips_bytes(mesh)?);
+    }
     let r = compute_regions(mesh).report();
     let pruned = if prune {
         let mut copy = mesh.clone();

@@ -10,7 +10,7 @@
 //!    [`layouts`], [`accuracy`], [`extremes`], [`exitface`], [`outofcore`];
 //! 3. plumbing — [`load`] (scenes and mesh files), [`camera`] (the default
 //!    view and the view flags), [`methods`] with the tracers that are not
-//!    in `tet-trace-cpu` ([`bvh`], [`brute`], `embree`), [`plots`] (SVG
+//!    in `tet-trace-cpu` ([`bvh`], [`strips`], [`brute`], `embree`), [`plots`] (SVG
 //!    drawing), [`output`] (stdout and error text) and [`cli`] (the
 //!    arguments).
 #![deny(missing_docs)]
@@ -36,6 +36,7 @@ mod methods;
 mod outofcore;
 mod output;
 mod plots;
+mod strips;
 mod tables;
 mod timing;
 

@@ -11,6 +11,7 @@ use tet_trace_cpu::tet80::{Tet80ConsistentTracer, Tet80Tracer};
 
 use crate::bvh::BvhTracer;
 use crate::cli::Method;
+use crate::strips::StripsTracer;
 
 /// Builds the tracer of `method` over `mesh`, in f64 when `f64` is set.
 pub fn tracer<'m>(method: Method, f64: bool, mesh: &'m TetMesh) -> Result<Box<dyn Tracer + 'm>> {
@@ -25,6 +26,8 @@ pub fn tracer<'m>(method: Method, f64: bool, mesh: &'m TetMesh) -> Result<Box<dy
         (Method::Tet16, false) => Box::new(<Tet16Tracer<'_>>::new(mesh)?),
         (Method::Tet16, true) => Box::new(Tet16TracerF64::new(mesh)?),
         (Method::Obvhs, false) => Box::new(BvhTracer::new(mesh)),
+        (Method::Strips, false) => Box::new(StripsTracer::new(mesh, false)?),
+        (Method::StripsPackets, false) => Box::new(StripsTracer::new(mesh, true)?),
         #[cfg(feature = "embree")]
         (Method::Embree, false) => Box::new(crate::embree::EmbreeTracer::new(mesh, false)?),
         #[cfg(feature = "embree")]
@@ -51,8 +54,8 @@ pub fn has_f64(method: Method) -> bool {
 }
 
 /// The CPU methods every comparison runs (`tables`, `accuracy --methods
-/// all`): the tet walks, the obvhs BVH and, when built with the `embree`
-/// feature, Embree's single rays and packets.
+/// all`): the tet walks, the obvhs BVH, Ray-Strips and, when built with
+/// the `embree` feature, Embree's single rays and packets.
 pub fn cpu_methods() -> Vec<Method> {
     let mut m = vec![
         Method::Tet20,
@@ -62,6 +65,7 @@ pub fn cpu_methods() -> Vec<Method> {
         Method::Tet80Consistent,
         Method::Sctp,
         Method::Obvhs,
+        Method::Strips,
     ];
     if cfg!(feature = "embree") {
         m.extend([Method::Embree, Method::Embree8]);

@@ -108,3 +108,83 @@ fn rays_from_the_boundary_never_loop() {
         }
     }
 }
+
+/// A pyramid whose apex is a vertex of 2·n² tets (a fan over a triangulated
+/// square): far more than the first ring searched around an origin, as at
+/// a corner of an enclosing box. Rays from the apex leave at once (a miss)
+/// or cross the pyramid to its constrained base, whatever tet `locate`
+/// returns for the apex.
+#[test]
+fn rays_from_a_vertex_with_a_large_star() {
+    let n = 14u32;
+    let mut points = vec![Vec3::new(0.5, 0.5, 0.0)];
+    for j in 0..=n {
+        for i in 0..=n {
+            points.push(Vec3::new(i as f32 / n as f32, j as f32 / n as f32, 1.0));
+        }
+    }
+    let at = |i: u32, j: u32| 1 + i + j * (n + 1);
+    let mut tets = Vec::new();
+    let mut base = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            for t in [
+                [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
+                [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
+            ] {
+                // Positively oriented (checked by `validate`).
+                tets.push([0, t[0], t[1], t[2]]);
+                base.push((t, base.len() as u32));
+            }
+        }
+    }
+    let count = base.len() as u32;
+    let mesh = TetMesh::assemble(points, tets, &base, count).unwrap();
+    mesh.validate().unwrap();
+    let apex = mesh.points[0];
+    let tracers: Vec<Box<dyn Tracer + '_>> = vec![
+        Box::new(Tet20Tracer::<tet_trace_cpu::DuffF32>::new(&mesh).unwrap()),
+        Box::new(Tet16Tracer::<tet_trace_cpu::DuffF32>::new(&mesh).unwrap()),
+        Box::new(Tet32Tracer::<tet_trace_cpu::DuffF32>::new(&mesh).unwrap()),
+        Box::new(Tet80ConsistentTracer::consistent(&mesh).unwrap()),
+    ];
+    let mut rng = SplitMix64(3);
+    let mut inward = 0;
+    for i in 0..120 {
+        // Half aimed at the base, half in random directions.
+        let d = if i % 2 == 0 {
+            Vec3::new(rng.next_f64() as f32, rng.next_f64() as f32, 1.0) - apex
+        } else {
+            random_direction(&mut rng)
+        };
+        let ray = Ray::new(apex, d);
+        // Inside the pyramid's cone: the line through the apex reaches
+        // the base square at z = 1.
+        let at_base = (d.z > 0.0).then(|| apex + d * (1.0 / d.z));
+        let crosses = at_base
+            .is_some_and(|p| p.x > 1e-3 && p.x < 1.0 - 1e-3 && p.y > 1e-3 && p.y < 1.0 - 1e-3);
+        let leaves = at_base
+            .is_none_or(|p| p.x < -1e-3 || p.x > 1.0 + 1e-3 || p.y < -1e-3 || p.y > 1.0 + 1e-3);
+        for start in [0, mesh.tets.len() as u32 / 2, mesh.tets.len() as u32 - 1] {
+            for t in &tracers {
+                let out = t.trace(&ray, Start::Tet(start));
+                assert!(
+                    !out.is_failure(),
+                    "{} from tet {start}: {ray:?} {out:?}",
+                    t.name()
+                );
+                if crosses {
+                    let h = out
+                        .hit()
+                        .unwrap_or_else(|| panic!("{}: {ray:?} {out:?}", t.name()));
+                    assert!((h.t - 1.0 / d.z).abs() < 1e-4 / d.z, "{}: {h:?}", t.name());
+                }
+                if leaves {
+                    assert!(out.hit().is_none(), "{}: {ray:?} {out:?}", t.name());
+                }
+            }
+        }
+        inward += crosses as usize;
+    }
+    assert!(inward > 40 && inward < 110, "{inward}");
+}

@@ -59,6 +59,8 @@ pub struct SceneResult {
     pub wide_box_tet20: Option<RenderDoc>,
     /// Accuracy against the f64 reference.
     pub accuracy: Option<CaseAccuracy>,
+    /// Ray-Strips beside the BVH (seed 002 Tables 1, 3, 4, 5).
+    pub ray_strips: Option<super::strips_vs_bvh::StripsRow>,
     /// GPU methods (seed 000 Table 3), when built with `--features gpu` and
     /// an adapter is present.
     pub gpu_renders: Vec<RenderDoc>,

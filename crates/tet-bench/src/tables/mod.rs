@@ -6,6 +6,9 @@
 //!   ([`render_speed`], with the paper's CPU numbers as ratios to the BVH
 //!   measured in the same run, since absolute times are machine-bound);
 //! * seed 000 Table 4 — bytes per layout per scene ([`memory`]);
+//! * Lauterbach et al. (seed 002) Tables 1, 3, 4, 5 — Ray-Strips' bytes,
+//!   single-ray and packet speed and construction beside the BVH
+//!   ([`strips_vs_bvh`]);
 //! * seed 000 Table 5 — the Armadillo Zoom camera series, with `--scenes`
 //!   ([`zoom`]);
 //! * seed 000 Figure 8 — Hilbert-sorted vs unsorted mesh, tet20 ([`sorting`]);
@@ -47,6 +50,7 @@ mod report;
 mod robustness;
 mod sorting;
 mod speed_accuracy;
+mod strips_vs_bvh;
 mod variant;
 mod zoom;
 
@@ -82,6 +86,7 @@ fn measure_scene(
     }
     let (info, bvh_build_s) = construction::measure(&loaded)?;
     let renders = render_speed::measure(spec, &loaded, opts, frames, pool)?;
+    let ray_strips = Some(strips_vs_bvh::measure(spec, &loaded, opts, frames, pool)?);
     let accuracy =
         robustness::measure(spec, &loaded, &cpu_methods(), args.quick, args.min_time_s())?;
     let unsorted_tet20 = Some(sorting::measure(planned, cache, opts, frames, pool)?);
@@ -98,6 +103,7 @@ fn measure_scene(
         out_of_core::measure(&loaded, &TABLE_FLAGS, &planned.extra, opts, frames, pool)
     };
     Ok(SceneResult {
+        ray_strips,
         quality5,
         out_of_core,
         shares_mesh_with: planned.shares_with.clone(),
@@ -158,6 +164,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
             Err(e) => {
                 eprintln!("  {spec}: {}", error_chain(&e));
                 SceneResult {
+                    ray_strips: None,
                     spec: spec.clone(),
                     info: None,
                     bvh_build_s: None,

@@ -11,7 +11,7 @@ use anyhow::{Context, Result};
 use super::doc::TablesDoc;
 use super::{
     construction, entry, exit_face, gpu, memory, out_of_core, quality, render_speed, robustness,
-    sorting, speed_accuracy, zoom,
+    sorting, speed_accuracy, strips_vs_bvh, zoom,
 };
 
 /// The Markdown report (`tables.md`, and stdout without `--json`).
@@ -48,6 +48,7 @@ pub fn markdown(doc: &TablesDoc) -> String {
     construction::markdown(&mut m, doc);
     render_speed::markdown(&mut m, doc);
     memory::markdown(&mut m, doc);
+    strips_vs_bvh::markdown(&mut m, doc);
     sorting::markdown(&mut m, doc);
     entry::markdown(&mut m, doc);
     zoom::markdown(&mut m, doc);

@@ -90,6 +90,45 @@ fn exit_state<P: Projection>(mesh: &TetMesh, proj: &P, tet: u32, k: usize) -> St
     }
 }
 
+/// Tets around an origin searched first; where that finds nothing the
+/// whole star is searched (a corner of the enclosing box can touch
+/// thousands of tets), up to [`STAR_LIMIT`].
+const STAR_FIRST: usize = 256;
+
+/// The most tets of a star searched (a guard, far above real stars).
+const STAR_LIMIT: usize = 1 << 20;
+
+/// The start state from the tets around an origin on a face, edge or
+/// vertex of `tet`: a tet whose exit face winds counter-clockwise around
+/// the origin ([`start_in_tet`]), else a boundary face through the origin
+/// ([`boundary_face_at`]); `None` when neither exists (rounding), where the
+/// caller falls back.
+fn search_star<P: Projection>(
+    mesh: &TetMesh,
+    proj: &P,
+    origin: Vec3,
+    tet: u32,
+) -> Option<State<P>> {
+    let mut searched = 1;
+    for limit in [STAR_FIRST, STAR_LIMIT] {
+        let around = star(mesh, origin, tet, limit);
+        let found = around[searched.min(around.len())..]
+            .iter()
+            .find_map(|&c| start_in_tet(mesh, proj, c));
+        if found.is_some() {
+            return found;
+        }
+        // A boundary face only once the whole star is known to hold no
+        // tet the line passes through.
+        if around.len() < limit || limit == STAR_LIMIT {
+            return boundary_face_at(mesh, origin, &around)
+                .map(|(c, k)| exit_state(mesh, proj, c, k));
+        }
+        searched = around.len();
+    }
+    None
+}
+
 /// A face on the mesh boundary (no tet behind it, constrained or not) that
 /// contains `p` (exact), among the faces of the tets `around` (each
 /// containing `p`): `(tet, face)`.
@@ -139,38 +178,16 @@ fn start_fallback<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) 
 /// other tets around an origin on a face, edge or vertex).
 pub fn start_exit_face<P: Projection>(mesh: &TetMesh, ray: &Ray, tet: u32) -> Option<(u32, usize)> {
     let proj = P::setup_scaled(ray, tet_scale(mesh, ray, tet));
-    let found = |t: u32| {
-        start_in_tet(mesh, &proj, t).map(|s| {
-            let k = (0..4)
-                .find(|&k| {
-                    mesh.neighbors[t as usize][k].0 == s.link && {
-                        let f = mesh.face_vertices(t, k);
-                        f.contains(&s.ids[0]) && f.contains(&s.ids[1]) && f.contains(&s.ids[2])
-                    }
-                })
-                .unwrap_or(0);
-            (t, k)
-        })
-    };
-    found(tet)
-        .or_else(|| {
-            let around = star(mesh, ray.origin, tet, 256);
-            around
-                .iter()
-                .skip(1)
-                .find_map(|&t| found(t))
-                .or_else(|| boundary_face_at(mesh, ray.origin, &around))
-        })
-        .or_else(|| {
-            let s = start_fallback(mesh, &proj, ray, tet);
-            let k = (0..4).find(|&k| {
-                mesh.neighbors[tet as usize][k].0 == s.link && {
-                    let f = mesh.face_vertices(tet, k);
-                    s.ids.iter().all(|i| f.contains(i))
-                }
-            })?;
-            Some((tet, k))
-        })
+    let s = start_in_tet(mesh, &proj, tet)
+        .or_else(|| search_star(mesh, &proj, ray.origin, tet))
+        .unwrap_or_else(|| start_fallback(mesh, &proj, ray, tet));
+    let f = (0..4).find(|&k| {
+        mesh.neighbors[s.tet as usize][k].0 == s.link && {
+            let f = mesh.face_vertices(s.tet, k);
+            s.ids.iter().all(|i| f.contains(i))
+        }
+    })?;
+    Some((s.tet, f))
 }
 
 /// One ray in flight: its projection, walk state, the tet it enters next
@@ -252,16 +269,8 @@ pub(crate) fn begin_with<P: Projection>(
                 None => {
                     // The origin is on the start tet's boundary and the ray
                     // leaves it at once: try the other tets around the origin.
-                    let around = star(mesh, ray.origin, t, 256);
-                    let found = around
-                        .iter()
-                        .skip(1)
-                        .find_map(|&c| start_in_tet(mesh, &proj, c))
-                        .or_else(|| {
-                            boundary_face_at(mesh, ray.origin, &around)
-                                .map(|(c, k)| exit_state(mesh, &proj, c, k))
-                        });
-                    found.unwrap_or_else(|| start_fallback(mesh, &proj, ray, t))
+                    search_star(mesh, &proj, ray.origin, t)
+                        .unwrap_or_else(|| start_fallback(mesh, &proj, ray, t))
                 }
             }
         }
