@@ -37,11 +37,11 @@
 //!
 //! * Stripification: a small greedy stripifier (`build::stripify`) instead
 //!   of the Stripe library. Its strips are shorter on irregular meshes
-//!   (bunny: about 7.7 triangles per strip at the default chunk size,
-//!   against Stripe's 19.3 in Table 5), so the bunny takes about 27
-//!   bytes per triangle instead of the paper's 23 (1.5 MB);
-//!   `strips_per_leaf: 4` recovers that budget (21.6 bytes per triangle)
-//!   at some cost in speed. Swaps are implemented but
+//!   (bunny: 8.1 triangles per strip at the default chunk size, against
+//!   Stripe's 19.3 in Table 5), so the bunny takes 26.8 bytes per
+//!   triangle (1.86 MB) instead of the paper's 1.5 MB (about 23);
+//!   `strips_per_leaf: 4` recovers that budget (21.5 bytes per triangle,
+//!   1.49 MB) at some cost in speed. Swaps are implemented but
 //!   off by default (see the stripifier's docs for why).
 //! * Triangle test: Woop et al.'s watertight test with the paper's edge
 //!   sharing along the strip, instead of Plücker edge tests.

@@ -24,10 +24,10 @@ impl Default for BuildOptions {
     /// swaps; chosen with the crate's `measure` example on a 70 k-triangle
     /// bumpy sphere and the Stanford bunny: chunks of 16–128 trace fastest
     /// (within the noise of the shared measuring machine), and 128 is the
-    /// most compact of them (bunny 27.2 B/triangle against 28.8 at 64;
-    /// 256 saves another 1.1 B/triangle but traced 10–40 % slower).
-    /// `strips_per_leaf: 4` brings the bunny to 21.6 B/triangle (1.50 MB)
-    /// but traced 10–30 % slower.
+    /// most compact of them (bunny 26.8 B/triangle against 28.4 at 64;
+    /// 256 saves another 0.9 B/triangle but traced 10–40 % slower).
+    /// `strips_per_leaf: 4` brings the bunny to 21.5 B/triangle (1.49 MB);
+    /// its speed ranged from equal to 30 % slower over the runs.
     fn default() -> Self {
         Self {
             chunk_triangles: 128,
