@@ -18,6 +18,24 @@
 //! | §5.2 intersection (edge sharing) | `traverse::triangle` |
 //! | §5.3 ray packets | `traverse::packet` |
 //!
+//! ```
+//! use glam::Vec3;
+//! use ray_strips::{BuildOptions, Ray, RayStrips};
+//!
+//! // A unit square in the z = 0 plane, as two triangles.
+//! let positions = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+//! let triangles = [[0, 1, 2], [0, 2, 3]];
+//! let rs = RayStrips::build(&positions, &triangles, &BuildOptions::default())?;
+//!
+//! let hit = rs.intersect(&Ray::new(Vec3::new(0.25, 0.5, 2.0), Vec3::NEG_Z)).unwrap();
+//! assert_eq!(hit.triangle, 1);
+//! assert_eq!(hit.t, 2.0);
+//! // p = (1 − u − v)·v0 + u·v1 + v·v2 for triangle 1 = (0, 2, 3).
+//! assert!((hit.u - 0.25).abs() < 1e-6 && (hit.v - 0.25).abs() < 1e-6);
+//! assert_eq!(rs.stats().strips, 1);
+//! # Ok::<(), ray_strips::BuildError>(())
+//! ```
+//!
 //! # Memory
 //!
 //! Geometry: the global vertex list (12 bytes per vertex, `f32`), one
