@@ -37,8 +37,8 @@
 //! `m` is odd; the *second* part takes `⌊L/2⌋` pairs. Parts with `m ≤ 3`
 //! are the implicit leaves (the paper stops at sub-strips of 2 triangles;
 //! with an odd `n` one leaf holds 3). Every leaf thus holds 2 or 3
-//! triangles, there are `⌊n/2⌋` leaves and `⌊n/2⌋ − 1` nodes, exactly the
-//! paper's count. In preorder the first child of node `i` is `i + 1` and the
+//! triangles (a strip of one triangle is a single leaf), there are `⌊n/2⌋`
+//! leaves and `⌊n/2⌋ − 1` nodes, exactly the paper's count. In preorder the first child of node `i` is `i + 1` and the
 //! second is `i + ⌈L/2⌉` (the first subtree has `⌈L/2⌉ − 1` nodes), so no
 //! child pointers are stored.
 //!

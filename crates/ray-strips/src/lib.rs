@@ -18,6 +18,24 @@
 //! | §5.2 intersection (edge sharing) | `traverse::triangle` |
 //! | §5.3 ray packets | `traverse::packet` |
 //!
+//! ```
+//! use glam::Vec3;
+//! use ray_strips::{BuildOptions, Ray, RayStrips};
+//!
+//! // A unit square in the z = 0 plane, as two triangles.
+//! let positions = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+//! let triangles = [[0, 1, 2], [0, 2, 3]];
+//! let rs = RayStrips::build(&positions, &triangles, &BuildOptions::default())?;
+//!
+//! let hit = rs.intersect(&Ray::new(Vec3::new(0.25, 0.5, 2.0), Vec3::NEG_Z)).unwrap();
+//! assert_eq!(hit.triangle, 1);
+//! assert_eq!(hit.t, 2.0);
+//! // p = (1 − u − v)·v0 + u·v1 + v·v2 for triangle 1 = (0, 2, 3).
+//! assert!((hit.u - 0.25).abs() < 1e-6 && (hit.v - 0.25).abs() < 1e-6);
+//! assert_eq!(rs.stats().strips, 1);
+//! # Ok::<(), ray_strips::BuildError>(())
+//! ```
+//!
 //! # Memory
 //!
 //! Geometry: the global vertex list (12 bytes per vertex, `f32`), one
@@ -37,11 +55,11 @@
 //!
 //! * Stripification: a small greedy stripifier (`build::stripify`) instead
 //!   of the Stripe library. Its strips are shorter on irregular meshes
-//!   (bunny: about 7.7 triangles per strip at the default chunk size,
-//!   against Stripe's 19.3 in Table 5), so the bunny takes about 27
-//!   bytes per triangle instead of the paper's 23 (1.5 MB);
-//!   `strips_per_leaf: 4` recovers that budget (21.6 bytes per triangle)
-//!   at some cost in speed. Swaps are implemented but
+//!   (bunny: 8.1 triangles per strip at the default chunk size, against
+//!   Stripe's 19.3 in Table 5), so the bunny takes 26.8 bytes per
+//!   triangle (1.86 MB) instead of the paper's 1.5 MB (about 23);
+//!   `strips_per_leaf: 4` recovers that budget (21.5 bytes per triangle,
+//!   1.49 MB) at some cost in speed. Swaps are implemented but
 //!   off by default (see the stripifier's docs for why).
 //! * Triangle test: Woop et al.'s watertight test with the paper's edge
 //!   sharing along the strip, instead of Plücker edge tests.

@@ -6,7 +6,8 @@ use glam::Vec3;
 ///
 /// The direction need not be normalised; `t` is measured in units of its
 /// length. A ray whose origin or direction is not finite, or whose direction
-/// is zero, hits nothing.
+/// is zero, hits nothing; direction components smaller than
+/// `f32::MIN_POSITIVE` (subnormal) are taken as zero.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
     /// Where the ray starts.

@@ -152,3 +152,16 @@ fn the_structure_is_send_and_sync() {
     fn check<T: Send + Sync>() {}
     check::<RayStrips>();
 }
+
+#[test]
+fn subnormal_direction_components_count_as_zero() {
+    let rs = RayStrips::build(&quad(), &[[0, 1, 2], [0, 2, 3]], &BuildOptions::default()).unwrap();
+    // Straight down through the shared diagonal's end at a box face, with a
+    // subnormal sideways component: still a hit, no NaN.
+    let tiny = f32::MIN_POSITIVE / 4.0;
+    let ray = Ray::new(Vec3::new(1.0, 1.0, 1.0), Vec3::new(tiny, -tiny, -1.0));
+    let h = rs.intersect(&ray).expect("hit at the corner");
+    assert_eq!(h.t, 1.0);
+    // Only subnormal components: nothing.
+    assert_eq!(rs.intersect(&Ray::new(Vec3::ONE, Vec3::splat(-tiny))), None);
+}

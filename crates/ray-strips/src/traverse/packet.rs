@@ -10,7 +10,7 @@
 //! arithmetic, and its result is bit for bit the single-ray result.
 
 use crate::layout::{BlockLayout, StripData, is_leaf, leaf_blocks, strip_words};
-use crate::traverse::prepared::{Best, Prepared};
+use crate::traverse::prepared::{Best, Prepared, fmin};
 use crate::traverse::single::{
     BVH_STACK, Part, STRIP_STACK, Stacks, child_intervals, node_children, strip_from, trace_from,
 };
@@ -156,7 +156,7 @@ fn strip_packet(
     loop {
         let (part, mut mask, dmin, mut dmax) = cur;
         for l in lanes(mask) {
-            dmax[l] = dmax[l].min(best[l].t);
+            dmax[l] = fmin(dmax[l], best[l].t);
             if dmin[l] > dmax[l] {
                 mask &= !(1 << l);
             }

@@ -22,6 +22,18 @@ pub(crate) fn up(x: f32) -> f32 {
     x + x.abs() * SLACK
 }
 
+/// `max` for values that are not NaN (one instruction, unlike `f32::max`).
+#[inline(always)]
+pub(crate) fn fmax(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
+/// `min` for values that are not NaN.
+#[inline(always)]
+pub(crate) fn fmin(a: f32, b: f32) -> f32 {
+    if a < b { a } else { b }
+}
+
 /// A traceable ray with its precomputed values.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Prepared {
@@ -37,6 +49,9 @@ pub(crate) struct Prepared {
     pub k: [usize; 3],
     /// Woop's shear constants `Sx, Sy, Sz`.
     pub shear: [f32; 3],
+    /// Whether some direction component is zero (slab tests then need the
+    /// careful path).
+    pub parallel: bool,
 }
 
 impl Prepared {
@@ -45,8 +60,16 @@ impl Prepared {
         if !ray.is_traceable() {
             return None;
         }
-        let dir = ray.direction.to_array();
-        let kz = ray.direction.abs().max_position();
+        // Subnormal components count as zero, so that `1 / d` is finite
+        // for every non-zero component and slab distances are never NaN.
+        let dir = ray
+            .direction
+            .to_array()
+            .map(|d| if d.abs() < f32::MIN_POSITIVE { 0.0 } else { d });
+        if dir == [0.0; 3] {
+            return None;
+        }
+        let kz = glam::Vec3::from(dir).abs().max_position();
         let mut kx = (kz + 1) % 3;
         let mut ky = (kx + 1) % 3;
         if dir[kz] < 0.0 {
@@ -59,6 +82,7 @@ impl Prepared {
             t_min: ray.t_min,
             k: [kx, ky, kz],
             shear: [dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]],
+            parallel: dir.contains(&0.0),
         })
     }
 
@@ -73,6 +97,27 @@ impl Prepared {
     /// `None` when empty.
     #[inline(always)]
     pub fn box_interval(&self, min: &[f32; 3], max: &[f32; 3], t_max: f32) -> Option<(f32, f32)> {
+        if !self.parallel {
+            // No direction component is zero: every slab distance is a
+            // number, and `down`/`up` are monotonic, so the slack is applied
+            // once to the combined ends.
+            let mut tn = f32::NEG_INFINITY;
+            let mut tf = f32::INFINITY;
+            for a in 0..3 {
+                let t0 = (min[a] - self.org[a]) * self.inv[a];
+                let t1 = (max[a] - self.org[a]) * self.inv[a];
+                let (near, far) = if self.inv[a] >= 0.0 {
+                    (t0, t1)
+                } else {
+                    (t1, t0)
+                };
+                tn = fmax(tn, near);
+                tf = fmin(tf, far);
+            }
+            let tn = fmax(self.t_min, down(tn));
+            let tf = fmin(t_max, up(tf));
+            return (tn <= tf).then_some((tn, tf));
+        }
         let mut tn = self.t_min;
         let mut tf = t_max;
         for a in 0..3 {

@@ -19,7 +19,7 @@
 //! ray aimed at a vertex or edge on a splitting plane.
 
 use crate::layout::{BlockLayout, StripData, is_leaf, leaf_blocks, split_counts, strip_words};
-use crate::traverse::prepared::{Best, Prepared, down, up};
+use crate::traverse::prepared::{Best, Prepared, down, fmax, fmin, up};
 use crate::traverse::triangle::intersect_leaf;
 
 /// Traversal stack depth of the high-level BVH (the builder caps the tree's
@@ -117,8 +117,8 @@ pub(crate) fn child_intervals(
     let t_exit = up((near_plane - o) * ray.inv[axis]);
     let t_entry = down((far_plane - o) * ray.inv[axis]);
     [
-        (t_exit >= dmin).then(|| (dmin, dmax.min(t_exit))),
-        (t_entry <= dmax).then(|| (dmin.max(t_entry), dmax)),
+        (t_exit >= dmin).then(|| (dmin, fmin(dmax, t_exit))),
+        (t_entry <= dmax).then(|| (fmax(dmin, t_entry), dmax)),
     ]
 }
 
@@ -190,7 +190,7 @@ pub(crate) fn strip_from(
     let mut hit = false;
     loop {
         let (part, dmin, dmax) = cur;
-        let dmax = dmax.min(best.t);
+        let dmax = fmin(dmax, best.t);
         if dmin <= dmax {
             if part.m <= 3 {
                 if intersect_leaf(data, layout, part.t0, part.m, ray, best) {
