@@ -230,7 +230,11 @@ impl<'m> Reference<'m> {
         let tol_t = self.tol / dlen;
         let mut best: Option<(f64, u32)> = None;
         let mut second = f64::INFINITY;
-        let r = BvhRay::new(a3(ray.origin), a3(ray.direction), 0.0, f32::INFINITY);
+        // obvhs wants directions of about unit length (it treats components
+        // below f32::EPSILON as zero): traverse with the unit direction,
+        // whose parameter is `t · dlen`.
+        let unit = (ray.direction.as_dvec3() / dlen).as_vec3();
+        let r = BvhRay::new(a3(ray.origin), a3(unit), 0.0, f32::INFINITY);
         let mut hit = RayHit::none();
         self.bvh.ray_traverse(r, &mut hit, |_, id| {
             let face = self.bvh.primitive_indices[id];
@@ -252,7 +256,7 @@ impl<'m> Reference<'m> {
                 }
             }
             // Keep looking a little beyond the closest hit for the gap test.
-            ((best.unwrap().0 + 2.0 * tol_t) as f32) * (1.0 + 1e-6)
+            (((best.unwrap().0 + 2.0 * tol_t) * dlen) as f32) * (1.0 + 1e-6)
         });
         let (t, face) = best?;
         let cf = &mesh.constrained[face as usize];

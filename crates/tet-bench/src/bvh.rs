@@ -185,6 +185,17 @@ impl<'m> BvhTracer<'m> {
     }
 }
 
+/// A power of two that brings the largest component of a (valid)
+/// direction into `[1, 2)` when it lies outside `[2⁻⁸, 2⁸]`, else 1.
+fn direction_scale(d: Vec3) -> f32 {
+    let m = d.abs().max_element();
+    if (1.0 / 256.0..=256.0).contains(&m) {
+        return 1.0;
+    }
+    let e = (m as f64).log2().floor() as i32;
+    (2.0f64).powi(-e.clamp(-126, 126)) as f32
+}
+
 /// The hit record of a BVH-style tracer that found constrained face `face`
 /// at distance `t` along `ray`: barycentrics and the tets on both sides
 /// recomputed from the mesh (so every method reports the same record;
@@ -233,19 +244,29 @@ impl Tracer for BvhTracer<'_> {
     }
 
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
+        if !ray.is_valid() {
+            return TraceOutcome::Failed {
+                failure: tet_trace_cpu::ray::Failure::InvalidRay,
+                tets_visited: 0,
+            };
+        }
         let skip = start.on_face().unwrap_or(u32::MAX);
+        // obvhs treats direction components below f32::EPSILON as zero: a
+        // ray of a tiny (or huge) scene traverses with its direction
+        // scaled by a power of two `k` (exact; `t` is then `t' · k`).
+        let k = direction_scale(ray.direction);
         let mut r = BvhRay::new(
             a(ray.origin),
-            a(ray.direction),
-            ray.t_min.max(0.0),
-            ray.t_max,
+            a(ray.direction * k),
+            ray.t_min.max(0.0) / k,
+            ray.t_max / k,
         );
-        r.tmin = ray.t_min;
+        r.tmin = ray.t_min / k;
         if self.count_nodes {
             let (best, nodes) = self.count_trace(&r, |id| self.faces[id] != skip);
             return match best {
                 Some((id, t)) => {
-                    let mut h = face_hit(self.mesh, ray, self.faces[id], t);
+                    let mut h = face_hit(self.mesh, ray, self.faces[id], t * k);
                     h.tets_visited = nodes;
                     TraceOutcome::Hit(h)
                 }
@@ -264,7 +285,7 @@ impl Tracer for BvhTracer<'_> {
         });
         if found {
             let face = self.faces[hit.primitive_id as usize];
-            TraceOutcome::Hit(face_hit(self.mesh, ray, face, hit.t))
+            TraceOutcome::Hit(face_hit(self.mesh, ray, face, hit.t * k))
         } else {
             TraceOutcome::Miss { tets_visited: 0 }
         }

@@ -53,7 +53,34 @@ fn build_then_info_reports_exact_layout_bytes() {
         .iter()
         .map(|l| l["name"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["baseline32", "tet32", "tet20", "tet16", "tet80"]);
+    assert_eq!(
+        names,
+        [
+            "baseline32",
+            "tet32",
+            "tet20",
+            "tet16",
+            "tet80",
+            "ray-strips"
+        ]
+    );
+    // Ray-Strips over the 2880 triangles: its parts add up, and its
+    // geometry holds at least a 4-byte word per triangle and a 12-byte
+    // position per vertex of the tube (1440).
+    let strips = &layouts[5];
+    let part = |k: &str| strips[k].as_u64().unwrap() as usize;
+    assert_eq!(
+        part("geometry_bytes") + part("hierarchy_bytes") + part("top_level_bytes"),
+        part("total_bytes")
+    );
+    assert!(part("geometry_bytes") >= 2880 * 4 + 1440 * 12);
+    let per_triangle = strips["total_bytes_per_triangle"].as_f64().unwrap();
+    assert!((per_triangle - part("total_bytes") as f64 / 2880.0).abs() < 1e-9);
+    assert!(
+        layouts[..5]
+            .iter()
+            .all(|l| l.get("geometry_bytes").is_none())
+    );
     // Hot bytes are tet records plus points (none for Tet80, whose records
     // hold the positions), record sizes as the papers give them.
     for (l, record, pts) in [

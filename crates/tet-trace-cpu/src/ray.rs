@@ -41,11 +41,13 @@ impl Ray {
         self.origin + self.direction * t
     }
 
-    /// True when origin and direction are finite and the direction non-zero.
+    /// True when origin and direction are finite and the direction non-zero
+    /// (of any size: a scene at 1e-30 has directions whose squared length
+    /// underflows f32).
     pub fn is_valid(&self) -> bool {
         self.origin.is_finite()
             && self.direction.is_finite()
-            && self.direction.length_squared() > 0.0
+            && self.direction != Vec3::ZERO
             && !self.t_min.is_nan()
             && !self.t_max.is_nan()
     }

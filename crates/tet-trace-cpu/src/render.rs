@@ -200,9 +200,12 @@ pub struct PinholeCamera {
 impl PinholeCamera {
     /// Builds the generator for a `width × height` image.
     pub fn new(camera: &Camera, width: u32, height: u32, pixel_centers: bool) -> Self {
-        let forward = (camera.target - camera.position).normalize();
-        let right = -camera.up.cross(forward).normalize();
+        // In f64: the view vector of a scene at 1e30 or 1e-30 has a squared
+        // length f32 cannot hold.
+        let forward = (camera.target.as_dvec3() - camera.position.as_dvec3()).normalize();
+        let right = -camera.up.as_dvec3().cross(forward).normalize();
         let up = -forward.cross(right);
+        let (forward, right, up) = (forward.as_vec3(), right.as_vec3(), up.as_vec3());
         PinholeCamera {
             position: camera.position,
             forward,

@@ -60,7 +60,7 @@ pub struct SceneResult {
     /// Accuracy against the f64 reference.
     pub accuracy: Option<CaseAccuracy>,
     /// Ray-Strips beside the BVH (seed 002 Tables 1, 3, 4, 5).
-    pub ray_strips: Option<super::strips_vs_bvh::StripsRow>,
+    pub ray_strips: Option<StripsRow>,
     /// GPU methods (seed 000 Table 3), when built with `--features gpu` and
     /// an adapter is present.
     pub gpu_renders: Vec<RenderDoc>,
@@ -179,4 +179,35 @@ pub struct SpeedAccuracy {
     pub cases: Vec<CaseAccuracy>,
     /// Why it is missing, when the scene could not be loaded.
     pub error: Option<String>,
+}
+
+/// What Ray-Strips measured on one scene (JSON `scenes[].ray_strips`).
+#[derive(Clone, Debug, Serialize)]
+pub struct StripsRow {
+    /// Triangles stored.
+    pub triangles: usize,
+    /// Strips.
+    pub strips: usize,
+    /// Triangles per strip, mean.
+    pub mean_strip_triangles: f64,
+    /// Chunks of the SAH stage.
+    pub chunks: usize,
+    /// Ray-Strips build, s.
+    pub build_s: f64,
+    /// obvhs BVH build over the same triangles, s.
+    pub bvh_build_s: f64,
+    /// Ray-Strips geometry bytes (vertices, strip indices, triangle words).
+    pub geometry_bytes: usize,
+    /// Strip hierarchies, bytes.
+    pub hierarchy_bytes: usize,
+    /// BVH over the strips, bytes.
+    pub top_level_bytes: usize,
+    /// Everything, bytes.
+    pub total_bytes: usize,
+    /// The obvhs BVH's nodes, bytes.
+    pub bvh_hierarchy_bytes: usize,
+    /// The obvhs BVH's precomputed triangles and face ids, bytes.
+    pub bvh_geometry_bytes: usize,
+    /// `strips-packets` render of the same view.
+    pub packets: RenderDoc,
 }

@@ -9,46 +9,14 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 use anyhow::Result;
-use serde::Serialize;
 use tet_trace_cpu::render::RenderOptions;
 
-use super::doc::TablesDoc;
+use super::doc::{StripsRow, TablesDoc};
 use crate::bvh::BvhTracer;
 use crate::cli::Method;
 use crate::load::Loaded;
 use crate::strips::StripsTracer;
-use crate::timing::{RenderDoc, time_method};
-
-/// What Ray-Strips measured on one scene (JSON `scenes[].ray_strips`).
-#[derive(Clone, Debug, Serialize)]
-pub struct StripsRow {
-    /// Triangles stored.
-    pub triangles: usize,
-    /// Strips.
-    pub strips: usize,
-    /// Triangles per strip, mean.
-    pub mean_strip_triangles: f64,
-    /// Chunks of the SAH stage.
-    pub chunks: usize,
-    /// Ray-Strips build, s.
-    pub build_s: f64,
-    /// obvhs BVH build over the same triangles, s.
-    pub bvh_build_s: f64,
-    /// Ray-Strips geometry bytes (vertices, strip indices, triangle words).
-    pub geometry_bytes: usize,
-    /// Strip hierarchies, bytes.
-    pub hierarchy_bytes: usize,
-    /// BVH over the strips, bytes.
-    pub top_level_bytes: usize,
-    /// Everything, bytes.
-    pub total_bytes: usize,
-    /// The obvhs BVH's nodes, bytes.
-    pub bvh_hierarchy_bytes: usize,
-    /// The obvhs BVH's precomputed triangles and face ids, bytes.
-    pub bvh_geometry_bytes: usize,
-    /// `strips-packets` render of the same view.
-    pub packets: RenderDoc,
-}
+use crate::timing::time_method;
 
 /// The paper's Bunny row (67 k triangles): Table 1 MB (Ray-Strips total,
 /// geometry, hierarchy; BVH hierarchy; indexed-list + BVH total;
