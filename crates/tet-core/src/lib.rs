@@ -48,6 +48,7 @@
 #![deny(missing_docs)]
 
 pub mod error;
+pub mod fields;
 pub mod format;
 pub mod hilbert;
 pub mod layout;
@@ -62,5 +63,6 @@ pub mod synthetic;
 mod validate;
 
 pub use error::MeshError;
+pub use fields::ScalarField;
 pub use link::{Link, LinkKind, MAX_TETS};
 pub use mesh::{Attributes, ConstrainedFace, FACE_VERTICES, FaceSide, NO_TET, TetMesh, face_key};

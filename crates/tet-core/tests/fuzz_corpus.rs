@@ -108,6 +108,7 @@ fn sample_meshes() -> Vec<(&'static str, TetMesh)> {
         normals: Some((0..n).map(|i| Vec3::new(i as f32, 0.0, 1.0)).collect()),
         uvs: Some((0..n).map(|i| Vec2::new(0.5, i as f32)).collect()),
         materials: Some((0..with_attributes.triangle_count).collect()),
+        scalars: None,
     };
     vec![
         ("empty", TetMesh::default()),

@@ -13,8 +13,11 @@ use super::error::{FormatError, IN_MEMORY};
 use super::header::{Header, parse_header};
 use super::scene_block::decode_scene;
 use super::section_reader::SectionReader;
-use super::spec::{FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCENE, FLAG_UVS, HEADER_LEN};
+use super::spec::{
+    FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCALARS, FLAG_SCENE, FLAG_UVS, HEADER_LEN, SCALAR_NAME_SLOT,
+};
 use super::words::from_le_words;
+use crate::fields::ScalarField;
 use crate::link::Link;
 use crate::mesh::{Attributes, ConstrainedFace, TetMesh};
 use crate::scene::SceneInfo;
@@ -69,6 +72,16 @@ impl<S: Source> PayloadReader<'_, S> {
         Ok(())
     }
 
+    /// Reads `N` plain bytes (not words) at absolute offset `offset`.
+    fn raw<const N: usize>(&mut self, offset: u64) -> Result<[u8; N], FormatError> {
+        self.skip_to(offset)?;
+        let mut buf = [0u8; N];
+        self.src.read_exact_into(&mut buf).map_err(|e| self.io(e))?;
+        self.crc.update(&buf);
+        self.pos += N as u64;
+        Ok(buf)
+    }
+
     /// Reads `count` elements at absolute offset `offset` straight into a
     /// `Vec<T>`. `count × size_of::<T>()` was checked against the file length.
     fn section<T: Pod>(&mut self, (offset, length): (u64, u64)) -> Result<Vec<T>, FormatError> {
@@ -116,6 +129,20 @@ fn decode<S: Source>(
     } else {
         None
     };
+    let scalars = if present(FLAG_SCALARS) {
+        let (offset, _) = header.scalars;
+        let slot: [u8; SCALAR_NAME_SLOT as usize] = r.raw(offset)?;
+        let name = decode_name(&slot, path)?;
+        let step_bytes = header.counts[0] * 4;
+        let mut steps = Vec::with_capacity(header.scalar_steps as usize);
+        for step in 0..u64::from(header.scalar_steps) {
+            let at = offset + SCALAR_NAME_SLOT + step * step_bytes;
+            steps.push(r.section::<f32>((at, step_bytes))?);
+        }
+        Some(ScalarField { name, steps })
+    } else {
+        None
+    };
     let scene_records: Vec<[u32; 12]> = if present(FLAG_SCENE) {
         r.section(header.scene)?
     } else {
@@ -142,6 +169,7 @@ fn decode<S: Source>(
             normals,
             uvs,
             materials,
+            scalars,
         },
     };
     let scene = decode_scene(&scene_records, path)?;
@@ -150,6 +178,24 @@ fn decode<S: Source>(
         source,
     })?;
     Ok((mesh, scene))
+}
+
+/// The scalar field's name from its NUL-padded slot: UTF-8 up to the
+/// first NUL, zeros after it.
+pub(super) fn decode_name(slot: &[u8], path: &Path) -> Result<String, FormatError> {
+    let bad = |detail: String| FormatError::BadField {
+        path: path.to_path_buf(),
+        field: "scalars name",
+        detail,
+    };
+    let len = slot.iter().position(|&b| b == 0).unwrap_or(slot.len());
+    if let Some(k) = slot[len..].iter().position(|&b| b != 0) {
+        return Err(bad(format!(
+            "byte {} after the name's end is not 0",
+            len + k
+        )));
+    }
+    String::from_utf8(slot[..len].to_vec()).map_err(|e| bad(format!("not UTF-8: {e}")))
 }
 
 /// Decodes a mesh from an in-memory file image (checks as in [`load`];
