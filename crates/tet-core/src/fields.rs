@@ -15,13 +15,15 @@ use crate::error::MeshError;
 
 /// Most bytes of a field's name (UTF-8): the mesh file stores the name in a
 /// fixed 64-byte slot, NUL-padded, so a name may not contain NUL either.
+/// Names are labels: no control characters at all (which XML files, e.g.
+/// VTK's, could not carry).
 pub const SCALAR_NAME_BYTES: usize = 64;
 
 /// One named per-point scalar field with one or more time steps.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ScalarField {
     /// Name of the field (at most [`SCALAR_NAME_BYTES`] bytes of UTF-8, no
-    /// NUL), e.g. `"density"`.
+    /// control character), e.g. `"density"`.
     pub name: String,
     /// One array per time step, each with one finite value per mesh point.
     pub steps: Vec<Vec<f32>>,
@@ -99,12 +101,13 @@ impl ScalarField {
     }
 }
 
-/// Checks a field name: at most [`SCALAR_NAME_BYTES`] bytes, no NUL.
+/// Checks a field name: at most [`SCALAR_NAME_BYTES`] bytes, no control
+/// character (NUL included).
 pub fn check_name(name: &str) -> Result<(), MeshError> {
     let detail = if name.len() > SCALAR_NAME_BYTES {
         format!("{} bytes, at most {SCALAR_NAME_BYTES}", name.len())
-    } else if name.contains('\0') {
-        "contains a NUL character".to_string()
+    } else if let Some(c) = name.chars().find(|c| c.is_control()) {
+        format!("contains the control character {c:?}")
     } else {
         return Ok(());
     };
@@ -150,7 +153,9 @@ mod tests {
         assert!(matches!(f.check(2), Err(MeshError::ScalarNoSteps { .. })));
         f.name = "x".repeat(65);
         assert!(matches!(f.check(2), Err(MeshError::ScalarName { .. })));
-        f.name = "a\0b".into();
-        assert!(matches!(f.check(2), Err(MeshError::ScalarName { .. })));
+        for bad in ["a\0b", "a\nb", "\u{10}"] {
+            f.name = bad.into();
+            assert!(matches!(f.check(2), Err(MeshError::ScalarName { .. })));
+        }
     }
 }

@@ -213,7 +213,7 @@ impl StreamWriter {
         };
         let Some(slot) = name_slot(name) else {
             return Err(refuse(format!(
-                "field name {name:?} does not fit the {}-byte slot (or holds a NUL)",
+                "field name {name:?} does not fit the {}-byte slot (or holds a control character)",
                 slot_len()
             )));
         };

@@ -33,7 +33,7 @@ fn section_bytes(mesh: &TetMesh) -> [Option<&[u8]>; 7] {
 }
 
 /// The scalar block's name slot: the name's UTF-8 bytes, NUL-padded.
-/// `None` when the name does not fit (or holds a NUL).
+/// `None` when the name does not fit (or holds a control character).
 pub(super) fn name_slot(name: &str) -> Option<[u8; SCALAR_NAME_SLOT as usize]> {
     check_name(name).ok()?;
     let mut slot = [0u8; SCALAR_NAME_SLOT as usize];
