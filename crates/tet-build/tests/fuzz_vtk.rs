@@ -88,9 +88,15 @@ fn seeds() -> Vec<(String, Vec<u8>)> {
         ("appended", VtkEncoding::Appended),
     ] {
         if enc != VtkEncoding::Appended {
-            out.push((format!("ours_{tag}.vtk"), vtk_files::join(0, &to_legacy_bytes(&m, enc))));
+            out.push((
+                format!("ours_{tag}.vtk"),
+                vtk_files::join(0, &to_legacy_bytes(&m, enc)),
+            ));
         }
-        out.push((format!("ours_{tag}.vtu"), vtk_files::join(1, &to_vtu_bytes(&m, enc))));
+        out.push((
+            format!("ours_{tag}.vtu"),
+            vtk_files::join(1, &to_vtu_bytes(&m, enc)),
+        ));
     }
     out.push(("hand.vtk".into(), vtk_files::join(2, LEGACY.as_bytes())));
     out.push(("hand.vtu".into(), vtk_files::join(2, VTU.as_bytes())));
@@ -100,17 +106,19 @@ fn seeds() -> Vec<(String, Vec<u8>)> {
     ));
     out.push((
         "huge_count.vtk".into(),
-        vtk_files::join(0, LEGACY.replace("POINTS 5", "POINTS 99999999999999").as_bytes()),
+        vtk_files::join(
+            0,
+            LEGACY
+                .replace("POINTS 5", "POINTS 99999999999999")
+                .as_bytes(),
+        ),
     ));
     out.push((
         "huge_block.vtu".into(),
         vtk_files::join(
             1,
-            VTU.replace(
-                r#"format="ascii">4 8<"#,
-                r#"format="binary">/////w==<"#,
-            )
-            .as_bytes(),
+            VTU.replace(r#"format="ascii">4 8<"#, r#"format="binary">/////w==<"#)
+                .as_bytes(),
         ),
     ));
     out
@@ -200,8 +208,14 @@ fn mutate(rng: &mut SplitMix64, data: &[u8]) -> Vec<u8> {
                 b.splice(pos..pos, token.iter().chain(b" ").copied());
             }
             3 => {
-                let s = b[..pos].iter().rposition(|&c| c == b'\n').map_or(1, |i| i + 1);
-                let e = b[pos..].iter().position(|&c| c == b'\n').map_or(b.len(), |i| pos + i + 1);
+                let s = b[..pos]
+                    .iter()
+                    .rposition(|&c| c == b'\n')
+                    .map_or(1, |i| i + 1);
+                let e = b[pos..]
+                    .iter()
+                    .position(|&c| c == b'\n')
+                    .map_or(b.len(), |i| pos + i + 1);
                 if rng.next_u64().is_multiple_of(2) {
                     b.drain(s..e);
                 } else {

@@ -560,7 +560,11 @@ pub fn to_legacy_bytes(mesh: &TetMesh, encoding: VtkEncoding) -> Vec<u8> {
                 out.extend_from_slice(&v.to_be_bytes());
             } else {
                 let _ = write!(s, "{v:?}");
-                s.push(if (i + 1).is_multiple_of(per_line) { '\n' } else { ' ' });
+                s.push(if (i + 1).is_multiple_of(per_line) {
+                    '\n'
+                } else {
+                    ' '
+                });
             }
         }
         out.extend_from_slice(s.as_bytes());

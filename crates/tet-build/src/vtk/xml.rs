@@ -488,7 +488,11 @@ impl Data {
         let mut s = String::new();
         let mut put = |i: usize, t: std::fmt::Arguments| {
             let _ = s.write_fmt(t);
-            s.push(if (i + 1).is_multiple_of(per_line) { '\n' } else { ' ' });
+            s.push(if (i + 1).is_multiple_of(per_line) {
+                '\n'
+            } else {
+                ' '
+            });
         };
         match self {
             Data::F32(v) => v

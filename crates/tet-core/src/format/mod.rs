@@ -121,13 +121,15 @@
 //! * `header`: the 176-byte header (parse with every check, encode);
 //! * `error`: [`FormatError`];
 //! * `words`: byte order and padding of the payload;
-//! * `scene_block`: the camera and light records;
+//! * `scene_block`: the camera and light records; `scalar_block`: the
+//!   scalar field's name slot;
 //! * `read` / `write`: whole meshes ([`load`], [`save`], …);
 //! * [`StreamWriter`] / [`SectionReader`]: a piece at a time.
 
 mod error;
 mod header;
 mod read;
+mod scalar_block;
 mod scene_block;
 mod section_reader;
 mod spec;

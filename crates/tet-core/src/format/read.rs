@@ -11,6 +11,7 @@ use glam::{Vec2, Vec3};
 
 use super::error::{FormatError, IN_MEMORY};
 use super::header::{Header, parse_header};
+use super::scalar_block::decode_name;
 use super::scene_block::decode_scene;
 use super::section_reader::SectionReader;
 use super::spec::{
@@ -178,24 +179,6 @@ fn decode<S: Source>(
         source,
     })?;
     Ok((mesh, scene))
-}
-
-/// The scalar field's name from its NUL-padded slot: UTF-8 up to the
-/// first NUL, zeros after it.
-pub(super) fn decode_name(slot: &[u8], path: &Path) -> Result<String, FormatError> {
-    let bad = |detail: String| FormatError::BadField {
-        path: path.to_path_buf(),
-        field: "scalars name",
-        detail,
-    };
-    let len = slot.iter().position(|&b| b == 0).unwrap_or(slot.len());
-    if let Some(k) = slot[len..].iter().position(|&b| b != 0) {
-        return Err(bad(format!(
-            "byte {} after the name's end is not 0",
-            len + k
-        )));
-    }
-    String::from_utf8(slot[..len].to_vec()).map_err(|e| bad(format!("not UTF-8: {e}")))
 }
 
 /// Decodes a mesh from an in-memory file image (checks as in [`load`];

@@ -13,7 +13,7 @@ use glam::{Vec2, Vec3};
 
 use super::error::FormatError;
 use super::header::{Header, parse_header};
-use super::read::decode_name;
+use super::scalar_block::decode_name;
 use super::scene_block::decode_scene;
 use super::spec::{
     ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCALARS, FLAG_SCENE, FLAG_UVS, HEADER_LEN,

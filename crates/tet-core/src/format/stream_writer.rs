@@ -12,13 +12,13 @@ use glam::{Vec2, Vec3};
 
 use super::error::FormatError;
 use super::header::{HeaderFields, header_bytes};
+use super::scalar_block::name_slot;
 use super::scene_block::scene_records;
 use super::spec::{
     ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCALARS, FLAG_SCENE, FLAG_UVS, HEADER_FIELDS,
     HEADER_LEN, SECTION_NAMES,
 };
 use super::words::{hash_le_words, padding, write_le_words};
-use super::write::name_slot;
 use crate::link::{Link, MAX_TETS};
 use crate::mesh::{Attributes, ConstrainedFace};
 use crate::scene::SceneInfo;

@@ -8,6 +8,7 @@ use crc32fast::Hasher;
 
 use super::error::FormatError;
 use super::header::{HeaderFields, header_bytes};
+use super::scalar_block::name_slot;
 use super::scene_block::scene_records;
 use super::spec::{
     FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCALARS, FLAG_SCENE, FLAG_UVS, HEADER_LEN, SCALAR_NAME_SLOT,
@@ -30,15 +31,6 @@ fn section_bytes(mesh: &TetMesh) -> [Option<&[u8]>; 7] {
         a.uvs.as_deref().map(bytemuck::cast_slice),
         a.materials.as_deref().map(bytemuck::cast_slice),
     ]
-}
-
-/// The scalar block's name slot: the name's UTF-8 bytes, NUL-padded.
-/// `None` when the name does not fit (or holds a control character).
-pub(super) fn name_slot(name: &str) -> Option<[u8; SCALAR_NAME_SLOT as usize]> {
-    check_name(name).ok()?;
-    let mut slot = [0u8; SCALAR_NAME_SLOT as usize];
-    slot[..name.len()].copy_from_slice(name.as_bytes());
-    Some(slot)
 }
 
 /// Checks what the header needs of a scalar field: a storable name, at
