@@ -271,8 +271,15 @@ fn linear_volume_is_built_with_its_field() {
 #[test]
 #[ignore = "builds the paper-sized volumes (seconds in release, longer in debug)"]
 fn paper_sized_volumes_build_and_validate() {
-    for name in ["ell32p", "feok", "bucky", "blunt", "fusion"] {
+    for name in ["ell32p", "feok", "bucky", "blunt", "fusion", "marschner-lobb", "buckycube"] {
+        let start = std::time::Instant::now();
         let m = synthetic_volume(name, &VolumeOptions::default()).unwrap();
+        println!(
+            "{name}: {} tets, {} points, built and validated in {:.2} s",
+            m.tets.len(),
+            m.points.len(),
+            start.elapsed().as_secs_f64()
+        );
         let info = synthetic_volume_info(name, &VolumeOptions::default()).unwrap();
         assert_eq!(m.tets.len() as u64, info.tet_count());
         let f = m.attributes.scalars.as_ref().unwrap();
@@ -281,6 +288,30 @@ fn paper_sized_volumes_build_and_validate() {
         assert!(
             lo < info.isovalue && info.isovalue < hi,
             "{name}: isovalue inside the range"
+        );
+    }
+}
+
+#[test]
+#[ignore = "builds the 11.3 M-tet bucky cube and the 3 M-tet x 116-step fusion volume (GBs of memory)"]
+fn full_size_volumes_build() {
+    let full = VolumeOptions {
+        full: true,
+        ..VolumeOptions::default()
+    };
+    for name in ["buckycube", "fusion"] {
+        let start = std::time::Instant::now();
+        let m = synthetic_volume(name, &full).unwrap();
+        let info = synthetic_volume_info(name, &full).unwrap();
+        assert_eq!(m.tets.len() as u64, info.tet_count());
+        let f = m.attributes.scalars.as_ref().unwrap();
+        assert_eq!(f.steps.len(), info.steps);
+        println!(
+            "{name} (full): {} tets, {} points, {} steps, built and validated in {:.1} s",
+            m.tets.len(),
+            m.points.len(),
+            f.steps.len(),
+            start.elapsed().as_secs_f64()
         );
     }
 }
