@@ -271,7 +271,15 @@ fn linear_volume_is_built_with_its_field() {
 #[test]
 #[ignore = "builds the paper-sized volumes (seconds in release, longer in debug)"]
 fn paper_sized_volumes_build_and_validate() {
-    for name in ["ell32p", "feok", "bucky", "blunt", "fusion", "marschner-lobb", "buckycube"] {
+    for name in [
+        "ell32p",
+        "feok",
+        "bucky",
+        "blunt",
+        "fusion",
+        "marschner-lobb",
+        "buckycube",
+    ] {
         let start = std::time::Instant::now();
         let m = synthetic_volume(name, &VolumeOptions::default()).unwrap();
         println!(
@@ -314,4 +322,45 @@ fn full_size_volumes_build() {
             start.elapsed().as_secs_f64()
         );
     }
+}
+
+#[test]
+fn load_volume_reads_every_format_and_the_names() {
+    use tet_build::volume::load_volume;
+    let opts = VolumeOptions::default();
+    let mut m = grid_mesh(&GridVolume::new(
+        [2, 1, 1],
+        Vec3::ZERO,
+        Vec3::ONE,
+        Split::Five,
+    ))
+    .unwrap();
+    attach_time_series(&mut m, "f", 2, |p, t| p.x + t as f32).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let vtu = dir.path().join("m.vtu");
+    tet_build::vtk::write_vtu(&vtu, &m).unwrap();
+    assert_eq!(load_volume(vtu.to_str().unwrap(), &opts).unwrap(), m);
+    let vtk = dir.path().join("m.vtk");
+    tet_build::vtk::write_vtk(&vtk, &m, tet_build::vtk::VtkEncoding::Binary).unwrap();
+    assert_eq!(load_volume(vtk.to_str().unwrap(), &opts).unwrap(), m);
+    let tmesh = dir.path().join("m.tmesh");
+    tet_core::format::save(&tmesh, &m).unwrap();
+    assert_eq!(load_volume(tmesh.to_str().unwrap(), &opts).unwrap(), m);
+    let base = dir.path().join("t");
+    tet_build::tetgen_files::write(&base, &tet_build::tetgen_files::from_tet_mesh(&m)).unwrap();
+    let from_tetgen = load_volume(dir.path().join("t.node").to_str().unwrap(), &opts).unwrap();
+    assert_eq!(from_tetgen.tets, m.tets);
+    assert_eq!(
+        from_tetgen.attributes.scalars.as_ref().unwrap().steps,
+        m.attributes.scalars.as_ref().unwrap().steps
+    );
+    assert_eq!(load_volume("linear", &opts).unwrap().tets.len(), 24_576);
+    assert!(matches!(
+        load_volume("no-such-volume", &opts),
+        Err(VolumeError::UnknownName { .. })
+    ));
+    assert!(matches!(
+        load_volume(dir.path().join("gone.vtu").to_str().unwrap(), &opts),
+        Err(VolumeError::Vtk(tet_build::vtk::VtkError::Io { .. }))
+    ));
 }

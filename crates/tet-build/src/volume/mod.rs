@@ -3,7 +3,9 @@
 //! ([`grid`]), analytic fields evaluated at the points ([`field`]), and
 //! named synthetic stand-ins for the paper's data sets with their sizes
 //! ([`named`]). The field of any [`TetMesh`] (a CDT, a VTK file) is set with
-//! [`attach_field`] / [`attach_time_series`].
+//! [`attach_field`] / [`attach_time_series`]. [`load_volume`] takes a
+//! command line's spec: a file of any supported format or a synthetic
+//! volume's name.
 //!
 //! Every mesh made here is valid ([`TetMesh::validate`]): positively
 //! oriented tets, neighbours linked, no constrained faces, and the field in
@@ -15,6 +17,7 @@ use thiserror::Error;
 pub mod field;
 pub mod grid;
 pub mod named;
+pub mod source;
 
 pub use field::{AnalyticField, c60_vertices};
 pub use grid::{GridVolume, Split, grid_mesh};
@@ -22,6 +25,7 @@ pub use named::{
     VolumeInfo, VolumeOptions, build_volume, synthetic_volume, synthetic_volume_info,
     synthetic_volume_names,
 };
+pub use source::load_volume;
 
 /// Why a volume could not be made.
 #[derive(Debug, Error)]
@@ -57,6 +61,15 @@ pub enum VolumeError {
     /// The mesh (or the field on it) breaks an invariant.
     #[error("invalid volume mesh: {0}")]
     Mesh(#[from] MeshError),
+    /// A VTK file could not be read.
+    #[error(transparent)]
+    Vtk(#[from] crate::vtk::VtkError),
+    /// TetGen files could not be read or converted.
+    #[error(transparent)]
+    Tetgen(#[from] crate::tetgen_files::FilesError),
+    /// A mesh file could not be loaded.
+    #[error(transparent)]
+    Format(#[from] tet_core::format::FormatError),
 }
 
 /// Sets `mesh`'s scalar field to one step of `f` evaluated at every point
