@@ -52,7 +52,7 @@ pub struct GridVolume {
 }
 
 impl GridVolume {
-    /// The grid on the unit cube `[0, 1]³`... scaled to `[lo, hi]`.
+    /// A grid of `cells` boxes over `[lo, hi]`, each split by `split`.
     pub fn new(cells: [u32; 3], lo: Vec3, hi: Vec3, split: Split) -> GridVolume {
         GridVolume {
             cells,
