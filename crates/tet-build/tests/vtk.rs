@@ -378,3 +378,57 @@ fn truncated_files_are_errors_never_panics() {
         }
     }
 }
+
+#[test]
+fn pvd_time_series_round_trip_and_mismatches() {
+    use tet_build::vtk::{read_pvd, write_pvd};
+    let dir = tempfile::tempdir().unwrap();
+    let m = mesh_with_field(3);
+    let pvd = dir.path().join("series.pvd");
+    write_pvd(&pvd, &m, VtkEncoding::Binary).unwrap();
+    for k in 0..3 {
+        assert!(dir.path().join(format!("series_t{k:04}.vtu")).is_file());
+    }
+    assert_eq!(read_pvd(&pvd).unwrap(), m);
+    assert_eq!(read_vtk(&pvd).unwrap(), m);
+    // Steps follow `timestep`, not the order of the lines.
+    let text = std::fs::read_to_string(&pvd).unwrap();
+    let reversed = text
+        .replace("timestep=\"0\"", "timestep=\"9\"")
+        .replace("timestep=\"2\"", "timestep=\"-1\"");
+    std::fs::write(&pvd, &reversed).unwrap();
+    let r = read_pvd(&pvd).unwrap();
+    let f = m.attributes.scalars.as_ref().unwrap();
+    assert_eq!(
+        r.attributes.scalars.unwrap().steps,
+        [f.steps[2].clone(), f.steps[1].clone(), f.steps[0].clone()]
+    );
+    // A step holding another mesh is an error naming the DataSet's line.
+    let other = mesh_with_field(0);
+    let mut moved = other.clone();
+    moved.points[0].x += 0.01;
+    moved.attributes.scalars = Some(ScalarField::single(
+        "density",
+        vec![0.0; moved.points.len()],
+    ));
+    std::fs::write(
+        dir.path().join("series_t0001.vtu"),
+        to_vtu_bytes(&moved, VtkEncoding::Ascii),
+    )
+    .unwrap();
+    std::fs::write(&pvd, &text).unwrap();
+    match read_pvd(&pvd) {
+        Err(VtkError::Parse { line, message, .. }) => {
+            assert_eq!(line, 5, "{message}");
+            assert!(message.contains("another mesh"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+    // A missing step file is an I/O error naming that file.
+    write_pvd(&pvd, &m, VtkEncoding::Ascii).unwrap();
+    std::fs::remove_file(dir.path().join("series_t0002.vtu")).unwrap();
+    match read_pvd(&pvd) {
+        Err(VtkError::Io { path, .. }) => assert!(path.ends_with("series_t0002.vtu")),
+        other => panic!("{other:?}"),
+    }
+}

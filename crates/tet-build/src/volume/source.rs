@@ -1,5 +1,5 @@
 //! A volume named by a spec string, for command lines: a VTK file
-//! (`.vtk`, `.vtu`), TetGen files (`base.node` / `base.ele`, with point
+//! (`.vtk`, `.vtu`, or a `.pvd` time series), TetGen files (`base.node` / `base.ele`, with point
 //! attributes as the field), a mesh file in the tet-core format (any other
 //! existing file, e.g. `.tmesh`), or one of the synthetic volumes
 //! ([`super::synthetic_volume_names`]).
@@ -18,7 +18,7 @@ use crate::{tetgen_files, vtk};
 pub fn load_volume(spec: &str, options: &VolumeOptions) -> Result<TetMesh, VolumeError> {
     let lower = spec.to_ascii_lowercase();
     let path = Path::new(spec);
-    if lower.ends_with(".vtk") || lower.ends_with(".vtu") {
+    if lower.ends_with(".vtk") || lower.ends_with(".vtu") || lower.ends_with(".pvd") {
         return Ok(vtk::read_vtk(path)?);
     }
     if lower.ends_with(".node") || lower.ends_with(".ele") {

@@ -33,6 +33,10 @@
 //!   `name_t0001`, … the suffix is dropped (so our files round-trip).
 //!   Values are rounded to `f32` and must be finite. Arrays with several
 //!   components (vectors, …) are read past.
+//! * **time series as files**: a ParaView collection (`.pvd`) lists one
+//!   file per time step; [`read_pvd`] joins them (same mesh in every file)
+//!   into one field with all their steps, [`write_pvd`] writes one `.vtu`
+//!   per step. [`read_vtk`] reads a `.pvd` too.
 //!
 //! Malformed files give [`VtkError`]s naming the file and the line (legacy;
 //! for XML the line of the element) or the cell at fault: unknown keywords
@@ -57,10 +61,12 @@ use thiserror::Error;
 mod base64;
 mod legacy;
 mod model;
+mod series;
 mod xml;
 
 pub use legacy::{from_legacy_bytes, to_legacy_bytes};
 pub use model::{KIND_ARRAY, TRIANGLE_ARRAY, TRIANGLE_COUNT_FIELD};
+pub use series::{read_pvd, write_pvd};
 pub use xml::{from_vtu_bytes, to_vtu_bytes};
 
 /// VTK cell type of a tetrahedron.
@@ -152,8 +158,15 @@ pub fn from_vtk_bytes(bytes: &[u8], path: &Path) -> Result<TetMesh, VtkError> {
     }
 }
 
-/// Reads a VTK file of either format (see the module docs).
+/// Reads a VTK file of either format, or a `.pvd` collection (by its
+/// extension; see the module docs).
 pub fn read_vtk(path: &Path) -> Result<TetMesh, VtkError> {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("pvd"))
+    {
+        return read_pvd(path);
+    }
     from_vtk_bytes(&read_bytes(path)?, path)
 }
 
