@@ -28,7 +28,11 @@
 //!   [`resolve`]: self-intersecting triangles split along their
 //!   intersections so that they meet only in shared vertices and edges.
 //! * [`tetgen`]: TetGen in process or in a worker process;
-//!   [`tetgen_files`], [`vtk`]: TetGen's and ParaView's file formats.
+//!   [`tetgen_files`], [`vtk`]: TetGen's and ParaView's (VTK) file formats,
+//!   VTK with per-point scalar fields.
+//! * [`volume`]: tetrahedral volumes with scalar fields for isosurface
+//!   tracing (Wald et al., seed 004): split grids, analytic fields, named
+//!   stand-ins for the paper's data sets.
 //! * [`pipeline`]: the in-core build, stage by stage.
 //! * [`outofcore`]: the build under a memory limit, part by part (Erkoç et
 //!   al., seed 003).
@@ -48,6 +52,7 @@ pub mod resolve;
 pub mod scene;
 pub mod source;
 pub mod tetgen_files;
+pub mod volume;
 pub mod vtk;
 
 #[cfg(feature = "tetgen")]

@@ -13,6 +13,11 @@
 //! | `.face`  | `#faces markers(0/1)`                     | `i v0 v1 v2 [marker]`            |
 //! | `.neigh` | `#tets 4`                                 | `i n0 n1 n2 n3` (`-1` = none)    |
 //!
+//! Point attributes carry a scalar field: [`to_tet_mesh`] makes each
+//! attribute column one time step of a field named [`ATTRIBUTE_FIELD`]
+//! (TetGen files name no field), and [`from_tet_mesh`] writes each step of
+//! a mesh's field as a column.
+//!
 //! Face markers name constrained faces: [`to_tet_mesh`] turns every face
 //! with marker `m > 0` into a constrained face of scene triangle `m - 1`
 //! (the convention of our shim), and [`from_tet_mesh`] writes them so.
@@ -32,6 +37,9 @@ use thiserror::Error;
 pub struct TetgenFiles {
     /// `.node` coordinates.
     pub points: Vec<[f64; 3]>,
+    /// `.node` point attributes: one column per attribute, each with one
+    /// value per point (empty when the file has none).
+    pub point_attributes: Vec<Vec<f64>>,
     /// `.ele` tets (any orientation).
     pub tets: Vec<[u32; 4]>,
     /// `.face` faces.
@@ -76,6 +84,13 @@ pub enum FilesError {
         tet: u32,
     },
 }
+
+/// Name of the scalar field made of `.node` point attributes.
+pub const ATTRIBUTE_FIELD: &str = "tetgen_attributes";
+
+/// Most point attributes a `.node` file may declare (a bound checked before
+/// any column is allocated).
+pub const MAX_ATTRIBUTES: usize = 1 << 16;
 
 /// Data lines of a file: (1-based line number, whitespace-separated fields).
 fn data_lines(text: &str) -> impl Iterator<Item = (usize, Vec<&str>)> {
@@ -193,8 +208,19 @@ pub fn read(base: &Path) -> Result<TetgenFiles, FilesError> {
     if dim != 3 {
         return Err(p.err(hl, format!("dimension {dim}, expected 3")));
     }
-    let (node_base, recs) = records(&p, &mut lines, n, 3)?;
+    let attributes: usize = match h.get(2) {
+        Some(_) => p.num(hl, &h, 2, "attribute count")?,
+        None => 0,
+    };
+    if attributes > MAX_ATTRIBUTES {
+        return Err(p.err(
+            hl,
+            format!("{attributes} attributes, at most {MAX_ATTRIBUTES}"),
+        ));
+    }
+    let (node_base, recs) = records(&p, &mut lines, n, 3 + attributes)?;
     let mut points = Vec::with_capacity(n);
+    let mut point_attributes = vec![Vec::with_capacity(recs.len()); attributes];
     for (line, f) in &recs {
         let c = [
             p.num::<f64>(*line, f, 0, "x")?,
@@ -205,6 +231,13 @@ pub fn read(base: &Path) -> Result<TetgenFiles, FilesError> {
             return Err(p.err(*line, "non-finite coordinate"));
         }
         points.push(c);
+        for (k, column) in point_attributes.iter_mut().enumerate() {
+            let v: f64 = p.num(*line, f, 3 + k, "attribute")?;
+            if !v.is_finite() {
+                return Err(p.err(*line, format!("attribute {k} is not finite")));
+            }
+            column.push(v);
+        }
     }
 
     let ele_path = with_ext(base, "ele");
@@ -229,6 +262,7 @@ pub fn read(base: &Path) -> Result<TetgenFiles, FilesError> {
 
     let mut files = TetgenFiles {
         points,
+        point_attributes,
         tets,
         ..TetgenFiles::default()
     };
@@ -287,14 +321,38 @@ pub fn read(base: &Path) -> Result<TetgenFiles, FilesError> {
     Ok(files)
 }
 
-/// Writes `<base>.node`, `<base>.ele`, `<base>.face` (when there are faces)
-/// and `<base>.neigh` (when neighbours are present), 0-based, atomically.
+/// Writes `<base>.node` (with the point attributes), `<base>.ele`,
+/// `<base>.face` (when there are faces) and `<base>.neigh` (when neighbours
+/// are present), 0-based, atomically. An attribute column without one value
+/// per point is refused ([`FilesError::Mesh`]).
 pub fn write(base: &Path, files: &TetgenFiles) -> Result<(), FilesError> {
+    let n = files.points.len();
+    if let Some((step, c)) = files
+        .point_attributes
+        .iter()
+        .enumerate()
+        .find(|(_, c)| c.len() != n)
+    {
+        return Err(FilesError::Mesh(MeshError::ScalarLength {
+            step,
+            actual: c.len(),
+            expected: n,
+        }));
+    }
     let mut s = String::new();
-    let _ = writeln!(s, "# written by tet-build\n{} 3 0 0", files.points.len());
+    let _ = writeln!(
+        s,
+        "# written by tet-build\n{} 3 {} 0",
+        files.points.len(),
+        files.point_attributes.len()
+    );
     for (i, p) in files.points.iter().enumerate() {
         // `{:?}` prints the shortest string that parses back to the same f64.
-        let _ = writeln!(s, "{i} {:?} {:?} {:?}", p[0], p[1], p[2]);
+        let _ = write!(s, "{i} {:?} {:?} {:?}", p[0], p[1], p[2]);
+        for column in &files.point_attributes {
+            let _ = write!(s, " {:?}", column.get(i).copied().unwrap_or(0.0));
+        }
+        s.push('\n');
     }
     atomic_write(&with_ext(base, "node"), s.as_bytes())?;
     let mut s = String::new();
@@ -335,7 +393,9 @@ pub fn write(base: &Path, files: &TetgenFiles) -> Result<(), FilesError> {
 /// oriented positively (by the exact f64 orientation of the file's
 /// coordinates), faces with marker `m > 0` become constrained faces of
 /// triangle `m - 1` (winding as in the file). `triangle_count` defaults to
-/// the largest marker.
+/// the largest marker. Point attributes become the steps of the scalar field
+/// [`ATTRIBUTE_FIELD`], rounded to f32 (a value beyond f32's range is a
+/// [`FilesError::Mesh`]).
 pub fn to_tet_mesh(
     files: &TetgenFiles,
     source: &Path,
@@ -374,14 +434,25 @@ pub fn to_tet_mesh(
             }
         }
     }
-    let mesh = TetMesh::assemble(points, tets, &tris, triangle_count.unwrap_or(max_marker))?;
+    let mut mesh = TetMesh::assemble(points, tets, &tris, triangle_count.unwrap_or(max_marker))?;
+    if !files.point_attributes.is_empty() {
+        mesh.attributes.scalars = Some(tet_core::ScalarField {
+            name: ATTRIBUTE_FIELD.to_string(),
+            steps: files
+                .point_attributes
+                .iter()
+                .map(|c| c.iter().map(|&v| v as f32).collect())
+                .collect(),
+        });
+    }
     mesh.validate()?;
     Ok(mesh)
 }
 
 /// The TetGen files of a mesh: constrained faces as faces with marker
 /// `triangle + 1` (source winding), neighbours across every face (also
-/// across constrained faces), `-1` on the boundary.
+/// across constrained faces), `-1` on the boundary; the scalar field's
+/// steps as point attributes (its name is not stored).
 pub fn from_tet_mesh(mesh: &TetMesh) -> TetgenFiles {
     let neighbors = (0..mesh.tets.len())
         .map(|t| {
@@ -404,6 +475,12 @@ pub fn from_tet_mesh(mesh: &TetMesh) -> TetgenFiles {
             .iter()
             .map(|p| p.as_dvec3().to_array())
             .collect(),
+        point_attributes: mesh.attributes.scalars.as_ref().map_or(Vec::new(), |f| {
+            f.steps
+                .iter()
+                .map(|s| s.iter().map(|&v| f64::from(v)).collect())
+                .collect()
+        }),
         tets: mesh.tets.clone(),
         faces: mesh.constrained.iter().map(|c| c.vertices).collect(),
         face_markers: Some(

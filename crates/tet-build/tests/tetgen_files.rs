@@ -221,3 +221,65 @@ fn vtu_lists_tets_then_constrained_faces() {
     // No temporary file is left behind.
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
+
+/// `.node` point attributes are the scalar field: read from a hand-written
+/// file, kept through `to_tet_mesh`, `from_tet_mesh`, `write` and `read`.
+#[test]
+fn node_attributes_are_the_scalar_field() {
+    use tet_build::tetgen_files::{ATTRIBUTE_FIELD, from_tet_mesh, read, to_tet_mesh, write};
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("a");
+    std::fs::write(
+        dir.path().join("a.node"),
+        "4 3 2 1\n0 0 0 0 1.5 -0.0 7\n1 1 0 0 2.5 1e-30 7\n2 0 1 0 3.5 -2 0\n3 0 0 1 4.5 8 0\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("a.ele"), "1 4 0\n0 0 1 2 3\n").unwrap();
+    let files = read(&base).unwrap();
+    assert_eq!(
+        files.point_attributes,
+        [vec![1.5, 2.5, 3.5, 4.5], vec![-0.0, 1e-30, -2.0, 8.0]]
+    );
+    let mesh = to_tet_mesh(&files, &base, None).unwrap();
+    let field = mesh.attributes.scalars.as_ref().unwrap();
+    assert_eq!(field.name, ATTRIBUTE_FIELD);
+    assert_eq!(
+        field.steps,
+        [vec![1.5f32, 2.5, 3.5, 4.5], vec![-0.0, 1e-30, -2.0, 8.0]]
+    );
+    assert!(field.steps[1][0].is_sign_negative());
+    let out = dir.path().join("b");
+    write(&out, &from_tet_mesh(&mesh)).unwrap();
+    let again = to_tet_mesh(&read(&out).unwrap(), &out, None).unwrap();
+    assert_eq!(again, mesh);
+    // A missing attribute value, a non-finite one, an f32 overflow, a
+    // column of the wrong length are typed errors.
+    std::fs::write(dir.path().join("a.node"), "1 3 2 0\n0 0 0 0 1\n").unwrap();
+    assert!(matches!(
+        read(&base),
+        Err(FilesError::Parse { line: 2, .. })
+    ));
+    std::fs::write(dir.path().join("a.node"), "1 3 1 0\n0 0 0 0 nan\n").unwrap();
+    assert!(matches!(
+        read(&base),
+        Err(FilesError::Parse { line: 2, .. })
+    ));
+    let mut big = files.clone();
+    big.point_attributes[0][2] = 1e39;
+    assert!(matches!(
+        to_tet_mesh(&big, &base, None),
+        Err(FilesError::Mesh(tet_core::MeshError::ScalarNotFinite {
+            step: 0,
+            point: 2,
+            ..
+        }))
+    ));
+    big.point_attributes[1].pop();
+    assert!(matches!(
+        write(&out, &big),
+        Err(FilesError::Mesh(tet_core::MeshError::ScalarLength {
+            step: 1,
+            ..
+        }))
+    ));
+}

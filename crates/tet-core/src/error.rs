@@ -153,4 +153,38 @@ pub enum MeshError {
         /// Length expected.
         expected: usize,
     },
+    /// A scalar field's name cannot be stored.
+    #[error("scalar field name {name:?}: {detail}")]
+    ScalarName {
+        /// The name (first 80 characters).
+        name: String,
+        /// What is wrong.
+        detail: String,
+    },
+    /// A scalar field has no time step.
+    #[error("scalar field {name:?} has no time step")]
+    ScalarNoSteps {
+        /// The field's name.
+        name: String,
+    },
+    /// A time step of the scalar field does not have one value per point.
+    #[error("scalar field step {step} has {actual} values, expected {expected} (one per point)")]
+    ScalarLength {
+        /// Time step.
+        step: usize,
+        /// Values found.
+        actual: usize,
+        /// Number of points.
+        expected: usize,
+    },
+    /// A scalar value is NaN or infinite.
+    #[error("scalar field step {step} point {point}: value {value} is not finite")]
+    ScalarNotFinite {
+        /// Time step.
+        step: usize,
+        /// Point index.
+        point: u32,
+        /// The value.
+        value: f32,
+    },
 }

@@ -11,6 +11,9 @@
 //!   cold constrained-face table.
 //! * [`synthetic`] generates valid meshes without an external mesher (for tests,
 //!   fuzzing and benchmarks).
+//! * [`fields`]: an optional per-point scalar field with one or more time
+//!   steps ([`Attributes::scalars`]), the data isosurfaces are traced in
+//!   (Wald et al., seed 004); stored in the mesh file's scalar block.
 //!
 //! Conventions (used by every layout and kernel):
 //! * tet `t` has vertices `tets[t] = [v0, v1, v2, v3]`, positively oriented:
@@ -48,6 +51,7 @@
 #![deny(missing_docs)]
 
 pub mod error;
+pub mod fields;
 pub mod format;
 pub mod hilbert;
 pub mod layout;
@@ -62,5 +66,6 @@ pub mod synthetic;
 mod validate;
 
 pub use error::MeshError;
+pub use fields::ScalarField;
 pub use link::{Link, LinkKind, MAX_TETS};
 pub use mesh::{Attributes, ConstrainedFace, FACE_VERTICES, FaceSide, NO_TET, TetMesh, face_key};

@@ -5,6 +5,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
 use crate::error::MeshError;
+use crate::fields::ScalarField;
 use crate::link::{Link, MAX_TETS};
 
 /// Face `k` of a tet is opposite vertex slot `k`; `FACE_VERTICES[k]` lists the
@@ -109,6 +110,10 @@ pub struct Attributes {
     pub uvs: Option<Vec<Vec2>>,
     /// Per-scene-triangle material ids (length = triangle count) when the scene has them.
     pub materials: Option<Vec<u32>>,
+    /// A per-point scalar field with one or more time steps (the volume an
+    /// isosurface is traced in), when the mesh has one. See
+    /// [`crate::fields`].
+    pub scalars: Option<ScalarField>,
 }
 
 impl Attributes {
@@ -117,6 +122,7 @@ impl Attributes {
         self.normals.as_ref().map_or(0, |v| v.len() * 12)
             + self.uvs.as_ref().map_or(0, |v| v.len() * 8)
             + self.materials.as_ref().map_or(0, |v| v.len() * 4)
+            + self.scalars.as_ref().map_or(0, ScalarField::bytes)
     }
 }
 

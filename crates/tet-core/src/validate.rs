@@ -303,7 +303,8 @@ impl TetMesh {
     }
 
     /// Checks the attribute arrays' lengths (normals and uvs per point,
-    /// materials per scene triangle).
+    /// materials per scene triangle) and the scalar field
+    /// ([`crate::fields::ScalarField::check`]).
     pub fn check_attributes(&self) -> Result<(), MeshError> {
         check_attributes(self)
     }
@@ -489,6 +490,9 @@ fn check_attributes(m: &TetMesh) -> Result<(), MeshError> {
                 expected,
             });
         }
+    }
+    if let Some(field) = &a.scalars {
+        field.check(n)?;
     }
     Ok(())
 }

@@ -417,9 +417,9 @@ fn malformed_section_table_and_flags() {
         Err(FormatError::BadField { field: "flags", .. })
     ));
     assert!(matches!(
-        patched(&|b| put_u32(b, "reserved", 1)),
+        patched(&|b| put_u32(b, "scalar_steps", 1)),
         Err(FormatError::BadField {
-            field: "reserved",
+            field: "scalar_steps",
             ..
         })
     ));

@@ -108,7 +108,18 @@ fn sample_meshes() -> Vec<(&'static str, TetMesh)> {
         normals: Some((0..n).map(|i| Vec3::new(i as f32, 0.0, 1.0)).collect()),
         uvs: Some((0..n).map(|i| Vec2::new(0.5, i as f32)).collect()),
         materials: Some((0..with_attributes.triangle_count).collect()),
+        scalars: None,
     };
+    // A two-step scalar field (its own block after the sections).
+    let mut with_scalars = grid([1, 2, 1], 0.2, None, 8);
+    let n = with_scalars.points.len();
+    with_scalars.attributes.scalars = Some(tet_core::ScalarField {
+        name: "density".into(),
+        steps: vec![
+            (0..n).map(|i| i as f32 - 3.5).collect(),
+            (0..n).map(|i| if i % 2 == 0 { -0.0 } else { 1e-30 }).collect(),
+        ],
+    });
     vec![
         ("empty", TetMesh::default()),
         ("cube", grid([1, 1, 1], 0.0, None, 1)),
@@ -118,6 +129,7 @@ fn sample_meshes() -> Vec<(&'static str, TetMesh)> {
             grid([2, 2, 1], 0.0, Some(([0, 0, 0], [1, 1, 1])), 3),
         ),
         ("attributes", with_attributes),
+        ("scalars", with_scalars),
     ]
 }
 

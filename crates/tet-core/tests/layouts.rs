@@ -476,6 +476,7 @@ fn attributes_survive_round_trips() {
         normals: Some((0..n).map(|i| Vec3::new(i as f32, 1.0, 0.0)).collect()),
         uvs: None,
         materials: Some(vec![7; m.triangle_count as usize]),
+        scalars: None,
     };
     check_all_layouts(&m);
 }

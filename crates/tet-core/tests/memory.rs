@@ -134,6 +134,7 @@ proptest! {
             normals: normals.then(|| vec![Vec3::Z; n]),
             uvs: uvs.then(|| vec![Vec2::ONE; n]),
             materials: materials.then(|| vec![0; m.triangle_count as usize]),
+            scalars: None,
         };
         check(&m);
     }

@@ -5,9 +5,9 @@ use std::path::Path;
 
 use super::error::FormatError;
 use super::spec::{
-    ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCENE, FLAG_UVS, HEADER_CRC_AT,
+    ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCALARS, FLAG_SCENE, FLAG_UVS, HEADER_CRC_AT,
     HEADER_FIELDS, HEADER_LEN, KNOWN_FLAGS, MAGIC, MAX_SCENE_RECORDS, PAYLOAD_CRC_AT,
-    SCENE_RECORD_BYTES, SECTION_NAMES, VERSION,
+    SCALAR_NAME_SLOT, SCENE_RECORD_BYTES, SECTION_NAMES, VERSION,
 };
 use super::words::padding;
 use crate::link::MAX_TETS;
@@ -21,6 +21,11 @@ pub(super) struct Header {
     /// (offset, length) per section; length 0 when absent.
     pub(super) sections: [(u64, u64); 7],
     pub(super) counts: [u64; 7],
+    /// Time steps of the scalar block (0 when absent).
+    pub(super) scalar_steps: u32,
+    /// (offset, length) of the scalar block (name slot included); length 0
+    /// when absent.
+    pub(super) scalars: (u64, u64),
     /// (offset, length) of the scene block; length 0 when absent.
     pub(super) scene: (u64, u64),
     pub(super) payload_crc: u32,
@@ -87,9 +92,18 @@ pub(super) fn parse_header(head: &[u8], actual: u64, path: &Path) -> Result<Head
             format!("unknown bits {:#x}", flags & !KNOWN_FLAGS),
         ));
     }
-    let reserved = u32_at(head, 28);
-    if reserved != 0 {
-        return Err(bad("reserved", format!("{reserved:#x}, expected 0")));
+    let scalar_steps = u32_at(head, 28);
+    if flags & FLAG_SCALARS == 0 && scalar_steps != 0 {
+        return Err(bad(
+            "scalar_steps",
+            format!("{scalar_steps:#x} without the scalar flag {FLAG_SCALARS:#x}, expected 0"),
+        ));
+    }
+    if flags & FLAG_SCALARS != 0 && scalar_steps == 0 {
+        return Err(bad(
+            "scalar_steps",
+            format!("0 with the scalar flag {FLAG_SCALARS:#x}: a field has at least one step"),
+        ));
     }
     let file_length = u64_at(head, 16);
     if actual < file_length {
@@ -202,6 +216,25 @@ pub(super) fn parse_header(head: &[u8], actual: u64, path: &Path) -> Result<Head
         sections[i] = (offset, length);
         end = section_end;
     }
+    let mut scalars = (0, 0);
+    if present(FLAG_SCALARS) {
+        let offset = end + padding(end);
+        // steps < 2^32 and points < 2^32: the product fits in u128 and is
+        // checked against the file before anything is allocated.
+        let values = u128::from(scalar_steps) * u128::from(point_count) * 4;
+        let length = u128::from(SCALAR_NAME_SLOT) + values;
+        let block_end = u128::from(offset) + length;
+        if block_end > u128::from(file_length) {
+            return Err(FormatError::Truncated {
+                path: p(),
+                field: "scalars",
+                needed: u64::try_from(block_end).unwrap_or(u64::MAX),
+                actual,
+            });
+        }
+        scalars = (offset, length as u64);
+        end = block_end as u64;
+    }
     let mut scene = (0, 0);
     if present(FLAG_SCENE) {
         let offset = end + padding(end);
@@ -235,6 +268,8 @@ pub(super) fn parse_header(head: &[u8], actual: u64, path: &Path) -> Result<Head
         triangle_count,
         sections,
         counts,
+        scalar_steps,
+        scalars,
         scene,
         payload_crc: u32_at(head, PAYLOAD_CRC_AT),
     })
@@ -245,6 +280,8 @@ pub(super) struct HeaderFields {
     pub(super) flags: u32,
     pub(super) file_length: u64,
     pub(super) triangle_count: u32,
+    /// Time steps of the scalar block (0 without one).
+    pub(super) scalar_steps: u32,
     /// Points, tets, constrained faces.
     pub(super) counts: [u64; 3],
     /// (offset, length) per section, in table order.
@@ -260,6 +297,7 @@ pub(super) fn header_bytes(h: &HeaderFields) -> [u8; HEADER_LEN] {
     head[12..16].copy_from_slice(&h.flags.to_le_bytes());
     head[16..24].copy_from_slice(&h.file_length.to_le_bytes());
     head[24..28].copy_from_slice(&h.triangle_count.to_le_bytes());
+    head[28..32].copy_from_slice(&h.scalar_steps.to_le_bytes());
     for (i, count) in h.counts.iter().enumerate() {
         head[32 + 8 * i..40 + 8 * i].copy_from_slice(&count.to_le_bytes());
     }

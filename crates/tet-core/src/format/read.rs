@@ -11,10 +11,14 @@ use glam::{Vec2, Vec3};
 
 use super::error::{FormatError, IN_MEMORY};
 use super::header::{Header, parse_header};
+use super::scalar_block::decode_name;
 use super::scene_block::decode_scene;
 use super::section_reader::SectionReader;
-use super::spec::{FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCENE, FLAG_UVS, HEADER_LEN};
+use super::spec::{
+    FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCALARS, FLAG_SCENE, FLAG_UVS, HEADER_LEN, SCALAR_NAME_SLOT,
+};
 use super::words::from_le_words;
+use crate::fields::ScalarField;
 use crate::link::Link;
 use crate::mesh::{Attributes, ConstrainedFace, TetMesh};
 use crate::scene::SceneInfo;
@@ -69,6 +73,16 @@ impl<S: Source> PayloadReader<'_, S> {
         Ok(())
     }
 
+    /// Reads `N` plain bytes (not words) at absolute offset `offset`.
+    fn raw<const N: usize>(&mut self, offset: u64) -> Result<[u8; N], FormatError> {
+        self.skip_to(offset)?;
+        let mut buf = [0u8; N];
+        self.src.read_exact_into(&mut buf).map_err(|e| self.io(e))?;
+        self.crc.update(&buf);
+        self.pos += N as u64;
+        Ok(buf)
+    }
+
     /// Reads `count` elements at absolute offset `offset` straight into a
     /// `Vec<T>`. `count × size_of::<T>()` was checked against the file length.
     fn section<T: Pod>(&mut self, (offset, length): (u64, u64)) -> Result<Vec<T>, FormatError> {
@@ -116,6 +130,20 @@ fn decode<S: Source>(
     } else {
         None
     };
+    let scalars = if present(FLAG_SCALARS) {
+        let (offset, _) = header.scalars;
+        let slot: [u8; SCALAR_NAME_SLOT as usize] = r.raw(offset)?;
+        let name = decode_name(&slot, path)?;
+        let step_bytes = header.counts[0] * 4;
+        let mut steps = Vec::with_capacity(header.scalar_steps as usize);
+        for step in 0..u64::from(header.scalar_steps) {
+            let at = offset + SCALAR_NAME_SLOT + step * step_bytes;
+            steps.push(r.section::<f32>((at, step_bytes))?);
+        }
+        Some(ScalarField { name, steps })
+    } else {
+        None
+    };
     let scene_records: Vec<[u32; 12]> = if present(FLAG_SCENE) {
         r.section(header.scene)?
     } else {
@@ -142,6 +170,7 @@ fn decode<S: Source>(
             normals,
             uvs,
             materials,
+            scalars,
         },
     };
     let scene = decode_scene(&scene_records, path)?;

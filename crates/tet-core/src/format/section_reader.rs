@@ -13,10 +13,11 @@ use glam::{Vec2, Vec3};
 
 use super::error::FormatError;
 use super::header::{Header, parse_header};
+use super::scalar_block::decode_name;
 use super::scene_block::decode_scene;
 use super::spec::{
-    ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCENE, FLAG_UVS, HEADER_LEN,
-    SCENE_RECORD_BYTES, SECTION_NAMES,
+    ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCALARS, FLAG_SCENE, FLAG_UVS, HEADER_LEN,
+    SCALAR_NAME_SLOT, SCENE_RECORD_BYTES, SECTION_NAMES,
 };
 use super::stream_writer::OptionalSections;
 use super::words::from_le_words;
@@ -97,6 +98,7 @@ impl SectionReader {
             normals: on(FLAG_NORMALS),
             uvs: on(FLAG_UVS),
             materials: on(FLAG_MATERIALS),
+            scalars: on(FLAG_SCALARS),
         }
     }
 
@@ -186,6 +188,55 @@ impl SectionReader {
     /// Materials `range` (count 0 when absent).
     pub fn read_materials(&mut self, range: Range<u64>) -> Result<Vec<u32>, FormatError> {
         self.read(6, range)
+    }
+
+    /// Time steps of the scalar field (0 when the file has none).
+    pub fn scalar_steps(&self) -> u32 {
+        self.header.scalar_steps
+    }
+
+    /// The scalar field's name (`None` when the file has no field); a slot
+    /// that is not NUL-padded UTF-8 is a [`FormatError::BadField`].
+    pub fn read_scalar_name(&mut self) -> Result<Option<String>, FormatError> {
+        if self.header.flags & FLAG_SCALARS == 0 {
+            return Ok(None);
+        }
+        let mut slot = [0u8; SCALAR_NAME_SLOT as usize];
+        let r = self
+            .file
+            .seek(SeekFrom::Start(self.header.scalars.0))
+            .and_then(|_| self.file.read_exact(&mut slot));
+        if let Err(e) = r {
+            return Err(self.io(e));
+        }
+        decode_name(&slot, &self.path).map(Some)
+    }
+
+    /// Values `range` (point indices) of time step `step` of the scalar
+    /// field, as stored (finiteness is checked by [`super::load`] only). A
+    /// step or range the file does not have is a
+    /// [`FormatError::SectionRange`] (count 0 without a field).
+    pub fn read_scalars(&mut self, step: u32, range: Range<u64>) -> Result<Vec<f32>, FormatError> {
+        let points = self.point_count();
+        let steps = u64::from(self.header.scalar_steps);
+        let out_of = |start, end, count| FormatError::SectionRange {
+            path: self.path.clone(),
+            section: "scalars",
+            start,
+            end,
+            count,
+        };
+        if u64::from(step) >= steps {
+            return Err(out_of(u64::from(step), u64::from(step) + 1, steps));
+        }
+        if range.start > range.end || range.end > points {
+            return Err(out_of(range.start, range.end, points));
+        }
+        let mut v = vec![0f32; (range.end - range.start) as usize];
+        let at =
+            self.header.scalars.0 + SCALAR_NAME_SLOT + (u64::from(step) * points + range.start) * 4;
+        self.read_at(at, &mut v)?;
+        Ok(v)
     }
 
     /// The scene block, checked as [`super::load_with_scene`] does (empty

@@ -15,7 +15,13 @@ pub const FLAG_UVS: u32 = 2;
 pub const FLAG_MATERIALS: u32 = 4;
 /// Flag bit: a scene block (camera and lights) ends the file.
 pub const FLAG_SCENE: u32 = 8;
-pub(super) const KNOWN_FLAGS: u32 = FLAG_NORMALS | FLAG_UVS | FLAG_MATERIALS | FLAG_SCENE;
+/// Flag bit: a scalar-field block (name and time steps) follows the
+/// sections; the header word `scalar_steps` holds its step count.
+pub const FLAG_SCALARS: u32 = 16;
+pub(super) const KNOWN_FLAGS: u32 =
+    FLAG_NORMALS | FLAG_UVS | FLAG_MATERIALS | FLAG_SCENE | FLAG_SCALARS;
+/// Bytes of the scalar block's name slot (UTF-8, NUL-padded).
+pub const SCALAR_NAME_SLOT: u64 = crate::fields::SCALAR_NAME_BYTES as u64;
 /// Bytes per scene-block record.
 pub const SCENE_RECORD_BYTES: u64 = 48;
 /// Most records a scene block may hold (one camera and the lights).
@@ -27,7 +33,7 @@ pub const HEADER_FIELDS: [(&str, usize, usize); 23] = [
     ("flags", 12, 4),
     ("file_length", 16, 8),
     ("triangle_count", 24, 4),
-    ("reserved", 28, 4),
+    ("scalar_steps", 28, 4),
     ("point_count", 32, 8),
     ("tet_count", 40, 8),
     ("constrained_count", 48, 8),

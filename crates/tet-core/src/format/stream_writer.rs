@@ -12,18 +12,20 @@ use glam::{Vec2, Vec3};
 
 use super::error::FormatError;
 use super::header::{HeaderFields, header_bytes};
+use super::scalar_block::name_slot;
 use super::scene_block::scene_records;
 use super::spec::{
-    ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCENE, FLAG_UVS, HEADER_FIELDS, HEADER_LEN,
-    SECTION_NAMES,
+    ELEMENT_BYTES, FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCALARS, FLAG_SCENE, FLAG_UVS, HEADER_FIELDS,
+    HEADER_LEN, SECTION_NAMES,
 };
 use super::words::{hash_le_words, padding, write_le_words};
 use crate::link::{Link, MAX_TETS};
 use crate::mesh::{Attributes, ConstrainedFace};
 use crate::scene::SceneInfo;
 
-/// Which optional sections a file has (flag bits 0–2). A present section
-/// may be empty; an absent one takes no bytes and no table entry.
+/// Which optional sections a file has (flag bits 0–2, and bit 4 for the
+/// scalar block). A present section may be empty; an absent one takes no
+/// bytes and no table entry. A present scalar block needs at least one step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct OptionalSections {
     /// Per-point normals (flag bit 0).
@@ -32,6 +34,9 @@ pub struct OptionalSections {
     pub uvs: bool,
     /// Per-triangle materials (flag bit 2).
     pub materials: bool,
+    /// A per-point scalar field (flag bit 4; see
+    /// [`StreamWriter::append_scalar_step`]).
+    pub scalars: bool,
 }
 
 impl OptionalSections {
@@ -41,6 +46,7 @@ impl OptionalSections {
             normals: attributes.normals.is_some(),
             uvs: attributes.uvs.is_some(),
             materials: attributes.materials.is_some(),
+            scalars: attributes.scalars.is_some(),
         }
     }
 
@@ -50,6 +56,7 @@ impl OptionalSections {
             (self.normals, FLAG_NORMALS),
             (self.uvs, FLAG_UVS),
             (self.materials, FLAG_MATERIALS),
+            (self.scalars, FLAG_SCALARS),
         ]
         .iter()
         .filter(|(on, _)| *on)
@@ -62,7 +69,8 @@ impl OptionalSections {
             0..=3 => true,
             4 => self.normals,
             5 => self.uvs,
-            _ => self.materials,
+            6 => self.materials,
+            _ => self.scalars,
         }
     }
 }
@@ -90,7 +98,12 @@ pub struct StreamWriter {
     crc: Hasher,
     /// Bytes written so far, the header's placeholder included.
     end: u64,
-    table: [(u64, u64); 7],
+    /// (offset, length) per section in table order, then the scalar block
+    /// (index 7, name slot included).
+    table: [(u64, u64); 8],
+    /// Name and steps of the scalar block written so far.
+    scalar_name: Option<String>,
+    scalar_steps: u32,
     /// The section being written, if one was started.
     open: Option<usize>,
     optional: OptionalSections,
@@ -122,7 +135,9 @@ impl StreamWriter {
             out: Some(BufWriter::with_capacity(1 << 16, file)),
             crc: Hasher::new(),
             end: 0,
-            table: [(0, 0); 7],
+            table: [(0, 0); 8],
+            scalar_name: None,
+            scalar_steps: 0,
             open: None,
             optional,
             triangle_count,
@@ -187,6 +202,50 @@ impl StreamWriter {
         self.append(6, bytemuck::cast_slice(materials))
     }
 
+    /// Appends one time step of the scalar field named `name` (needs
+    /// [`OptionalSections::scalars`]): one value per point written, after
+    /// every other section. Every step must carry the same name.
+    pub fn append_scalar_step(&mut self, name: &str, values: &[f32]) -> Result<(), FormatError> {
+        let refuse = |detail: String| FormatError::SectionOrder {
+            path: self.path.clone(),
+            section: "scalars",
+            detail,
+        };
+        let Some(slot) = name_slot(name) else {
+            return Err(refuse(format!(
+                "field name {name:?} does not fit the {}-byte slot (or holds a control character)",
+                slot_len()
+            )));
+        };
+        let points = self.points_written();
+        if values.len() as u64 != points {
+            return Err(refuse(format!(
+                "step {} has {} values, the file has {points} points",
+                self.scalar_steps,
+                values.len()
+            )));
+        }
+        if self.scalar_steps == u32::MAX {
+            return Err(refuse("too many steps".into()));
+        }
+        match &self.scalar_name {
+            Some(first) if first != name => {
+                return Err(refuse(format!(
+                    "step {} is named {name:?}, the field {first:?}",
+                    self.scalar_steps
+                )));
+            }
+            Some(_) => {}
+            None => {
+                self.append_with(7, &slot, false)?;
+                self.scalar_name = Some(name.to_string());
+            }
+        }
+        self.append(7, bytemuck::cast_slice(values))?;
+        self.scalar_steps += 1;
+        Ok(())
+    }
+
     fn io(&self, source: io::Error) -> FormatError {
         FormatError::Io {
             path: self.path.clone(),
@@ -207,11 +266,26 @@ impl StreamWriter {
 
     /// Writes and hashes payload bytes made of 4-byte words.
     fn write_payload(&mut self, bytes: &[u8]) -> Result<(), FormatError> {
+        self.write_payload_with(bytes, true)
+    }
+
+    /// Writes and hashes payload bytes: 4-byte words (`words`) or plain
+    /// bytes (the scalar name slot).
+    fn write_payload_with(&mut self, bytes: &[u8], words: bool) -> Result<(), FormatError> {
         let out = self.out.as_mut().expect("an unfinished writer has a file");
-        if let Err(e) = write_le_words(out, bytes) {
+        let written = if words {
+            write_le_words(out, bytes)
+        } else {
+            out.write_all(bytes)
+        };
+        if let Err(e) = written {
             return Err(self.io(e));
         }
-        hash_le_words(&mut self.crc, bytes);
+        if words {
+            hash_le_words(&mut self.crc, bytes);
+        } else {
+            self.crc.update(bytes);
+        }
         self.end += bytes.len() as u64;
         Ok(())
     }
@@ -236,9 +310,13 @@ impl StreamWriter {
     }
 
     fn append(&mut self, i: usize, bytes: &[u8]) -> Result<(), FormatError> {
+        self.append_with(i, bytes, true)
+    }
+
+    fn append_with(&mut self, i: usize, bytes: &[u8], words: bool) -> Result<(), FormatError> {
         let refuse = |detail: String| FormatError::SectionOrder {
             path: self.path.clone(),
-            section: SECTION_NAMES[i],
+            section: section_name(i),
             detail,
         };
         if !self.optional.present(i) {
@@ -251,7 +329,7 @@ impl StreamWriter {
             Some(j) if j > i => {
                 return Err(refuse(format!(
                     "section {} was already started (sections go in table order)",
-                    SECTION_NAMES[j]
+                    section_name(j)
                 )));
             }
             _ => {
@@ -260,7 +338,7 @@ impl StreamWriter {
                 self.open = Some(i);
             }
         }
-        self.write_payload(bytes)?;
+        self.write_payload_with(bytes, words)?;
         self.table[i].1 += bytes.len() as u64;
         Ok(())
     }
@@ -275,7 +353,14 @@ impl StreamWriter {
     /// written, the file synced and renamed over the target. Returns the
     /// file's length. On error the temporary file is removed.
     pub fn finish_with_scene(mut self, scene: &SceneInfo) -> Result<u64, FormatError> {
-        self.advance_to(7)?;
+        self.advance_to(8)?;
+        if self.optional.scalars && self.scalar_steps == 0 {
+            return Err(FormatError::BadField {
+                path: self.path.clone(),
+                field: "scalar_steps",
+                detail: "the file was created with a scalar field but no step was appended".into(),
+            });
+        }
         let count = |i: usize| self.table[i].1 / ELEMENT_BYTES[i];
         let (points, tets, constrained) = (count(0), count(1), count(3));
         let mismatch = |i: usize, expected: u64| FormatError::SizeMismatch {
@@ -316,8 +401,9 @@ impl StreamWriter {
             flags,
             file_length: self.end,
             triangle_count: self.triangle_count,
+            scalar_steps: self.scalar_steps,
             counts: [points, tets, constrained],
-            table: self.table,
+            table: self.table[..7].try_into().expect("seven table entries"),
             payload_crc: self.crc.clone().finalize(),
         });
         let out = self.out.take().expect("an unfinished writer has a file");
@@ -344,6 +430,16 @@ impl Drop for StreamWriter {
             let _ = fs::remove_file(&self.tmp);
         }
     }
+}
+
+/// Name of section `i` in table order; 7 is the scalar block.
+fn section_name(i: usize) -> &'static str {
+    SECTION_NAMES.get(i).copied().unwrap_or("scalars")
+}
+
+/// Bytes of the scalar name slot.
+fn slot_len() -> u64 {
+    super::spec::SCALAR_NAME_SLOT
 }
 
 /// A fresh temporary path in `path`'s directory, named after it (so that

@@ -8,10 +8,14 @@ use crc32fast::Hasher;
 
 use super::error::FormatError;
 use super::header::{HeaderFields, header_bytes};
+use super::scalar_block::name_slot;
 use super::scene_block::scene_records;
-use super::spec::{FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCENE, FLAG_UVS, HEADER_LEN};
+use super::spec::{
+    FLAG_MATERIALS, FLAG_NORMALS, FLAG_SCALARS, FLAG_SCENE, FLAG_UVS, HEADER_LEN, SCALAR_NAME_SLOT,
+};
 use super::stream_writer::{OptionalSections, StreamWriter};
 use super::words::{hash_le_words, padding, write_le_words};
+use crate::fields::{ScalarField, check_name};
 use crate::mesh::TetMesh;
 use crate::scene::SceneInfo;
 
@@ -29,11 +33,39 @@ fn section_bytes(mesh: &TetMesh) -> [Option<&[u8]>; 7] {
     ]
 }
 
+/// Checks what the header needs of a scalar field: a storable name, at
+/// least one step, every step of `points` values. (Values themselves are
+/// checked on load.)
+fn scalar_block_error(field: &ScalarField, points: usize) -> Option<String> {
+    if let Err(e) = check_name(&field.name) {
+        return Some(e.to_string());
+    }
+    if field.steps.is_empty() || field.steps.len() > u32::MAX as usize {
+        return Some(format!(
+            "scalar field has {} steps, expected 1..=2^32-1",
+            field.steps.len()
+        ));
+    }
+    field
+        .steps
+        .iter()
+        .position(|s| s.len() != points)
+        .map(|step| {
+            format!(
+                "scalar field step {step} has {} values, expected {points}",
+                field.steps[step].len()
+            )
+        })
+}
+
 /// Serialises `mesh` into `w` (header first, then the sections).
 ///
 /// The mesh is not validated: an invalid mesh is written as is and rejected
 /// by [`super::load`] with [`FormatError::InvalidMesh`] (or a size mismatch when an
-/// attribute array has the wrong length).
+/// attribute array has the wrong length). A scalar field the header cannot
+/// describe (name too long or with a NUL, no step, a step of the wrong
+/// length) is refused with [`io::ErrorKind::InvalidInput`] instead of being
+/// written wrong.
 pub fn write_to(mesh: &TetMesh, w: &mut impl Write) -> io::Result<()> {
     write_to_with_scene(mesh, &SceneInfo::default(), w)
 }
@@ -47,7 +79,14 @@ pub fn write_to_with_scene(
 ) -> io::Result<()> {
     let sections = section_bytes(mesh);
     let records = scene_records(scene);
+    let scalars = mesh.attributes.scalars.as_ref();
+    if let Some(detail) = scalars.and_then(|f| scalar_block_error(f, mesh.points.len())) {
+        return Err(io::Error::new(io::ErrorKind::InvalidInput, detail));
+    }
     let mut flags = if records.is_empty() { 0 } else { FLAG_SCENE };
+    if scalars.is_some() {
+        flags |= FLAG_SCALARS;
+    }
     for (bit, s) in [
         (FLAG_NORMALS, sections[4]),
         (FLAG_UVS, sections[5]),
@@ -69,6 +108,17 @@ pub fn write_to_with_scene(
             end += len + padding(len);
         }
     }
+    let slot = scalars.and_then(|f| name_slot(&f.name));
+    if let (Some(field), Some(slot)) = (scalars, &slot) {
+        crc.update(slot);
+        let mut len = SCALAR_NAME_SLOT;
+        for step in &field.steps {
+            hash_le_words(&mut crc, bytemuck::cast_slice(step));
+            len += step.len() as u64 * 4;
+        }
+        crc.update(&[0u8; 8][..padding(len) as usize]);
+        end += len + padding(len);
+    }
     let scene_bytes: &[u8] = bytemuck::cast_slice(&records);
     hash_le_words(&mut crc, scene_bytes);
     end += scene_bytes.len() as u64;
@@ -76,6 +126,7 @@ pub fn write_to_with_scene(
         flags,
         file_length: end,
         triangle_count: mesh.triangle_count,
+        scalar_steps: scalars.map_or(0, |f| f.steps.len() as u32),
         counts: [
             mesh.points.len() as u64,
             mesh.tets.len() as u64,
@@ -88,6 +139,15 @@ pub fn write_to_with_scene(
     for bytes in sections.into_iter().flatten() {
         write_le_words(w, bytes)?;
         w.write_all(&[0u8; 8][..padding(bytes.len() as u64) as usize])?;
+    }
+    if let (Some(field), Some(slot)) = (scalars, &slot) {
+        w.write_all(slot)?;
+        let mut len = SCALAR_NAME_SLOT;
+        for step in &field.steps {
+            write_le_words(w, bytemuck::cast_slice(step))?;
+            len += step.len() as u64 * 4;
+        }
+        w.write_all(&[0u8; 8][..padding(len) as usize])?;
     }
     write_le_words(w, scene_bytes)
 }
@@ -141,6 +201,11 @@ pub fn save_with_scene(
     }
     if let Some(m) = &a.materials {
         w.append_materials(m)?;
+    }
+    if let Some(field) = &a.scalars {
+        for step in &field.steps {
+            w.append_scalar_step(&field.name, step)?;
+        }
     }
     w.finish_with_scene(scene).map(|_| ())
 }
