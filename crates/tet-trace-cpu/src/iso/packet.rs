@@ -1,0 +1,1 @@
+//! Packet traversal (placeholder, filled below).

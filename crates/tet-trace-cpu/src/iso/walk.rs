@@ -1,0 +1,599 @@
+//! The iso walk (beyond the paper): the watertight tet walk of
+//! [`crate::walk`] finds the isosurface without any acceleration structure.
+//!
+//! A ray enters the volume through a boundary face ([`crate::entry`], the
+//! same entry decision as the walk's own edge test) or starts in the tet
+//! around its origin ([`crate::locate()`]), then steps tet to neighbour across
+//! the exit face chosen by Algorithm 1 of seed 000 over the Tet32, Tet20 or
+//! Tet16 layout ([`WalkLayout`]; the exit rules of [`crate::tet32`],
+//! [`crate::tet20`], [`crate::tet16`]). Per tet visited:
+//!
+//! 1. the range test: the four vertex values straddle an isovalue
+//!    ([`super::straddles`]); most tets stop here;
+//! 2. only then the field values `F_in`, `F_out` where the ray crosses the
+//!    entry and exit faces: barycentric interpolation of the face's three
+//!    vertex values with weights from the walk's own projected 2-D points
+//!    (the 2-D determinants that steer the walk), evaluated with the face's
+//!    vertices sorted by id and clamped to their value range, so the tet on
+//!    either side of a face gets the same bits; likewise the face's ray
+//!    parameter from the vertices' depths along the ray;
+//! 3. a crossing where `F_in` and `F_out` lie on different sides of the
+//!    isovalue, at `t = t_in + (v − F_in)/(F_out − F_in)·(t_out − t_in)`.
+//!
+//! The walk visits a gap-free sequence of tets (watertight), each face value
+//! is shared bit for bit by the two tets of the face, and a skipped tet's
+//! faces lie on one side of every isovalue (clamping keeps a face's value in
+//! its vertices' range): the classification of the face values along the
+//! ray changes exactly where a crossing is reported, so no crossing falls
+//! into a crack between tets. The first crossing accepted (in `[t_min,
+//! t_max]`, passing the clip box) is the nearest, so a shadow ray (any hit)
+//! is the same walk. Rays that leave the volume miss; a walk stops at the
+//! step cap ([`crate::walk::step_cap`]) with [`Failure::StepCap`].
+//!
+//! Volume meshes rarely have constrained faces; any the mesh has are
+//! walked through (the walk runs on a copy without them).
+
+use std::borrow::Cow;
+
+use glam::{DVec3, Vec2, Vec3};
+use tet_core::layout::{LayoutMesh, Tet16Mesh, Tet20Mesh, Tet32Mesh};
+use tet_core::{Link, TetMesh};
+
+use super::{IsoError, IsoHit, IsoQuery, IsoStats, check_values, gradient};
+use crate::entry::Viewpoint;
+use crate::locate::{LocateError, locate};
+use crate::ray::{Failure, Ray, TraceOutcome};
+use crate::walk::start::begin;
+use crate::walk::step::advance;
+use crate::walk::stop::Advance;
+use crate::walk::{BoundaryEntry, DuffF32, EntryHint, Face2, Start, Topology, step_cap};
+
+/// The compact layout an [`IsoWalk`] steps over.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum WalkLayout {
+    /// [`tet_core::layout::Tet32`]: ids and links (32 bytes per tet).
+    Tet32,
+    /// [`tet_core::layout::Tet20`]: `VX` and rank-ordered links (20 bytes).
+    Tet20,
+    /// [`tet_core::layout::Tet16`]: `VX` and xor-ed links (16 bytes).
+    Tet16,
+}
+
+impl WalkLayout {
+    /// All three, smallest record last.
+    pub const ALL: [WalkLayout; 3] = [WalkLayout::Tet32, WalkLayout::Tet20, WalkLayout::Tet16];
+
+    /// Name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            WalkLayout::Tet32 => "tet32",
+            WalkLayout::Tet20 => "tet20",
+            WalkLayout::Tet16 => "tet16",
+        }
+    }
+}
+
+enum Topo {
+    Tet32(Tet32Mesh),
+    Tet20(Tet20Mesh),
+    Tet16(Tet16Mesh),
+}
+
+/// Result of one iso walk.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum IsoOutcome {
+    /// The first crossing.
+    Hit {
+        /// The crossing.
+        hit: IsoHit,
+        /// Tets visited.
+        tets_visited: u32,
+    },
+    /// No crossing before the ray left the volume (or beyond `t_max`).
+    Miss {
+        /// Tets visited.
+        tets_visited: u32,
+    },
+    /// The walk failed (reported, as by the other walks).
+    Failed {
+        /// Why.
+        failure: Failure,
+        /// Tets visited before giving up.
+        tets_visited: u32,
+    },
+}
+
+impl IsoOutcome {
+    /// The crossing, if any.
+    pub fn hit(&self) -> Option<&IsoHit> {
+        match self {
+            IsoOutcome::Hit { hit, .. } => Some(hit),
+            _ => None,
+        }
+    }
+
+    /// True for [`IsoOutcome::Failed`].
+    pub fn is_failure(&self) -> bool {
+        matches!(self, IsoOutcome::Failed { .. })
+    }
+
+    /// Tets visited.
+    pub fn tets_visited(&self) -> u32 {
+        match *self {
+            IsoOutcome::Hit { tets_visited, .. }
+            | IsoOutcome::Miss { tets_visited }
+            | IsoOutcome::Failed { tets_visited, .. } => tets_visited,
+        }
+    }
+}
+
+/// The iso walk over one mesh and one set of point values.
+pub struct IsoWalk<'m> {
+    mesh: Cow<'m, TetMesh>,
+    values: &'m [f32],
+    topo: Topo,
+    entry: Option<BoundaryEntry>,
+    cap: u32,
+}
+
+/// The mesh with every constrained face replaced by a plain link (a volume
+/// walk crosses them); borrowed when there is none.
+fn unconstrained(mesh: &TetMesh) -> Cow<'_, TetMesh> {
+    if mesh.constrained.is_empty() {
+        return Cow::Borrowed(mesh);
+    }
+    let mut m = mesh.clone();
+    for (t, links) in m.neighbors.iter_mut().enumerate() {
+        for l in links.iter_mut() {
+            if let Some(c) = l.as_constrained() {
+                let other = mesh
+                    .constrained
+                    .get(c as usize)
+                    .and_then(|cf| cf.other_side(t as u32))
+                    .filter(|s| s.exists());
+                *l = other.map_or(Link::BOUNDARY, |s| Link::tet(s.tet));
+            }
+        }
+    }
+    m.constrained.clear();
+    m.triangle_count = 0;
+    Cow::Owned(m)
+}
+
+impl<'m> IsoWalk<'m> {
+    /// Encodes `mesh` in `layout` for walks over the field `values` (one
+    /// value per mesh point). Rays from outside need a convex boundary
+    /// ([`BoundaryEntry::new`]); without one they are reported as
+    /// [`Failure::Lost`].
+    pub fn new(mesh: &'m TetMesh, values: &'m [f32], layout: WalkLayout) -> Result<Self, IsoError> {
+        check_values(values, mesh.points.len())?;
+        let mesh = unconstrained(mesh);
+        let err = |e: tet_core::layout::LayoutError| IsoError::Layout(e.to_string());
+        let topo = match layout {
+            WalkLayout::Tet32 => Topo::Tet32(LayoutMesh::from_mesh(&mesh).map_err(err)?),
+            WalkLayout::Tet20 => Topo::Tet20(LayoutMesh::from_mesh(&mesh).map_err(err)?),
+            WalkLayout::Tet16 => Topo::Tet16(LayoutMesh::from_mesh(&mesh).map_err(err)?),
+        };
+        let entry = BoundaryEntry::new(&mesh).ok();
+        let cap = step_cap(&mesh);
+        Ok(IsoWalk {
+            mesh,
+            values,
+            topo,
+            entry,
+            cap,
+        })
+    }
+
+    /// The same walk over other values of the same points (a new time step:
+    /// nothing to rebuild).
+    pub fn with_values(mut self, values: &'m [f32]) -> Result<Self, IsoError> {
+        check_values(values, self.mesh.points.len())?;
+        self.values = values;
+        Ok(self)
+    }
+
+    /// The mesh walked (constrained faces removed).
+    pub fn mesh(&self) -> &TetMesh {
+        &self.mesh
+    }
+
+    /// Bytes of the walk's hot data: layout records and points (the values
+    /// are the caller's, 4 bytes per point, not counted).
+    pub fn bytes(&self) -> usize {
+        let (recs, pts) = match &self.topo {
+            Topo::Tet32(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
+            Topo::Tet20(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
+            Topo::Tet16(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
+        };
+        recs + pts * 12
+    }
+
+    /// Locates the viewpoint of many rays once ([`Viewpoint::locate`]).
+    pub fn viewpoint(&self, position: Vec3) -> Option<Viewpoint> {
+        Viewpoint::locate(&self.mesh, position).ok()
+    }
+
+    /// Traces `ray`: locates its origin (walking from tet 0), or enters the
+    /// volume through its boundary from outside.
+    pub fn trace(&self, ray: &Ray, query: &IsoQuery) -> IsoOutcome {
+        let start = match locate(&self.mesh, ray.origin, 0) {
+            Ok(t) => Ok(Start::Tet(t)),
+            Err(LocateError::OutsideMesh { .. }) => match &self.entry {
+                Some(e) => e.start(&self.mesh, ray),
+                None => Err(TraceOutcome::Failed {
+                    failure: Failure::Lost,
+                    tets_visited: 0,
+                }),
+            },
+            Err(_) => Err(TraceOutcome::Failed {
+                failure: Failure::InvalidRay,
+                tets_visited: 0,
+            }),
+        };
+        self.trace_start(ray, start, query, &mut IsoStats::default())
+    }
+
+    /// Traces `ray`, whose origin is the viewpoint `vp` (see
+    /// [`IsoWalk::viewpoint`]); `hint` carries the entry face between rays.
+    pub fn trace_from(
+        &self,
+        vp: &Viewpoint,
+        ray: &Ray,
+        query: &IsoQuery,
+        hint: &mut EntryHint,
+        stats: &mut IsoStats,
+    ) -> IsoOutcome {
+        let start = match vp {
+            Viewpoint::Inside(t) => Ok(Start::Tet(*t)),
+            Viewpoint::Outside(e) => e.start_with::<DuffF32>(&self.mesh, ray, hint),
+        };
+        self.trace_start(ray, start, query, stats)
+    }
+
+    /// Shadow ray (any hit): true when some crossing lies in `[t_min,
+    /// t_max]`; the walk's first crossing is its nearest, so this is
+    /// [`IsoWalk::trace`]. `Err` when the walk failed.
+    pub fn occluded(&self, ray: &Ray, query: &IsoQuery) -> Result<bool, Failure> {
+        match self.trace(ray, query) {
+            IsoOutcome::Hit { .. } => Ok(true),
+            IsoOutcome::Miss { .. } => Ok(false),
+            IsoOutcome::Failed { failure, .. } => Err(failure),
+        }
+    }
+
+    /// Traces `ray` from a walk start (`Err`: its outcome before any walk).
+    pub fn trace_start(
+        &self,
+        ray: &Ray,
+        start: Result<Start, TraceOutcome>,
+        query: &IsoQuery,
+        stats: &mut IsoStats,
+    ) -> IsoOutcome {
+        if query.check().is_err() {
+            return IsoOutcome::Failed {
+                failure: Failure::InvalidRay,
+                tets_visited: 0,
+            };
+        }
+        let start = match start {
+            Ok(s) => s,
+            Err(out) => return converted(out),
+        };
+        match &self.topo {
+            Topo::Tet32(t) => self.walk(t, ray, start, query, stats),
+            Topo::Tet20(t) => self.walk(t, ray, start, query, stats),
+            Topo::Tet16(t) => self.walk(t, ray, start, query, stats),
+        }
+    }
+
+    fn walk<T: Topology>(
+        &self,
+        topo: &T,
+        ray: &Ray,
+        start: Start,
+        query: &IsoQuery,
+        stats: &mut IsoStats,
+    ) -> IsoOutcome {
+        let mesh: &TetMesh = &self.mesh;
+        let ctx = Ctx::new(mesh, self.values, ray, query);
+        let mut lane = match begin::<DuffF32>(mesh, ray, start) {
+            Ok(l) => l,
+            Err(TraceOutcome::Miss { tets_visited }) => {
+                // The start tet's exit face is the boundary.
+                if let Start::Tet(t) = start {
+                    stats.range_tests += 1;
+                    if let Some(hit) = ctx.start_tet_alone(t) {
+                        return IsoOutcome::Hit {
+                            hit,
+                            tets_visited: 1,
+                        };
+                    }
+                }
+                return IsoOutcome::Miss { tets_visited };
+            }
+            Err(out) => return converted(out),
+        };
+        // The face value cached from the previous tet's exit face.
+        let mut cached: Option<(f32, f32)> = None;
+        if let Start::Tet(_) = start {
+            // The start tet: from the origin to its exit face.
+            let tet = lane.st.tet;
+            let ids = mesh.tets[tet as usize];
+            let v = ids.map(|i| self.values[i as usize]);
+            stats.range_tests += 1;
+            if ctx.active4(v) {
+                let f_in = ctx.value_at_origin(tet);
+                let out = ctx.face(lane.st.ids, &lane.st.p);
+                cached = Some(out);
+                stats.isopolygon_tests += 1;
+                match ctx.crossing(tet, (f_in, 0.0), out) {
+                    Found::Hit(hit) => {
+                        return IsoOutcome::Hit {
+                            hit,
+                            tets_visited: lane.st.visited,
+                        };
+                    }
+                    Found::Beyond => {
+                        return IsoOutcome::Miss {
+                            tets_visited: lane.st.visited,
+                        };
+                    }
+                    Found::None => {}
+                }
+            }
+        }
+        let points = &mesh.points[..];
+        loop {
+            let tet = lane.next;
+            let entry_ids = lane.st.ids;
+            let entry_p = lane.st.p;
+            let adv = advance(points, topo, &mut lane, self.cap);
+            match adv {
+                Advance::Go | Advance::Face => {}
+                Advance::Cap => {
+                    return IsoOutcome::Failed {
+                        failure: Failure::StepCap,
+                        tets_visited: lane.st.visited,
+                    };
+                }
+                Advance::Lost => {
+                    return IsoOutcome::Failed {
+                        failure: Failure::Lost,
+                        tets_visited: lane.st.visited,
+                    };
+                }
+            }
+            let exit_ids = lane.st.ids;
+            let slot = (0..3).find(|&i| exit_ids[i] != entry_ids[i]).unwrap_or(0);
+            let d = exit_ids[slot];
+            let vals = self.values;
+            let v = [
+                vals[entry_ids[0] as usize],
+                vals[entry_ids[1] as usize],
+                vals[entry_ids[2] as usize],
+                vals[d as usize],
+            ];
+            stats.range_tests += 1;
+            let entry_cache = cached.take();
+            if ctx.active4(v) {
+                let f_in = entry_cache.unwrap_or_else(|| ctx.face(entry_ids, &entry_p));
+                let out = ctx.face(exit_ids, &lane.st.p);
+                cached = Some(out);
+                stats.isopolygon_tests += 1;
+                match ctx.crossing(tet, f_in, out) {
+                    Found::Hit(hit) => {
+                        return IsoOutcome::Hit {
+                            hit,
+                            tets_visited: lane.st.visited,
+                        };
+                    }
+                    Found::Beyond => {
+                        return IsoOutcome::Miss {
+                            tets_visited: lane.st.visited,
+                        };
+                    }
+                    Found::None => {}
+                }
+            }
+            if adv == Advance::Face {
+                // The boundary (constrained faces were removed).
+                return IsoOutcome::Miss {
+                    tets_visited: lane.st.visited,
+                };
+            }
+        }
+    }
+}
+
+/// The walk's outcome before any walk, as an [`IsoOutcome`].
+fn converted(out: TraceOutcome) -> IsoOutcome {
+    match out {
+        TraceOutcome::Failed {
+            failure,
+            tets_visited,
+        } => IsoOutcome::Failed {
+            failure,
+            tets_visited,
+        },
+        other => IsoOutcome::Miss {
+            tets_visited: other.tets_visited(),
+        },
+    }
+}
+
+/// What one tet holds.
+enum Found {
+    Hit(IsoHit),
+    /// A crossing beyond `t_max`: every later one is too.
+    Beyond,
+    None,
+}
+
+/// Per-ray constants of a walk.
+struct Ctx<'a> {
+    mesh: &'a TetMesh,
+    values: &'a [f32],
+    ray: &'a Ray,
+    query: &'a IsoQuery<'a>,
+    inv_dd: f32,
+}
+
+impl<'a> Ctx<'a> {
+    fn new(mesh: &'a TetMesh, values: &'a [f32], ray: &'a Ray, query: &'a IsoQuery<'a>) -> Self {
+        Ctx {
+            mesh,
+            values,
+            ray,
+            query,
+            inv_dd: 1.0 / ray.direction.length_squared(),
+        }
+    }
+
+    #[inline(always)]
+    fn active4(&self, v: [f32; 4]) -> bool {
+        let lo = v[0].min(v[1]).min(v[2].min(v[3]));
+        let hi = v[0].max(v[1]).max(v[2].max(v[3]));
+        self.query.active(lo, hi)
+    }
+
+    /// Depth of point `i` along the ray (a pure function of the point).
+    #[inline(always)]
+    fn depth(&self, i: u32) -> f32 {
+        (self.mesh.points[i as usize] - self.ray.origin).dot(self.ray.direction) * self.inv_dd
+    }
+
+    /// Field value and ray parameter where the ray crosses the face `ids`
+    /// (projected points `p`), computed in id order (see the module docs).
+    #[inline(always)]
+    fn face(&self, ids: [u32; 3], p: &Face2) -> (f32, f32) {
+        let mut k = [
+            (ids[0], p.point(0)),
+            (ids[1], p.point(1)),
+            (ids[2], p.point(2)),
+        ];
+        if k[0].0 > k[1].0 {
+            k.swap(0, 1);
+        }
+        if k[1].0 > k[2].0 {
+            k.swap(1, 2);
+        }
+        if k[0].0 > k[1].0 {
+            k.swap(0, 1);
+        }
+        let det = |a: Vec2, b: Vec2| a.x * b.y - a.y * b.x;
+        let w = [
+            det(k[1].1, k[2].1),
+            det(k[2].1, k[0].1),
+            det(k[0].1, k[1].1),
+        ];
+        let v = k.map(|(i, _)| self.values[i as usize]);
+        let z = k.map(|(i, _)| self.depth(i));
+        let s = w[0] + w[1] + w[2];
+        if s == 0.0 || !s.is_finite() {
+            return (v[0], z[0]);
+        }
+        let f = (w[0] * v[0] + w[1] * v[1] + w[2] * v[2]) / s;
+        let t = (w[0] * z[0] + w[1] * z[1] + w[2] * z[2]) / s;
+        let (vlo, vhi) = (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
+        let (zlo, zhi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
+        (f.clamp(vlo, vhi), t.clamp(zlo, zhi))
+    }
+
+    /// Field value at the ray origin inside `tet`, clamped to its range.
+    fn value_at_origin(&self, tet: u32) -> f32 {
+        let ids = self.mesh.tets[tet as usize];
+        let v = ids.map(|i| self.values[i as usize]);
+        let (lo, hi) = (
+            v[0].min(v[1]).min(v[2].min(v[3])),
+            v[0].max(v[1]).max(v[2].max(v[3])),
+        );
+        let (f0, _) = linear_along(self.mesh, self.values, tet, self.ray);
+        (f0 as f32).clamp(lo, hi)
+    }
+
+    /// The start tet when the ray leaves the volume through its exit face:
+    /// the crossing of the linear field (f64) ahead of the origin.
+    fn start_tet_alone(&self, tet: u32) -> Option<IsoHit> {
+        let (f0, f1) = linear_along(self.mesh, self.values, tet, self.ray);
+        let ids = self.mesh.tets[tet as usize];
+        let v = ids.map(|i| self.values[i as usize]);
+        if !self.active4(v) || f1 == 0.0 {
+            return None;
+        }
+        let mut best: Option<IsoHit> = None;
+        for (k, &iso) in self.query.isovalues.iter().enumerate() {
+            let t = ((iso as f64 - f0) / f1) as f32;
+            if t >= self.ray.t_min.max(0.0) && t <= self.ray.t_max && self.keeps(t) {
+                let hit = self.hit(tet, k, t);
+                if best.is_none_or(|b| hit.before(&b)) {
+                    best = Some(hit);
+                }
+            }
+        }
+        best
+    }
+
+    #[inline]
+    fn keeps(&self, t: f32) -> bool {
+        self.query.keeps(self.ray.at(t))
+    }
+
+    fn hit(&self, tet: u32, k: usize, t: f32) -> IsoHit {
+        let ids = self.mesh.tets[tet as usize];
+        IsoHit {
+            t,
+            tet,
+            isovalue_index: k as u8,
+            normal: gradient(
+                ids.map(|i| self.mesh.points[i as usize]),
+                ids.map(|i| self.values[i as usize]),
+            ),
+        }
+    }
+
+    /// The nearest accepted crossing between the entry `(F_in, t_in)` and
+    /// the exit `(F_out, t_out)` of `tet`.
+    #[inline]
+    fn crossing(&self, tet: u32, (fa, ta): (f32, f32), (fb, tb): (f32, f32)) -> Found {
+        let mut best: Option<IsoHit> = None;
+        let mut beyond = false;
+        for (k, &iso) in self.query.isovalues.iter().enumerate() {
+            if (fa >= iso) == (fb >= iso) {
+                continue;
+            }
+            let s = (iso - fa) / (fb - fa);
+            let t = (ta + s * (tb - ta)).clamp(ta.min(tb), ta.max(tb));
+            if t > self.ray.t_max {
+                beyond = true;
+                continue;
+            }
+            if t < self.ray.t_min || !self.keeps(t) {
+                continue;
+            }
+            let hit = self.hit(tet, k, t);
+            if best.is_none_or(|b| hit.before(&b)) {
+                best = Some(hit);
+            }
+        }
+        match best {
+            Some(h) => Found::Hit(h),
+            None if beyond => Found::Beyond,
+            None => Found::None,
+        }
+    }
+}
+
+/// The linear field of `tet` along `ray` in f64: `f(t) = f0 + f1·t`.
+fn linear_along(mesh: &TetMesh, values: &[f32], tet: u32, ray: &Ray) -> (f64, f64) {
+    let ids = mesh.tets[tet as usize];
+    let p = ids.map(|i| mesh.points[i as usize].as_dvec3());
+    let v = ids.map(|i| values[i as usize] as f64);
+    let m = glam::DMat3::from_cols(p[1] - p[0], p[2] - p[0], p[3] - p[0]);
+    if m.determinant() == 0.0 {
+        return (v[0], 0.0);
+    }
+    let g = m.inverse().transpose() * DVec3::new(v[1] - v[0], v[2] - v[0], v[3] - v[0]);
+    let o = ray.origin.as_dvec3();
+    (v[0] + g.dot(o - p[0]), g.dot(ray.direction.as_dvec3()))
+}
