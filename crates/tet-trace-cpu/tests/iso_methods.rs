@@ -294,17 +294,21 @@ fn crack_free_through_vertices_and_edges() {
         let bih = Ibvh::build_bih(&mesh, &values).unwrap();
         let mut tried = 0;
         for (i, &v) in mesh.points.iter().enumerate() {
-            let iso = values[i];
-            if !(iso > 0.5 && iso < 2.5) {
+            if !(values[i] > 0.5 && values[i] < 2.5) {
                 continue;
             }
-            let q = IsoQuery::new(std::slice::from_ref(&iso));
-            let midpoint = (v + c) * 0.5;
-            for target in [
-                v,
-                midpoint,
-                (v + mesh.points[(i + 1) % mesh.points.len()]) * 0.5,
-            ] {
+            // The isosurface through vertex `v`, or through the midpoint of
+            // the lattice edge from `v` along x (the next point).
+            let j = (i + 1) % mesh.points.len();
+            let edge_mid = (v + mesh.points[j]) * 0.5;
+            let cases = [
+                (values[i], v),
+                (values[i], (v + c) * 0.5),
+                (values[i], edge_mid),
+                ((values[i] + values[j]) * 0.5, edge_mid),
+            ];
+            for (iso, target) in cases {
+                let q = IsoQuery::new(std::slice::from_ref(&iso));
                 // From outside, through `target`, toward the centre side.
                 for k in [2.0f32, 3.0, 5.0] {
                     let origin = c + (target - c) * k + Vec3::new(0.0, 0.0, 0.0);
