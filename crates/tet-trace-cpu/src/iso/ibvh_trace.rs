@@ -187,7 +187,7 @@ impl Ibvh {
         let Some(t) = poly.intersect(pre) else {
             return;
         };
-        if !(t >= pre.ray.t_min && t <= pre.ray.t_max) || !query.keeps(pre.ray.at(t)) {
+        if !(t >= pre.ray.t_min && t <= pre.ray.t_max && query.keeps(pre.ray.at(t))) {
             return;
         }
         let tet = self.prim_tet[j];
