@@ -362,3 +362,77 @@ fn walk_never_fails_on_grids() {
         }
     }
 }
+
+/// A camera's rays on a larger grid: the walks (from the camera's
+/// viewpoint, entering through the boundary) and the IBVH packets find the
+/// same crossings; a ray that one method hits and another misses grazes the
+/// surface (silhouette), where rounding may go either way.
+#[test]
+fn walks_and_ibvh_agree_on_a_camera() {
+    let n = 10u32;
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [n; 3],
+        jitter: 0.1,
+        seed: 9,
+        ..Default::default()
+    });
+    let c = Vec3::splat(n as f32 * 0.5);
+    let values: Vec<f32> = mesh
+        .points
+        .iter()
+        .map(|p| {
+            (-p.distance_squared(c - 1.0) / 8.0).exp() + (-p.distance_squared(c + 1.5) / 6.0).exp()
+        })
+        .collect();
+    let isos = [0.3, 0.6];
+    let q = IsoQuery::new(&isos);
+    let eye = c + Vec3::new(12.0, -9.0, 7.0);
+    let fwd = (c - eye).normalize();
+    let right = fwd.cross(Vec3::Z).normalize();
+    let up = right.cross(fwd);
+    let res = 48;
+    let rays: Vec<Ray> = (0..res * res)
+        .map(|i| {
+            let (x, y) = ((i % res) as f32, (i / res) as f32);
+            let u = (x + 0.5) / res as f32 * 0.8 - 0.4;
+            let v = (y + 0.5) / res as f32 * 0.8 - 0.4;
+            Ray::new(eye, fwd + right * u + up * v)
+        })
+        .collect();
+    let bih = Ibvh::build_bih(&mesh, &values).unwrap();
+    let mut packets = vec![None; rays.len()];
+    bih.trace_packet(&rays, &q, &mut packets);
+    let mut both = 0;
+    for l in WalkLayout::ALL {
+        let w = IsoWalk::new(&mesh, &values, l).unwrap();
+        let vp = w.viewpoint(eye).unwrap();
+        let mut hint = Default::default();
+        for (ray, b) in rays.iter().zip(&packets) {
+            let out = w.trace_from(&vp, ray, &q, &mut hint, &mut Default::default());
+            let h = walk_hit(out);
+            let grazing = |x: &IsoHit| x.normal.dot(ray.direction.normalize()).abs() < 0.05;
+            match (h, *b) {
+                (Some(x), Some(y)) => {
+                    let len = ray.direction.length();
+                    assert!(
+                        (x.t - y.t).abs() * len < 1e-3 || grazing(&x),
+                        "{}: t {} vs {} on {ray:?}",
+                        l.name(),
+                        x.t,
+                        y.t
+                    );
+                    both += 1;
+                }
+                (Some(x), None) | (None, Some(x)) => {
+                    assert!(
+                        grazing(&x),
+                        "{}: one method misses a crossing {x:?} on {ray:?}",
+                        l.name()
+                    )
+                }
+                (None, None) => {}
+            }
+        }
+    }
+    assert!(both > 1000, "{both}");
+}

@@ -45,6 +45,7 @@
 //! 2-D edge test (ray-centred projection and tie rule), so a ray never slips
 //! between the polygons of two neighbouring tets.
 
+mod hull;
 pub mod ibvh;
 pub mod ibvh_trace;
 pub mod marching;

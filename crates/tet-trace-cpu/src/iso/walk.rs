@@ -39,6 +39,8 @@ use glam::{DVec3, Vec2, Vec3};
 use tet_core::layout::{LayoutMesh, Tet16Mesh, Tet20Mesh, Tet32Mesh};
 use tet_core::{Link, TetMesh};
 
+use super::hull::Hull;
+use super::marching::RayPre;
 use super::{IsoError, IsoHit, IsoQuery, IsoStats, check_values, gradient};
 use crate::entry::Viewpoint;
 use crate::locate::{LocateError, locate};
@@ -132,7 +134,8 @@ pub struct IsoWalk<'m> {
     mesh: Cow<'m, TetMesh>,
     values: &'m [f32],
     topo: Topo,
-    entry: Option<BoundaryEntry>,
+    /// Boundary faces, when the boundary is convex (rays from outside).
+    hull: Option<Hull>,
     cap: u32,
 }
 
@@ -174,13 +177,13 @@ impl<'m> IsoWalk<'m> {
             WalkLayout::Tet20 => Topo::Tet20(LayoutMesh::from_mesh(&mesh).map_err(err)?),
             WalkLayout::Tet16 => Topo::Tet16(LayoutMesh::from_mesh(&mesh).map_err(err)?),
         };
-        let entry = BoundaryEntry::new(&mesh).ok();
+        let hull = BoundaryEntry::new(&mesh).ok().map(|_| Hull::new(&mesh));
         let cap = step_cap(&mesh);
         Ok(IsoWalk {
             mesh,
             values,
             topo,
-            entry,
+            hull,
             cap,
         })
     }
@@ -198,15 +201,16 @@ impl<'m> IsoWalk<'m> {
         &self.mesh
     }
 
-    /// Bytes of the walk's hot data: layout records and points (the values
-    /// are the caller's, 4 bytes per point, not counted).
+    /// Bytes of the walk's data: layout records, points and the boundary
+    /// faces' BVH (the values are the caller's, 4 bytes per point, not
+    /// counted).
     pub fn bytes(&self) -> usize {
         let (recs, pts) = match &self.topo {
             Topo::Tet32(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
             Topo::Tet20(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
             Topo::Tet16(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
         };
-        recs + pts * 12
+        recs + pts * 12 + self.hull.as_ref().map_or(0, Hull::bytes)
     }
 
     /// Locates the viewpoint of many rays once ([`Viewpoint::locate`]).
@@ -219,13 +223,7 @@ impl<'m> IsoWalk<'m> {
     pub fn trace(&self, ray: &Ray, query: &IsoQuery) -> IsoOutcome {
         let start = match locate(&self.mesh, ray.origin, 0) {
             Ok(t) => Ok(Start::Tet(t)),
-            Err(LocateError::OutsideMesh { .. }) => match &self.entry {
-                Some(e) => e.start(&self.mesh, ray),
-                None => Err(TraceOutcome::Failed {
-                    failure: Failure::Lost,
-                    tets_visited: 0,
-                }),
-            },
+            Err(LocateError::OutsideMesh { .. }) => self.enter(ray, &mut EntryHint::default()),
             Err(_) => Err(TraceOutcome::Failed {
                 failure: Failure::InvalidRay,
                 tets_visited: 0,
@@ -246,9 +244,25 @@ impl<'m> IsoWalk<'m> {
     ) -> IsoOutcome {
         let start = match vp {
             Viewpoint::Inside(t) => Ok(Start::Tet(*t)),
-            Viewpoint::Outside(e) => e.start_with::<DuffF32>(&self.mesh, ray, hint),
+            Viewpoint::Outside(_) => self.enter(ray, hint),
         };
         self.trace_start(ray, start, query, stats)
+    }
+
+    /// The start of a ray whose origin lies outside the mesh: the boundary
+    /// face its line enters through ([`Hull`]), a miss when none, a
+    /// failure when the boundary is not convex or the ray invalid.
+    fn enter(&self, ray: &Ray, hint: &mut EntryHint) -> Result<Start, TraceOutcome> {
+        let fail = |failure| TraceOutcome::Failed {
+            failure,
+            tets_visited: 0,
+        };
+        if !ray.is_valid() {
+            return Err(fail(Failure::InvalidRay));
+        }
+        let hull = self.hull.as_ref().ok_or(fail(Failure::Lost))?;
+        hull.start(&self.mesh, &RayPre::new(ray), hint)
+            .ok_or(TraceOutcome::Miss { tets_visited: 0 })
     }
 
     /// Shadow ray (any hit): true when some crossing lies in `[t_min,
