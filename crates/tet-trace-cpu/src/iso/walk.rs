@@ -1,9 +1,10 @@
 //! The iso walk (beyond the paper): the watertight tet walk of
 //! [`crate::walk`] finds the isosurface without any acceleration structure.
 //!
-//! A ray enters the volume through a boundary face ([`crate::entry`], the
-//! same entry decision as the walk's own edge test) or starts in the tet
-//! around its origin ([`crate::locate()`]), then steps tet to neighbour across
+//! A ray enters the volume through a boundary face (the entry decision of
+//! [`crate::entry`], the walk's own edge test, with the faces in a BVH:
+//! `iso::hull`) or starts in the tet around its origin
+//! ([`crate::locate()`]), then steps tet to neighbour across
 //! the exit face chosen by Algorithm 1 of seed 000 over the Tet32, Tet20 or
 //! Tet16 layout ([`WalkLayout`]; the exit rules of [`crate::tet32`],
 //! [`crate::tet20`], [`crate::tet16`]). Per tet visited:
@@ -48,7 +49,9 @@ use crate::ray::{Failure, Ray, TraceOutcome};
 use crate::walk::start::begin;
 use crate::walk::step::advance;
 use crate::walk::stop::Advance;
-use crate::walk::{BoundaryEntry, DuffF32, EntryHint, Face2, Start, Topology, step_cap};
+use crate::walk::{
+    BoundaryEntry, DuffF32, EntryHint, Face2, Projection, Start, Topology, step_cap,
+};
 
 /// The compact layout an [`IsoWalk`] steps over.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -358,10 +361,12 @@ impl<'m> IsoWalk<'m> {
             }
         }
         let points = &mesh.points[..];
+        let vals = self.values;
+        // The values of the entry face's vertices, slot by slot.
+        let mut fv = lane.st.ids.map(|i| vals[i as usize]);
         loop {
             let tet = lane.next;
             let entry_ids = lane.st.ids;
-            let entry_p = lane.st.p;
             let adv = advance(points, topo, &mut lane, self.cap);
             match adv {
                 Advance::Go | Advance::Face => {}
@@ -381,17 +386,19 @@ impl<'m> IsoWalk<'m> {
             let exit_ids = lane.st.ids;
             let slot = (0..3).find(|&i| exit_ids[i] != entry_ids[i]).unwrap_or(0);
             let d = exit_ids[slot];
-            let vals = self.values;
-            let v = [
-                vals[entry_ids[0] as usize],
-                vals[entry_ids[1] as usize],
-                vals[entry_ids[2] as usize],
-                vals[d as usize],
-            ];
+            let vd = vals[d as usize];
+            let v = [fv[0], fv[1], fv[2], vd];
+            fv[slot] = vd;
             stats.range_tests += 1;
             let entry_cache = cached.take();
             if ctx.active4(v) {
-                let f_in = entry_cache.unwrap_or_else(|| ctx.face(entry_ids, &entry_p));
+                // The entry face's projections are recomputed when the
+                // previous tet did not compute its value: a pure function
+                // of the vertex, so the same bits.
+                let f_in = entry_cache.unwrap_or_else(|| {
+                    let p = entry_ids.map(|i| lane.proj.project(points[i as usize]));
+                    ctx.face(entry_ids, &Face2::new(p))
+                });
                 let out = ctx.face(exit_ids, &lane.st.p);
                 cached = Some(out);
                 stats.isopolygon_tests += 1;
