@@ -201,6 +201,20 @@ fn main() {
                 (h, st, failed)
             });
             report(&format!("walk {}", l.name()), ms, &hits, &st);
+            let (ms, (thits, st)) = best_ms(3, || {
+                let parts: Vec<(Vec<Option<IsoHit>>, IsoStats)> = rays
+                    .par_chunks(256)
+                    .map(|tile| {
+                        let mut st = IsoStats::default();
+                        let mut out = vec![IsoOutcome::Miss { tets_visited: 0 }; tile.len()];
+                        w.trace_tile(&vp, tile, &q, &mut out, &mut st);
+                        (out.iter().map(|o| o.hit().copied()).collect(), st)
+                    })
+                    .collect();
+                merge(parts)
+            });
+            assert_eq!(thits, hits, "interleaved walks differ from single walks");
+            report(&format!("walk {} interleaved", l.name()), ms, &thits, &st);
             let same_tet = hits
                 .iter()
                 .zip(&reference)

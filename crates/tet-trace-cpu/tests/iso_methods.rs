@@ -407,8 +407,12 @@ fn walks_and_ibvh_agree_on_a_camera() {
         let w = IsoWalk::new(&mesh, &values, l).unwrap();
         let vp = w.viewpoint(eye).unwrap();
         let mut hint = Default::default();
-        for (ray, b) in rays.iter().zip(&packets) {
+        let mut tile = vec![IsoOutcome::Miss { tets_visited: 0 }; rays.len()];
+        w.trace_tile(&vp, &rays, &q, &mut tile, &mut Default::default());
+        for ((ray, b), t) in rays.iter().zip(&packets).zip(&tile) {
             let out = w.trace_from(&vp, ray, &q, &mut hint, &mut Default::default());
+            // The interleaved walks of a tile are the single walks.
+            assert_eq!(*t, out, "{}: tile vs single on {ray:?}", l.name());
             let h = walk_hit(out);
             let grazing = |x: &IsoHit| x.normal.dot(ray.direction.normalize()).abs() < 0.05;
             match (h, *b) {

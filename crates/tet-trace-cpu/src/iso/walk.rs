@@ -44,9 +44,10 @@ use super::hull::Hull;
 use super::marching::RayPre;
 use super::{IsoError, IsoHit, IsoQuery, IsoStats, check_values, gradient};
 use crate::entry::Viewpoint;
+use crate::kernel::LANES;
 use crate::locate::{LocateError, locate};
 use crate::ray::{Failure, Ray, TraceOutcome};
-use crate::walk::start::begin;
+use crate::walk::start::{Lane, begin};
 use crate::walk::step::advance;
 use crate::walk::stop::Advance;
 use crate::walk::{
@@ -279,6 +280,77 @@ impl<'m> IsoWalk<'m> {
         }
     }
 
+    /// Traces the rays of a tile (all from the viewpoint `vp`) into `out`
+    /// (same length), [`LANES`] walks interleaved on this thread, one step
+    /// each per round, so that their dependent memory loads overlap. Each
+    /// outcome is [`IsoWalk::trace_from`]'s for that ray (the same
+    /// functions).
+    pub fn trace_tile(
+        &self,
+        vp: &Viewpoint,
+        rays: &[Ray],
+        query: &IsoQuery,
+        out: &mut [IsoOutcome],
+        stats: &mut IsoStats,
+    ) {
+        match &self.topo {
+            Topo::Tet32(t) => self.tile(t, vp, rays, query, out, stats),
+            Topo::Tet20(t) => self.tile(t, vp, rays, query, out, stats),
+            Topo::Tet16(t) => self.tile(t, vp, rays, query, out, stats),
+        }
+    }
+
+    fn tile<T: Topology>(
+        &self,
+        topo: &T,
+        vp: &Viewpoint,
+        rays: &[Ray],
+        query: &IsoQuery,
+        out: &mut [IsoOutcome],
+        stats: &mut IsoStats,
+    ) {
+        let n = rays.len().min(out.len());
+        let mut hint = EntryHint::default();
+        let mut lanes: [Option<(usize, WalkState)>; LANES] = std::array::from_fn(|_| None);
+        let mut next = 0;
+        loop {
+            let mut active = 0;
+            for slot in lanes.iter_mut() {
+                while slot.is_none() && next < n {
+                    let i = next;
+                    next += 1;
+                    let ray = &rays[i];
+                    let start = match vp {
+                        Viewpoint::Inside(t) => Ok(Start::Tet(*t)),
+                        Viewpoint::Outside(_) => self.enter(ray, &mut hint),
+                    };
+                    let opened = match start {
+                        _ if query.check().is_err() => Err(IsoOutcome::Failed {
+                            failure: Failure::InvalidRay,
+                            tets_visited: 0,
+                        }),
+                        Ok(s) => self.open(ray, s, query, stats),
+                        Err(o) => Err(converted(o)),
+                    };
+                    match opened {
+                        Ok(w) => *slot = Some((i, w)),
+                        Err(o) => out[i] = o,
+                    }
+                }
+                if let Some((i, w)) = slot {
+                    active += 1;
+                    if let Some(o) = self.step(topo, w, stats) {
+                        out[*i] = o;
+                        *slot = None;
+                    }
+                }
+            }
+            if active == 0 && next >= n {
+                return;
+            }
+        }
+    }
+
     /// Traces `ray` from a walk start (`Err`: its outcome before any walk).
     pub fn trace_start(
         &self,
@@ -312,119 +384,158 @@ impl<'m> IsoWalk<'m> {
         query: &IsoQuery,
         stats: &mut IsoStats,
     ) -> IsoOutcome {
+        let mut w = match self.open(ray, start, query, stats) {
+            Ok(w) => w,
+            Err(out) => return out,
+        };
+        loop {
+            if let Some(out) = self.step(topo, &mut w, stats) {
+                return out;
+            }
+        }
+    }
+
+    /// Everything before the walk's loop: the start tet (from the origin
+    /// to its exit face) or the entry face. `Err`: the walk already ended.
+    pub(super) fn open<'a>(
+        &'a self,
+        ray: &'a Ray,
+        start: Start,
+        query: &'a IsoQuery<'a>,
+        stats: &mut IsoStats,
+    ) -> Result<WalkState<'a>, IsoOutcome> {
         let mesh: &TetMesh = &self.mesh;
         let ctx = Ctx::new(mesh, self.values, ray, query);
-        let mut lane = match begin::<DuffF32>(mesh, ray, start) {
+        let lane = match begin::<DuffF32>(mesh, ray, start) {
             Ok(l) => l,
             Err(TraceOutcome::Miss { tets_visited }) => {
                 // The start tet's exit face is the boundary.
                 if let Start::Tet(t) = start {
                     stats.range_tests += 1;
                     if let Some(hit) = ctx.start_tet_alone(t) {
-                        return IsoOutcome::Hit {
+                        return Err(IsoOutcome::Hit {
                             hit,
                             tets_visited: 1,
-                        };
+                        });
                     }
                 }
-                return IsoOutcome::Miss { tets_visited };
+                return Err(IsoOutcome::Miss { tets_visited });
             }
-            Err(out) => return converted(out),
+            Err(out) => return Err(converted(out)),
         };
-        // The face value cached from the previous tet's exit face.
-        let mut cached: Option<(f32, f32)> = None;
+        let fv = lane.st.ids.map(|i| self.values[i as usize]);
+        let mut w = WalkState {
+            lane,
+            fv,
+            cached: None,
+            ctx,
+        };
         if let Start::Tet(_) = start {
             // The start tet: from the origin to its exit face.
-            let tet = lane.st.tet;
+            let tet = w.lane.st.tet;
             let ids = mesh.tets[tet as usize];
             let v = ids.map(|i| self.values[i as usize]);
             stats.range_tests += 1;
-            if ctx.active4(v) {
-                let f_in = ctx.value_at_origin(tet);
-                let out = ctx.face(lane.st.ids, &lane.st.p);
-                cached = Some(out);
+            if w.ctx.active4(v) {
+                let f_in = w.ctx.value_at_origin(tet);
+                let out = w.ctx.face(w.lane.st.ids, &w.lane.st.p);
+                w.cached = Some(out);
                 stats.isopolygon_tests += 1;
-                match ctx.crossing(tet, (f_in, 0.0), out) {
+                let visited = w.lane.st.visited;
+                match w.ctx.crossing(tet, (f_in, 0.0), out) {
                     Found::Hit(hit) => {
-                        return IsoOutcome::Hit {
+                        return Err(IsoOutcome::Hit {
                             hit,
-                            tets_visited: lane.st.visited,
-                        };
+                            tets_visited: visited,
+                        });
                     }
                     Found::Beyond => {
-                        return IsoOutcome::Miss {
-                            tets_visited: lane.st.visited,
-                        };
+                        return Err(IsoOutcome::Miss {
+                            tets_visited: visited,
+                        });
                     }
                     Found::None => {}
                 }
             }
         }
-        let points = &mesh.points[..];
-        let vals = self.values;
-        // The values of the entry face's vertices, slot by slot.
-        let mut fv = lane.st.ids.map(|i| vals[i as usize]);
-        loop {
-            let tet = lane.next;
-            let entry_ids = lane.st.ids;
-            let adv = advance(points, topo, &mut lane, self.cap);
-            match adv {
-                Advance::Go | Advance::Face => {}
-                Advance::Cap => {
-                    return IsoOutcome::Failed {
-                        failure: Failure::StepCap,
-                        tets_visited: lane.st.visited,
-                    };
-                }
-                Advance::Lost => {
-                    return IsoOutcome::Failed {
-                        failure: Failure::Lost,
-                        tets_visited: lane.st.visited,
-                    };
-                }
-            }
-            let exit_ids = lane.st.ids;
-            let slot = (0..3).find(|&i| exit_ids[i] != entry_ids[i]).unwrap_or(0);
-            let d = exit_ids[slot];
-            let vd = vals[d as usize];
-            let v = [fv[0], fv[1], fv[2], vd];
-            fv[slot] = vd;
-            stats.range_tests += 1;
-            let entry_cache = cached.take();
-            if ctx.active4(v) {
-                // The entry face's projections are recomputed when the
-                // previous tet did not compute its value: a pure function
-                // of the vertex, so the same bits.
-                let f_in = entry_cache.unwrap_or_else(|| {
-                    let p = entry_ids.map(|i| lane.proj.project(points[i as usize]));
-                    ctx.face(entry_ids, &Face2::new(p))
-                });
-                let out = ctx.face(exit_ids, &lane.st.p);
-                cached = Some(out);
-                stats.isopolygon_tests += 1;
-                match ctx.crossing(tet, f_in, out) {
-                    Found::Hit(hit) => {
-                        return IsoOutcome::Hit {
-                            hit,
-                            tets_visited: lane.st.visited,
-                        };
-                    }
-                    Found::Beyond => {
-                        return IsoOutcome::Miss {
-                            tets_visited: lane.st.visited,
-                        };
-                    }
-                    Found::None => {}
-                }
-            }
-            if adv == Advance::Face {
-                // The boundary (constrained faces were removed).
-                return IsoOutcome::Miss {
-                    tets_visited: lane.st.visited,
-                };
-            }
-        }
+        Ok(w)
     }
+
+    /// One step of the walk: enter the next tet, test it; `Some` when the
+    /// walk ended.
+    #[inline(always)]
+    pub(super) fn step<T: Topology>(
+        &self,
+        topo: &T,
+        w: &mut WalkState,
+        stats: &mut IsoStats,
+    ) -> Option<IsoOutcome> {
+        let points = &self.mesh.points[..];
+        let vals = self.values;
+        let lane = &mut w.lane;
+        let tet = lane.next;
+        let entry_ids = lane.st.ids;
+        let adv = advance(points, topo, lane, self.cap);
+        let failed = |failure| {
+            Some(IsoOutcome::Failed {
+                failure,
+                tets_visited: lane.st.visited,
+            })
+        };
+        match adv {
+            Advance::Go | Advance::Face => {}
+            Advance::Cap => return failed(Failure::StepCap),
+            Advance::Lost => return failed(Failure::Lost),
+        }
+        let exit_ids = lane.st.ids;
+        let slot = (0..3).find(|&i| exit_ids[i] != entry_ids[i]).unwrap_or(0);
+        let d = exit_ids[slot];
+        let vd = vals[d as usize];
+        let v = [w.fv[0], w.fv[1], w.fv[2], vd];
+        w.fv[slot] = vd;
+        stats.range_tests += 1;
+        let entry_cache = w.cached.take();
+        let visited = lane.st.visited;
+        if w.ctx.active4(v) {
+            // The entry face's projections are recomputed when the previous
+            // tet did not compute its value: a pure function of the vertex,
+            // so the same bits.
+            let f_in = entry_cache.unwrap_or_else(|| {
+                let p = entry_ids.map(|i| lane.proj.project(points[i as usize]));
+                w.ctx.face(entry_ids, &Face2::new(p))
+            });
+            let out = w.ctx.face(exit_ids, &lane.st.p);
+            w.cached = Some(out);
+            stats.isopolygon_tests += 1;
+            match w.ctx.crossing(tet, f_in, out) {
+                Found::Hit(hit) => {
+                    return Some(IsoOutcome::Hit {
+                        hit,
+                        tets_visited: visited,
+                    });
+                }
+                Found::Beyond => {
+                    return Some(IsoOutcome::Miss {
+                        tets_visited: visited,
+                    });
+                }
+                Found::None => {}
+            }
+        }
+        // The boundary (constrained faces were removed).
+        (adv == Advance::Face).then_some(IsoOutcome::Miss {
+            tets_visited: visited,
+        })
+    }
+}
+
+/// One walk in flight: the tet walk's lane, the entry face's values, the
+/// cached face value and the ray's constants.
+pub(super) struct WalkState<'a> {
+    lane: Lane<DuffF32>,
+    fv: [f32; 3],
+    cached: Option<(f32, f32)>,
+    ctx: Ctx<'a>,
 }
 
 /// The walk's outcome before any walk, as an [`IsoOutcome`].
