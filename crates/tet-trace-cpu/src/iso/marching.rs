@@ -205,3 +205,60 @@ impl RayPre {
         (t0, t1)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every case's polygon runs over the edges between an above and a below
+    /// vertex, each such edge once, consecutive edges sharing a vertex (a
+    /// cycle around the tet); the two empty cases have none.
+    #[test]
+    fn cases_cut_exactly_the_straddling_edges() {
+        for (m, &(n, edges)) in CASES.iter().enumerate() {
+            let above = |i: u8| m & (1 << i) != 0;
+            let straddling = (0..4u8)
+                .flat_map(|i| (i + 1..4).map(move |j| (i, j)))
+                .filter(|&(i, j)| above(i) != above(j))
+                .count();
+            assert_eq!(n as usize, straddling, "case {m}");
+            let e = &edges[..n as usize];
+            for (k, &[i, j]) in e.iter().enumerate() {
+                assert_ne!(above(i), above(j), "case {m}");
+                let [a, b] = e[(k + 1) % e.len()];
+                assert!([a, b].contains(&i) || [a, b].contains(&j), "case {m}");
+            }
+        }
+    }
+
+    /// A polygon vertex on an edge gets the same bits from either end.
+    #[test]
+    fn edge_points_are_canonical() {
+        let p = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z * 1.3];
+        let v = [0.1, 0.9, 0.4, 0.7];
+        let a = IsoPolygon::new([5, 9, 2, 7], p, v, 0.5).unwrap();
+        // The same tet with its slots permuted.
+        let b = IsoPolygon::new(
+            [9, 5, 7, 2],
+            [p[1], p[0], p[3], p[2]],
+            [v[1], v[0], v[3], v[2]],
+            0.5,
+        )
+        .unwrap();
+        let mut pa: Vec<_> = (0..a.n as usize)
+            .map(|k| (a.keys[k], a.points[k].to_array()))
+            .collect();
+        let mut pb: Vec<_> = (0..b.n as usize)
+            .map(|k| (b.keys[k], b.points[k].to_array()))
+            .collect();
+        pa.sort_by(|x, y| x.0.cmp(&y.0));
+        pb.sort_by(|x, y| x.0.cmp(&y.0));
+        assert_eq!(pa, pb);
+        for (_, q) in &pa {
+            // On the plane of the linear field: f = 0.1 + 0.8x + 0.3y + 0.6/1.3·z.
+            let q = Vec3::from_array(*q);
+            let f = 0.1 + 0.8 * q.x + 0.3 * q.y + 0.6 / 1.3 * q.z;
+            assert!((f - 0.5).abs() < 1e-6, "{f}");
+        }
+    }
+}

@@ -340,6 +340,7 @@ impl<'m> IsoWalk<'m> {
                 if let Some((i, w)) = slot {
                     active += 1;
                     if let Some(o) = self.step(topo, w, stats) {
+                        stats.range_tests += o.tets_visited().saturating_sub(w.opened) as u64;
                         out[*i] = o;
                         *slot = None;
                     }
@@ -390,6 +391,8 @@ impl<'m> IsoWalk<'m> {
         };
         loop {
             if let Some(out) = self.step(topo, &mut w, stats) {
+                // One range test per tet entered (not counted per step).
+                stats.range_tests += out.tets_visited().saturating_sub(w.opened) as u64;
                 return out;
             }
         }
@@ -424,11 +427,13 @@ impl<'m> IsoWalk<'m> {
             Err(out) => return Err(converted(out)),
         };
         let fv = lane.st.ids.map(|i| self.values[i as usize]);
+        let opened = lane.st.visited;
         let mut w = WalkState {
             lane,
             fv,
             cached: None,
             ctx,
+            opened,
         };
         if let Start::Tet(_) = start {
             // The start tet: from the origin to its exit face.
@@ -493,7 +498,6 @@ impl<'m> IsoWalk<'m> {
         let vd = vals[d as usize];
         let v = [w.fv[0], w.fv[1], w.fv[2], vd];
         w.fv[slot] = vd;
-        stats.range_tests += 1;
         let entry_cache = w.cached.take();
         let visited = lane.st.visited;
         if w.ctx.active4(v) {
@@ -536,6 +540,8 @@ pub(super) struct WalkState<'a> {
     fv: [f32; 3],
     cached: Option<(f32, f32)>,
     ctx: Ctx<'a>,
+    /// Tets visited when the walk loop began.
+    opened: u32,
 }
 
 /// The walk's outcome before any walk, as an [`IsoOutcome`].
@@ -569,6 +575,9 @@ struct Ctx<'a> {
     ray: &'a Ray,
     query: &'a IsoQuery<'a>,
     inv_dd: f32,
+    /// Smallest and largest isovalue.
+    iso_lo: f32,
+    iso_hi: f32,
 }
 
 impl<'a> Ctx<'a> {
@@ -579,6 +588,16 @@ impl<'a> Ctx<'a> {
             ray,
             query,
             inv_dd: 1.0 / ray.direction.length_squared(),
+            iso_lo: query
+                .isovalues
+                .iter()
+                .copied()
+                .fold(f32::INFINITY, f32::min),
+            iso_hi: query
+                .isovalues
+                .iter()
+                .copied()
+                .fold(f32::NEG_INFINITY, f32::max),
         }
     }
 
@@ -586,6 +605,10 @@ impl<'a> Ctx<'a> {
     fn active4(&self, v: [f32; 4]) -> bool {
         let lo = v[0].min(v[1]).min(v[2].min(v[3]));
         let hi = v[0].max(v[1]).max(v[2].max(v[3]));
+        // Most tets lie on one side of every isovalue: two comparisons.
+        if hi < self.iso_lo || lo >= self.iso_hi {
+            return false;
+        }
         self.query.active(lo, hi)
     }
 
