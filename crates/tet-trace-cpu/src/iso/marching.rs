@@ -251,8 +251,8 @@ mod tests {
         let mut pb: Vec<_> = (0..b.n as usize)
             .map(|k| (b.keys[k], b.points[k].to_array()))
             .collect();
-        pa.sort_by(|x, y| x.0.cmp(&y.0));
-        pb.sort_by(|x, y| x.0.cmp(&y.0));
+        pa.sort_by_key(|x| x.0);
+        pb.sort_by_key(|x| x.0);
         assert_eq!(pa, pb);
         for (_, q) in &pa {
             // On the plane of the linear field: f = 0.1 + 0.8x + 0.3y + 0.6/1.3·z.
