@@ -13,10 +13,11 @@ use glam::Vec3;
 use rayon::prelude::*;
 use tet_core::TetMesh;
 use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
-use tet_trace_cpu::Ray;
 use tet_trace_cpu::iso::walk::IsoOutcome;
 use tet_trace_cpu::iso::{BuildKind, Ibvh, IsoHit, IsoQuery, IsoStats, IsoWalk, WalkLayout};
+use tet_trace_cpu::tet20::Tet20Tracer;
 use tet_trace_cpu::walk::EntryHint;
+use tet_trace_cpu::{DuffF32, Ray, TraceOutcome, Viewpoint};
 
 fn gaussians(mesh: &TetMesh, n: f32) -> Vec<f32> {
     let mut r = SplitMix64(9);
@@ -171,6 +172,26 @@ fn main() {
             });
             assert_eq!(hits, phits, "packets differ from single rays");
             report(&format!("{name} packets 16×16"), ms, &phits, &st);
+        }
+        // Baseline: the plain Tet20 walk (no isosurface), every ray to the
+        // volume's far side: its cost per tet is the floor of the iso walk's.
+        {
+            let tracer = Tet20Tracer::<DuffF32>::new(&mesh).expect("tet20 layout");
+            let vp = Viewpoint::locate(&mesh, eye).expect("viewpoint");
+            let (ms, steps) = best_ms(3, || {
+                rays.par_chunks(256)
+                    .map(|tile| {
+                        let mut out = vec![TraceOutcome::Miss { tets_visited: 0 }; tile.len()];
+                        vp.trace_batch(&tracer, tile, &mut out);
+                        out.iter().map(|o| o.tets_visited() as u64).sum::<u64>()
+                    })
+                    .sum::<u64>()
+            });
+            println!(
+                "| plain tet20 walk through the volume (baseline) | {ms:.1} | {:.2} | | | | {:.1} |",
+                rays_m / (ms / 1e3),
+                steps as f64 / rays.len() as f64
+            );
         }
         let reference: Vec<Option<IsoHit>> = rays.iter().map(|r| bih.trace(r, &q)).collect();
         for (l, w, _) in &walks {

@@ -440,3 +440,39 @@ fn walks_and_ibvh_agree_on_a_camera() {
     }
     assert!(both > 1000, "{both}");
 }
+
+/// Rays from inside that leave the volume: a crossing of the field's
+/// extrapolation beyond the boundary is no crossing; one just before it is.
+#[test]
+fn rays_leaving_the_volume_miss() {
+    let mesh = grid(0.0);
+    let values = linear(&mesh, Vec3::X);
+    let s = N as f32;
+    let bih = Ibvh::build_bih(&mesh, &values).unwrap();
+    let walks: Vec<IsoWalk> = WalkLayout::ALL
+        .iter()
+        .map(|&l| IsoWalk::new(&mesh, &values, l).unwrap())
+        .collect();
+    let mut r = SplitMix64(77);
+    for _ in 0..100 {
+        let x = s - r.range_f32(0.001, 0.3);
+        let origin = Vec3::new(x, r.range_f32(0.5, s - 0.5), r.range_f32(0.5, s - 0.5));
+        let ray = Ray::new(
+            origin,
+            Vec3::new(1.0, r.range_f32(-0.1, 0.1), r.range_f32(-0.1, 0.1)),
+        );
+        for (iso, hits) in [(s + 0.5, false), ((x + s) * 0.5, true)] {
+            let q = IsoQuery::new(std::slice::from_ref(&iso));
+            assert_eq!(
+                closest(&mesh, &values, &ray, &q).is_some(),
+                hits,
+                "reference, {ray:?}"
+            );
+            assert_eq!(bih.trace(&ray, &q).is_some(), hits, "ibvh, {ray:?}");
+            for (w, l) in walks.iter().zip(WalkLayout::ALL) {
+                let h = walk_hit(w.trace(&ray, &q));
+                assert_eq!(h.is_some(), hits, "{}, iso {iso}, {ray:?}", l.name());
+            }
+        }
+    }
+}

@@ -112,8 +112,11 @@ impl Hull {
         if self.nodes.is_empty() {
             return None;
         }
-        let mut stack = vec![0usize];
-        while let Some(i) = stack.pop() {
+        let mut stack = [0u32; 64];
+        let mut sp = 1;
+        while sp > 0 {
+            sp -= 1;
+            let i = stack[sp] as usize;
             let n = &self.nodes[i];
             let (t0, t1) = pre.slab(n.lo, n.hi);
             if !(t0 <= t1 && t1 >= 0.0) {
@@ -127,9 +130,13 @@ impl Hull {
                         return Some(start(&self.faces[j]));
                     }
                 }
+            } else if sp + 2 <= stack.len() {
+                stack[sp] = n.index;
+                stack[sp + 1] = i as u32 + 1;
+                sp += 2;
             } else {
-                stack.push(n.index as usize);
-                stack.push(i + 1);
+                // Deeper than any median-split tree of < 2⁶² faces.
+                break;
             }
         }
         None

@@ -670,7 +670,7 @@ impl<'a> Ctx<'a> {
     /// The start tet when the ray leaves the volume through its exit face:
     /// the crossing of the linear field (f64) ahead of the origin.
     fn start_tet_alone(&self, tet: u32) -> Option<IsoHit> {
-        let (f0, f1) = linear_along(self.mesh, self.values, tet, self.ray);
+        let (f0, f1, exit) = linear_and_exit(self.mesh, self.values, tet, self.ray);
         let ids = self.mesh.tets[tet as usize];
         let v = ids.map(|i| self.values[i as usize]);
         if !self.active4(v) || f1 == 0.0 {
@@ -678,8 +678,11 @@ impl<'a> Ctx<'a> {
         }
         let mut best: Option<IsoHit> = None;
         for (k, &iso) in self.query.isovalues.iter().enumerate() {
-            let t = ((iso as f64 - f0) / f1) as f32;
-            if t >= self.ray.t_min.max(0.0) && t <= self.ray.t_max && self.keeps(t) {
+            let t64 = (iso as f64 - f0) / f1;
+            let t = t64 as f32;
+            // Beyond the exit the ray is outside the volume.
+            let inside = t64 <= exit * (1.0 + 1e-9);
+            if inside && t >= self.ray.t_min.max(0.0) && t <= self.ray.t_max && self.keeps(t) {
                 let hit = self.hit(tet, k, t);
                 if best.is_none_or(|b| hit.before(&b)) {
                     best = Some(hit);
@@ -741,14 +744,32 @@ impl<'a> Ctx<'a> {
 
 /// The linear field of `tet` along `ray` in f64: `f(t) = f0 + f1·t`.
 fn linear_along(mesh: &TetMesh, values: &[f32], tet: u32, ray: &Ray) -> (f64, f64) {
+    let (f0, f1, _) = linear_and_exit(mesh, values, tet, ray);
+    (f0, f1)
+}
+
+/// [`linear_along`] and the ray parameter where the ray leaves the tet
+/// (f64; infinite for a flat tet).
+fn linear_and_exit(mesh: &TetMesh, values: &[f32], tet: u32, ray: &Ray) -> (f64, f64, f64) {
     let ids = mesh.tets[tet as usize];
     let p = ids.map(|i| mesh.points[i as usize].as_dvec3());
     let v = ids.map(|i| values[i as usize] as f64);
     let m = glam::DMat3::from_cols(p[1] - p[0], p[2] - p[0], p[3] - p[0]);
     if m.determinant() == 0.0 {
-        return (v[0], 0.0);
+        return (v[0], 0.0, f64::INFINITY);
     }
-    let g = m.inverse().transpose() * DVec3::new(v[1] - v[0], v[2] - v[0], v[3] - v[0]);
+    let inv = m.inverse();
+    let g = inv.transpose() * DVec3::new(v[1] - v[0], v[2] - v[0], v[3] - v[0]);
     let o = ray.origin.as_dvec3();
-    (v[0] + g.dot(o - p[0]), g.dot(ray.direction.as_dvec3()))
+    let d = ray.direction.as_dvec3();
+    // Barycentrics along the ray: λ(t) = a + b·t; the exit is the first
+    // t > 0 where a decreasing one reaches 0.
+    let (la, lb) = (inv * (o - p[0]), inv * d);
+    let a = [1.0 - la.x - la.y - la.z, la.x, la.y, la.z];
+    let b = [-lb.x - lb.y - lb.z, lb.x, lb.y, lb.z];
+    let exit = (0..4)
+        .filter(|&i| b[i] < 0.0)
+        .map(|i| -a[i] / b[i])
+        .fold(f64::INFINITY, f64::min);
+    (v[0] + g.dot(o - p[0]), g.dot(d), exit)
 }
