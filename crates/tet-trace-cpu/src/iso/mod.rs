@@ -6,7 +6,7 @@
 //! vertex values straddle `v` (the paper's *isotet* and *isopolygon*, §3).
 //! Three ways to find the first crossing of a ray:
 //!
-//! * [`reference`]: f64 brute force over every tet (the yardstick of tests);
+//! * [`mod@reference`]: f64 brute force over every tet (the yardstick of tests);
 //! * [`walk`]: the iso walk (beyond the paper): the watertight tet walk of
 //!   [`crate::walk`] over Tet32/Tet20/Tet16, testing each visited tet's value
 //!   range and locating the crossing from the field values where the ray
