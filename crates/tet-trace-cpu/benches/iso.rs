@@ -202,6 +202,26 @@ fn main() {
                 steps as f64 / entering.len() as f64
             );
             println!("|   (ns per tet: {:.1}) | | | | | | |", ms * 1e6 / steps as f64);
+            // The same walks one ray at a time (the scalar walk the iso
+            // walk builds on).
+            let (ms, steps) = best_ms(3, || {
+                entering
+                    .par_chunks(256)
+                    .zip(starts.par_chunks(256))
+                    .map(|(tile, st)| {
+                        tile.iter()
+                            .zip(st)
+                            .map(|(r, s)| tracer.trace(r, *s).tets_visited() as u64)
+                            .sum::<u64>()
+                    })
+                    .sum::<u64>()
+            });
+            println!(
+                "| plain tet20 walk, single rays (baseline) | {ms:.1} | {:.2} | | | | {:.1} |",
+                entering.len() as f64 / 1e6 / (ms / 1e3),
+                steps as f64 / entering.len() as f64
+            );
+            println!("|   (ns per tet: {:.1}) | | | | | | |", ms * 1e6 / steps as f64);
         }
         let reference: Vec<Option<IsoHit>> = rays.iter().map(|r| bih.trace(r, &q)).collect();
         for (l, w, _) in &walks {
