@@ -222,6 +222,25 @@ fn gaussians_several_isovalues() {
     assert!(seen.iter().filter(|&&s| s).count() >= 2, "{seen:?}");
 }
 
+/// Many more rays, four isovalues, with and without a crop box.
+#[test]
+fn many_rays_four_isovalues() {
+    let mesh = grid(0.14);
+    let values = gaussians(&mesh);
+    let isos = [0.15, 0.3, 0.5, 0.75];
+    let clip = ClipBox {
+        lo: Vec3::new(0.0, 2.2, 0.0),
+        hi: Vec3::new(3.7, 9.0, 9.0),
+        mode: ClipMode::CutAway,
+    };
+    for q in [IsoQuery::new(&isos), IsoQuery::new(&isos).with_clip(clip)] {
+        let mut all = rays(3000, 61, false);
+        all.extend(rays(2000, 62, true));
+        let checked = check_all(&mesh, &values, &q, &all);
+        assert!(checked > 4000, "only {checked} rays checked");
+    }
+}
+
 #[test]
 fn clip_box_keep_and_cut() {
     let mesh = grid(0.1);
