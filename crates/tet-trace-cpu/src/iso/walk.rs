@@ -493,7 +493,13 @@ impl<'m> IsoWalk<'m> {
             Advance::Lost => return failed(Failure::Lost),
         }
         let exit_ids = lane.st.ids;
-        let slot = (0..3).find(|&i| exit_ids[i] != entry_ids[i]).unwrap_or(0);
+        // The slot the new vertex replaced, branch-free (which slot it is
+        // varies unpredictably from step to step).
+        let changed = (exit_ids[0] != entry_ids[0]) as u32
+            | ((exit_ids[1] != entry_ids[1]) as u32) << 1
+            | ((exit_ids[2] != entry_ids[2]) as u32) << 2
+            | 8;
+        let slot = (changed.trailing_zeros() as usize).min(2);
         let d = exit_ids[slot];
         let vd = vals[d as usize];
         let v = [w.fv[0], w.fv[1], w.fv[2], vd];
