@@ -44,6 +44,7 @@ pub mod area_light;
 pub mod batch;
 pub mod entry;
 pub mod exact;
+pub mod iso;
 pub mod kernel;
 pub mod locate;
 pub mod lockstep;

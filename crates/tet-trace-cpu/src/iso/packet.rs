@@ -1,0 +1,292 @@
+//! Packet traversal of the implicit BVH (seed 004 §5.2): packets of up to
+//! [`PACKET`] rays (16 × 16) share one traversal with
+//!
+//! 1. implicit culling (value range, and clip box) first, once per packet;
+//! 2. speculative first-active descent: when the packet's first active ray
+//!    hits the node's box, descend without testing the others;
+//! 3. otherwise an interval-arithmetic test (Boulos et al., Reshetov et al.:
+//!    bounds of the origins and reciprocal directions over the packet)
+//!    rejects a node that every ray misses;
+//! 4. otherwise first-active tracking: the rays before the first one that
+//!    hits the box are inactive below this node.
+//!
+//! In a leaf each tet's range is tested and each isopolygon built once per
+//! packet, then intersected with every active ray by the single-ray test.
+//!
+//! # Same answer as single rays
+//!
+//! Each ray keeps the nearest crossing by [`IsoHit::before`] among those it
+//! tests, with the single-ray tests of [`super::ibvh_trace`]. A ray
+//! deactivated at a node misses its (padded) box before its nearest crossing
+//! so far, so the node holds no crossing that could win; a crossing a ray
+//! does test only competes by its `(t, tet, isovalue)` key. The result is
+//! bit for bit that of [`Ibvh::trace`] (tested), whatever the visiting order.
+//! The paper's frustum culling of isopolygons (corner rays against the
+//! polygon's edge half-spaces) is not done: the single-ray test projects per
+//! ray, so there is no shared 2-D plane for the corner rays.
+
+use glam::Vec3;
+
+use super::ibvh::Ibvh;
+use super::ibvh_trace::{may_beat, node_live};
+use super::marching::{IsoPolygon, RayPre};
+use super::{IsoHit, IsoQuery, IsoStats};
+use crate::ray::Ray;
+
+/// Rays per packet (16 × 16); longer slices are traced in chunks.
+pub const PACKET: usize = 256;
+
+/// Interval bounds of a packet's rays.
+struct Interval {
+    o_lo: Vec3,
+    o_hi: Vec3,
+    inv_lo: Vec3,
+    inv_hi: Vec3,
+    t_lo: f32,
+}
+
+impl Interval {
+    fn new(pre: &[RayPre]) -> Interval {
+        let mut iv = Interval {
+            o_lo: Vec3::INFINITY,
+            o_hi: Vec3::NEG_INFINITY,
+            inv_lo: Vec3::INFINITY,
+            inv_hi: Vec3::NEG_INFINITY,
+            t_lo: f32::INFINITY,
+        };
+        for p in pre {
+            iv.o_lo = iv.o_lo.min(p.ray.origin);
+            iv.o_hi = iv.o_hi.max(p.ray.origin);
+            iv.inv_lo = iv.inv_lo.min(p.inv_d);
+            iv.inv_hi = iv.inv_hi.max(p.inv_d);
+            iv.t_lo = iv.t_lo.min(p.ray.t_min);
+        }
+        iv
+    }
+
+    /// True when every ray of the packet certainly misses the box before
+    /// `t_far` (the largest far bound of the active rays).
+    fn misses(&self, lo: Vec3, hi: Vec3, t_far: f32) -> bool {
+        let mut tn = self.t_lo;
+        let mut tf = t_far;
+        for a in 0..3 {
+            let (il, ih) = (self.inv_lo[a], self.inv_hi[a]);
+            // Mixed signs or a zero direction component: no bound.
+            if !(il.is_finite() && ih.is_finite()) || (il <= 0.0 && ih >= 0.0) {
+                continue;
+            }
+            let (near, far) = if il > 0.0 {
+                (lo[a], hi[a])
+            } else {
+                (hi[a], lo[a])
+            };
+            let span = |plane: f32| {
+                let (x, y) = (plane - self.o_hi[a], plane - self.o_lo[a]);
+                let q = [x * il, x * ih, y * il, y * ih];
+                (
+                    q[0].min(q[1]).min(q[2].min(q[3])),
+                    q[0].max(q[1]).max(q[2].max(q[3])),
+                )
+            };
+            tn = tn.max(span(near).0);
+            tf = tf.min(span(far).1);
+        }
+        tn > tf + 1e-5 * (tn.abs() + tf.abs())
+    }
+}
+
+/// Per-ray state of a packet.
+struct Lanes<'a> {
+    pre: Vec<RayPre>,
+    best: &'a mut [Option<IsoHit>],
+    done: Vec<bool>,
+    any: bool,
+}
+
+impl Lanes<'_> {
+    /// The single-ray box test, with this ray's current nearest crossing.
+    #[inline(always)]
+    fn hits(&self, r: usize, lo: Vec3, hi: Vec3) -> bool {
+        if self.done[r] {
+            return false;
+        }
+        let p = &self.pre[r];
+        let (t0, t1) = p.slab(lo, hi);
+        t0 <= t1 && t1 >= p.ray.t_min && t0 <= p.ray.t_max && may_beat(t0, self.best[r].as_ref())
+    }
+
+    /// Largest far bound over rays `first..`.
+    fn t_far(&self, first: usize) -> f32 {
+        (first..self.pre.len())
+            .filter(|&r| !self.done[r])
+            .map(|r| {
+                let t = self.pre[r].ray.t_max;
+                self.best[r].map_or(t, |b| {
+                    t.min(b.t + super::ibvh_trace::CULL_SLACK * b.t.abs())
+                })
+            })
+            .fold(f32::NEG_INFINITY, f32::max)
+    }
+}
+
+impl Ibvh {
+    /// Traces `rays` (best coherent, e.g. a 16 × 16 pixel tile) in packets of
+    /// [`PACKET`]; `out[i]` is [`Ibvh::trace`] of `rays[i]`, bit for bit.
+    /// Invalid rays get `None`.
+    pub fn trace_packet(&self, rays: &[Ray], query: &IsoQuery, out: &mut [Option<IsoHit>]) {
+        self.trace_packet_stats(rays, query, out, &mut IsoStats::default());
+    }
+
+    /// [`Ibvh::trace_packet`], counting its work into `stats`.
+    pub fn trace_packet_stats(
+        &self,
+        rays: &[Ray],
+        query: &IsoQuery,
+        out: &mut [Option<IsoHit>],
+        stats: &mut IsoStats,
+    ) {
+        for (r, o) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+            self.packet(r, query, o, false, stats);
+        }
+    }
+
+    /// Shadow packet (any hit): `out[i]` is [`Ibvh::occluded`] of `rays[i]`.
+    pub fn occluded_packet(&self, rays: &[Ray], query: &IsoQuery, out: &mut [bool]) {
+        let mut hits = vec![None; PACKET.min(rays.len())];
+        for (r, o) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+            let h = &mut hits[..r.len()];
+            h.fill(None);
+            self.packet(r, query, h, true, &mut IsoStats::default());
+            for (x, y) in o.iter_mut().zip(h.iter()) {
+                *x = y.is_some();
+            }
+        }
+    }
+
+    fn packet(
+        &self,
+        rays: &[Ray],
+        query: &IsoQuery,
+        out: &mut [Option<IsoHit>],
+        any: bool,
+        stats: &mut IsoStats,
+    ) {
+        let n = rays.len().min(out.len());
+        out[..n].fill(None);
+        if self.nodes.is_empty() || query.check().is_err() {
+            return;
+        }
+        // Invalid rays are never active.
+        let done: Vec<bool> = rays[..n].iter().map(|r| !r.is_valid()).collect();
+        let pre: Vec<RayPre> = rays[..n].iter().map(RayPre::new).collect();
+        let Some(start) = done.iter().position(|&d| !d) else {
+            return;
+        };
+        let iv = Interval::new(&pre);
+        let mut lanes = Lanes {
+            pre,
+            best: &mut out[..n],
+            done,
+            any,
+        };
+        let mut t_far = lanes.t_far(start);
+        let mut stack: Vec<(u32, u32)> = Vec::with_capacity(64);
+        stack.push((0, start as u32));
+        while let Some((node, first)) = stack.pop() {
+            let (node, mut first) = (node as usize, first as usize);
+            stats.nodes_visited += 1;
+            let nd = &self.nodes[node];
+            if !node_live(nd, query) {
+                continue;
+            }
+            let (lo, hi) = (nd.lo3(), nd.hi3());
+            stats.box_tests += 1;
+            if !lanes.hits(first, lo, hi) {
+                if iv.misses(lo, hi, t_far) {
+                    stats.frustum_culls += 1;
+                    continue;
+                }
+                let found = (first + 1..n).find(|&r| {
+                    stats.box_tests += 1;
+                    lanes.hits(r, lo, hi)
+                });
+                match found {
+                    Some(r) => first = r,
+                    None => continue,
+                }
+            }
+            if nd.is_leaf() {
+                if self.packet_leaf(
+                    nd.index as usize,
+                    nd.count as usize,
+                    first,
+                    query,
+                    &mut lanes,
+                    stats,
+                ) {
+                    t_far = lanes.t_far(first);
+                }
+                continue;
+            }
+            let (l, r) = (node + 1, nd.index as usize);
+            let cl = self.nodes[l].lo3() + self.nodes[l].hi3();
+            let cr = self.nodes[r].lo3() + self.nodes[r].hi3();
+            let d = lanes.pre[first].ray.direction;
+            let (near, far) = if (cr - cl).dot(d) >= 0.0 {
+                (l, r)
+            } else {
+                (r, l)
+            };
+            stack.push((far as u32, first as u32));
+            stack.push((near as u32, first as u32));
+        }
+    }
+
+    /// One leaf for rays `first..`; true when some ray's best changed.
+    fn packet_leaf(
+        &self,
+        from: usize,
+        count: usize,
+        first: usize,
+        query: &IsoQuery,
+        lanes: &mut Lanes,
+        stats: &mut IsoStats,
+    ) -> bool {
+        let mut changed = false;
+        for j in from..from + count {
+            let ids = self.prims[j];
+            let p4 = ids.map(|i| self.points[i as usize]);
+            let v = p4.map(|p| p.w);
+            stats.range_tests += 1;
+            let (lo, hi) = (
+                v[0].min(v[1]).min(v[2].min(v[3])),
+                v[0].max(v[1]).max(v[2].max(v[3])),
+            );
+            if !query.active(lo, hi) {
+                continue;
+            }
+            let p = p4.map(|q| q.truncate());
+            for (k, &iso) in query.isovalues.iter().enumerate() {
+                let Some(poly) = IsoPolygon::new(ids, p, v, iso) else {
+                    continue;
+                };
+                stats.isopolygons += 1;
+                for r in first..lanes.pre.len() {
+                    if lanes.done[r] {
+                        continue;
+                    }
+                    stats.isopolygon_tests += 1;
+                    let before = lanes.best[r];
+                    self.offer(j, k, &poly, p, v, &lanes.pre[r], query, &mut lanes.best[r]);
+                    if lanes.best[r] != before {
+                        changed = true;
+                        if lanes.any {
+                            lanes.done[r] = true;
+                        }
+                    }
+                }
+            }
+        }
+        changed
+    }
+}

@@ -1,0 +1,781 @@
+//! The iso walk (beyond the paper): the watertight tet walk of
+//! [`crate::walk`] finds the isosurface without any acceleration structure.
+//!
+//! A ray enters the volume through a boundary face (the entry decision of
+//! [`crate::entry`], the walk's own edge test, with the faces in a BVH:
+//! `iso::hull`) or starts in the tet around its origin
+//! ([`crate::locate()`]), then steps tet to neighbour across
+//! the exit face chosen by Algorithm 1 of seed 000 over the Tet32, Tet20 or
+//! Tet16 layout ([`WalkLayout`]; the exit rules of [`crate::tet32`],
+//! [`crate::tet20`], [`crate::tet16`]). Per tet visited:
+//!
+//! 1. the range test: the four vertex values straddle an isovalue
+//!    ([`super::straddles`]); most tets stop here;
+//! 2. only then the field values `F_in`, `F_out` where the ray crosses the
+//!    entry and exit faces: barycentric interpolation of the face's three
+//!    vertex values with weights from the walk's own projected 2-D points
+//!    (the 2-D determinants that steer the walk), evaluated with the face's
+//!    vertices sorted by id and clamped to their value range, so the tet on
+//!    either side of a face gets the same bits; likewise the face's ray
+//!    parameter from the vertices' depths along the ray;
+//! 3. a crossing where `F_in` and `F_out` lie on different sides of the
+//!    isovalue, at `t = t_in + (v − F_in)/(F_out − F_in)·(t_out − t_in)`.
+//!
+//! The walk visits a gap-free sequence of tets (watertight), each face value
+//! is shared bit for bit by the two tets of the face, and a skipped tet's
+//! faces lie on one side of every isovalue (clamping keeps a face's value in
+//! its vertices' range): the classification of the face values along the
+//! ray changes exactly where a crossing is reported, so no crossing falls
+//! into a crack between tets. The first crossing accepted (in `[t_min,
+//! t_max]`, passing the clip box) is the nearest, so a shadow ray (any hit)
+//! is the same walk. Rays that leave the volume miss; a walk stops at the
+//! step cap ([`crate::walk::step_cap`]) with [`Failure::StepCap`].
+//!
+//! Volume meshes rarely have constrained faces; any the mesh has are
+//! walked through (the walk runs on a copy without them).
+
+use std::borrow::Cow;
+
+use glam::{DVec3, Vec2, Vec3};
+use tet_core::layout::{LayoutMesh, Tet16Mesh, Tet20Mesh, Tet32Mesh};
+use tet_core::{Link, TetMesh};
+
+use super::hull::Hull;
+use super::marching::RayPre;
+use super::{IsoError, IsoHit, IsoQuery, IsoStats, check_values, gradient};
+use crate::entry::Viewpoint;
+use crate::kernel::LANES;
+use crate::locate::{LocateError, locate};
+use crate::ray::{Failure, Ray, TraceOutcome};
+use crate::walk::start::{Lane, begin};
+use crate::walk::step::advance;
+use crate::walk::stop::Advance;
+use crate::walk::{
+    BoundaryEntry, DuffF32, EntryHint, Face2, Projection, Start, Topology, step_cap,
+};
+
+/// The compact layout an [`IsoWalk`] steps over.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum WalkLayout {
+    /// [`tet_core::layout::Tet32`]: ids and links (32 bytes per tet).
+    Tet32,
+    /// [`tet_core::layout::Tet20`]: `VX` and rank-ordered links (20 bytes).
+    Tet20,
+    /// [`tet_core::layout::Tet16`]: `VX` and xor-ed links (16 bytes).
+    Tet16,
+}
+
+impl WalkLayout {
+    /// All three, smallest record last.
+    pub const ALL: [WalkLayout; 3] = [WalkLayout::Tet32, WalkLayout::Tet20, WalkLayout::Tet16];
+
+    /// Name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            WalkLayout::Tet32 => "tet32",
+            WalkLayout::Tet20 => "tet20",
+            WalkLayout::Tet16 => "tet16",
+        }
+    }
+}
+
+enum Topo {
+    Tet32(Tet32Mesh),
+    Tet20(Tet20Mesh),
+    Tet16(Tet16Mesh),
+}
+
+/// Result of one iso walk.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum IsoOutcome {
+    /// The first crossing.
+    Hit {
+        /// The crossing.
+        hit: IsoHit,
+        /// Tets visited.
+        tets_visited: u32,
+    },
+    /// No crossing before the ray left the volume (or beyond `t_max`).
+    Miss {
+        /// Tets visited.
+        tets_visited: u32,
+    },
+    /// The walk failed (reported, as by the other walks).
+    Failed {
+        /// Why.
+        failure: Failure,
+        /// Tets visited before giving up.
+        tets_visited: u32,
+    },
+}
+
+impl IsoOutcome {
+    /// The crossing, if any.
+    pub fn hit(&self) -> Option<&IsoHit> {
+        match self {
+            IsoOutcome::Hit { hit, .. } => Some(hit),
+            _ => None,
+        }
+    }
+
+    /// True for [`IsoOutcome::Failed`].
+    pub fn is_failure(&self) -> bool {
+        matches!(self, IsoOutcome::Failed { .. })
+    }
+
+    /// Tets visited.
+    pub fn tets_visited(&self) -> u32 {
+        match *self {
+            IsoOutcome::Hit { tets_visited, .. }
+            | IsoOutcome::Miss { tets_visited }
+            | IsoOutcome::Failed { tets_visited, .. } => tets_visited,
+        }
+    }
+}
+
+/// The iso walk over one mesh and one set of point values.
+pub struct IsoWalk<'m> {
+    mesh: Cow<'m, TetMesh>,
+    values: &'m [f32],
+    topo: Topo,
+    /// Boundary faces, when the boundary is convex (rays from outside).
+    hull: Option<Hull>,
+    cap: u32,
+}
+
+/// The mesh with every constrained face replaced by a plain link (a volume
+/// walk crosses them); borrowed when there is none.
+fn unconstrained(mesh: &TetMesh) -> Cow<'_, TetMesh> {
+    if mesh.constrained.is_empty() {
+        return Cow::Borrowed(mesh);
+    }
+    let mut m = mesh.clone();
+    for (t, links) in m.neighbors.iter_mut().enumerate() {
+        for l in links.iter_mut() {
+            if let Some(c) = l.as_constrained() {
+                let other = mesh
+                    .constrained
+                    .get(c as usize)
+                    .and_then(|cf| cf.other_side(t as u32))
+                    .filter(|s| s.exists());
+                *l = other.map_or(Link::BOUNDARY, |s| Link::tet(s.tet));
+            }
+        }
+    }
+    m.constrained.clear();
+    m.triangle_count = 0;
+    Cow::Owned(m)
+}
+
+impl<'m> IsoWalk<'m> {
+    /// Encodes `mesh` in `layout` for walks over the field `values` (one
+    /// value per mesh point). Rays from outside need a convex boundary
+    /// ([`BoundaryEntry::new`]); without one they are reported as
+    /// [`Failure::Lost`].
+    pub fn new(mesh: &'m TetMesh, values: &'m [f32], layout: WalkLayout) -> Result<Self, IsoError> {
+        check_values(values, mesh.points.len())?;
+        let mesh = unconstrained(mesh);
+        let err = |e: tet_core::layout::LayoutError| IsoError::Layout(e.to_string());
+        let topo = match layout {
+            WalkLayout::Tet32 => Topo::Tet32(LayoutMesh::from_mesh(&mesh).map_err(err)?),
+            WalkLayout::Tet20 => Topo::Tet20(LayoutMesh::from_mesh(&mesh).map_err(err)?),
+            WalkLayout::Tet16 => Topo::Tet16(LayoutMesh::from_mesh(&mesh).map_err(err)?),
+        };
+        let hull = BoundaryEntry::new(&mesh).ok().map(|_| Hull::new(&mesh));
+        let cap = step_cap(&mesh);
+        Ok(IsoWalk {
+            mesh,
+            values,
+            topo,
+            hull,
+            cap,
+        })
+    }
+
+    /// The same walk over other values of the same points (a new time step:
+    /// nothing to rebuild).
+    pub fn with_values(mut self, values: &'m [f32]) -> Result<Self, IsoError> {
+        check_values(values, self.mesh.points.len())?;
+        self.values = values;
+        Ok(self)
+    }
+
+    /// The mesh walked (constrained faces removed).
+    pub fn mesh(&self) -> &TetMesh {
+        &self.mesh
+    }
+
+    /// Bytes of the walk's data: layout records, points and the boundary
+    /// faces' BVH (the values are the caller's, 4 bytes per point, not
+    /// counted).
+    pub fn bytes(&self) -> usize {
+        let (recs, pts) = match &self.topo {
+            Topo::Tet32(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
+            Topo::Tet20(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
+            Topo::Tet16(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
+        };
+        recs + pts * 12 + self.hull.as_ref().map_or(0, Hull::bytes)
+    }
+
+    /// Locates the viewpoint of many rays once ([`Viewpoint::locate`]).
+    pub fn viewpoint(&self, position: Vec3) -> Option<Viewpoint> {
+        Viewpoint::locate(&self.mesh, position).ok()
+    }
+
+    /// Traces `ray`: locates its origin (walking from tet 0), or enters the
+    /// volume through its boundary from outside.
+    pub fn trace(&self, ray: &Ray, query: &IsoQuery) -> IsoOutcome {
+        let start = match locate(&self.mesh, ray.origin, 0) {
+            Ok(t) => Ok(Start::Tet(t)),
+            Err(LocateError::OutsideMesh { .. }) => self.enter(ray, &mut EntryHint::default()),
+            Err(_) => Err(TraceOutcome::Failed {
+                failure: Failure::InvalidRay,
+                tets_visited: 0,
+            }),
+        };
+        self.trace_start(ray, start, query, &mut IsoStats::default())
+    }
+
+    /// Traces `ray`, whose origin is the viewpoint `vp` (see
+    /// [`IsoWalk::viewpoint`]); `hint` carries the entry face between rays.
+    pub fn trace_from(
+        &self,
+        vp: &Viewpoint,
+        ray: &Ray,
+        query: &IsoQuery,
+        hint: &mut EntryHint,
+        stats: &mut IsoStats,
+    ) -> IsoOutcome {
+        let start = match vp {
+            Viewpoint::Inside(t) => Ok(Start::Tet(*t)),
+            Viewpoint::Outside(_) => self.enter(ray, hint),
+        };
+        self.trace_start(ray, start, query, stats)
+    }
+
+    /// The start of a ray whose origin lies outside the mesh: the boundary
+    /// face its line enters through ([`Hull`]), a miss when none, a
+    /// failure when the boundary is not convex or the ray invalid.
+    fn enter(&self, ray: &Ray, hint: &mut EntryHint) -> Result<Start, TraceOutcome> {
+        let fail = |failure| TraceOutcome::Failed {
+            failure,
+            tets_visited: 0,
+        };
+        if !ray.is_valid() {
+            return Err(fail(Failure::InvalidRay));
+        }
+        let hull = self.hull.as_ref().ok_or(fail(Failure::Lost))?;
+        hull.start(&self.mesh, &RayPre::new(ray), hint)
+            .ok_or(TraceOutcome::Miss { tets_visited: 0 })
+    }
+
+    /// Shadow ray (any hit): true when some crossing lies in `[t_min,
+    /// t_max]`; the walk's first crossing is its nearest, so this is
+    /// [`IsoWalk::trace`]. `Err` when the walk failed.
+    pub fn occluded(&self, ray: &Ray, query: &IsoQuery) -> Result<bool, Failure> {
+        match self.trace(ray, query) {
+            IsoOutcome::Hit { .. } => Ok(true),
+            IsoOutcome::Miss { .. } => Ok(false),
+            IsoOutcome::Failed { failure, .. } => Err(failure),
+        }
+    }
+
+    /// Traces the rays of a tile (all from the viewpoint `vp`) into `out`
+    /// (same length), [`LANES`] walks interleaved on this thread, one step
+    /// each per round, so that their dependent memory loads overlap. Each
+    /// outcome is [`IsoWalk::trace_from`]'s for that ray (the same
+    /// functions).
+    pub fn trace_tile(
+        &self,
+        vp: &Viewpoint,
+        rays: &[Ray],
+        query: &IsoQuery,
+        out: &mut [IsoOutcome],
+        stats: &mut IsoStats,
+    ) {
+        match &self.topo {
+            Topo::Tet32(t) => self.tile(t, vp, rays, query, out, stats),
+            Topo::Tet20(t) => self.tile(t, vp, rays, query, out, stats),
+            Topo::Tet16(t) => self.tile(t, vp, rays, query, out, stats),
+        }
+    }
+
+    fn tile<T: Topology>(
+        &self,
+        topo: &T,
+        vp: &Viewpoint,
+        rays: &[Ray],
+        query: &IsoQuery,
+        out: &mut [IsoOutcome],
+        stats: &mut IsoStats,
+    ) {
+        let n = rays.len().min(out.len());
+        let mut hint = EntryHint::default();
+        let mut lanes: [Option<(usize, WalkState)>; LANES] = std::array::from_fn(|_| None);
+        let mut next = 0;
+        loop {
+            let mut active = 0;
+            for slot in lanes.iter_mut() {
+                while slot.is_none() && next < n {
+                    let i = next;
+                    next += 1;
+                    let ray = &rays[i];
+                    let start = match vp {
+                        Viewpoint::Inside(t) => Ok(Start::Tet(*t)),
+                        Viewpoint::Outside(_) => self.enter(ray, &mut hint),
+                    };
+                    let opened = match start {
+                        _ if query.check().is_err() => Err(IsoOutcome::Failed {
+                            failure: Failure::InvalidRay,
+                            tets_visited: 0,
+                        }),
+                        Ok(s) => self.open(ray, s, query, stats),
+                        Err(o) => Err(converted(o)),
+                    };
+                    match opened {
+                        Ok(w) => *slot = Some((i, w)),
+                        Err(o) => out[i] = o,
+                    }
+                }
+                if let Some((i, w)) = slot {
+                    active += 1;
+                    if let Some(o) = self.step(topo, w, stats) {
+                        stats.range_tests += o.tets_visited().saturating_sub(w.opened) as u64;
+                        out[*i] = o;
+                        *slot = None;
+                    }
+                }
+            }
+            if active == 0 && next >= n {
+                return;
+            }
+        }
+    }
+
+    /// Traces `ray` from a walk start (`Err`: its outcome before any walk).
+    pub fn trace_start(
+        &self,
+        ray: &Ray,
+        start: Result<Start, TraceOutcome>,
+        query: &IsoQuery,
+        stats: &mut IsoStats,
+    ) -> IsoOutcome {
+        if query.check().is_err() {
+            return IsoOutcome::Failed {
+                failure: Failure::InvalidRay,
+                tets_visited: 0,
+            };
+        }
+        let start = match start {
+            Ok(s) => s,
+            Err(out) => return converted(out),
+        };
+        match &self.topo {
+            Topo::Tet32(t) => self.walk(t, ray, start, query, stats),
+            Topo::Tet20(t) => self.walk(t, ray, start, query, stats),
+            Topo::Tet16(t) => self.walk(t, ray, start, query, stats),
+        }
+    }
+
+    fn walk<T: Topology>(
+        &self,
+        topo: &T,
+        ray: &Ray,
+        start: Start,
+        query: &IsoQuery,
+        stats: &mut IsoStats,
+    ) -> IsoOutcome {
+        let mut w = match self.open(ray, start, query, stats) {
+            Ok(w) => w,
+            Err(out) => return out,
+        };
+        loop {
+            if let Some(out) = self.step(topo, &mut w, stats) {
+                // One range test per tet entered (not counted per step).
+                stats.range_tests += out.tets_visited().saturating_sub(w.opened) as u64;
+                return out;
+            }
+        }
+    }
+
+    /// Everything before the walk's loop: the start tet (from the origin
+    /// to its exit face) or the entry face. `Err`: the walk already ended.
+    pub(super) fn open<'a>(
+        &'a self,
+        ray: &'a Ray,
+        start: Start,
+        query: &'a IsoQuery<'a>,
+        stats: &mut IsoStats,
+    ) -> Result<WalkState<'a>, IsoOutcome> {
+        let mesh: &TetMesh = &self.mesh;
+        let ctx = Ctx::new(mesh, self.values, ray, query);
+        let lane = match begin::<DuffF32>(mesh, ray, start) {
+            Ok(l) => l,
+            Err(TraceOutcome::Miss { tets_visited }) => {
+                // The start tet's exit face is the boundary.
+                if let Start::Tet(t) = start {
+                    stats.range_tests += 1;
+                    if let Some(hit) = ctx.start_tet_alone(t) {
+                        return Err(IsoOutcome::Hit {
+                            hit,
+                            tets_visited: 1,
+                        });
+                    }
+                }
+                return Err(IsoOutcome::Miss { tets_visited });
+            }
+            Err(out) => return Err(converted(out)),
+        };
+        let fv = lane.st.ids.map(|i| self.values[i as usize]);
+        let opened = lane.st.visited;
+        let mut w = WalkState {
+            lane,
+            fv,
+            cached: None,
+            ctx,
+            opened,
+        };
+        if let Start::Tet(_) = start {
+            // The start tet: from the origin to its exit face.
+            let tet = w.lane.st.tet;
+            let ids = mesh.tets[tet as usize];
+            let v = ids.map(|i| self.values[i as usize]);
+            stats.range_tests += 1;
+            if w.ctx.active4(v) {
+                let f_in = w.ctx.value_at_origin(tet);
+                let out = w.ctx.face(w.lane.st.ids, &w.lane.st.p);
+                w.cached = Some(out);
+                stats.isopolygon_tests += 1;
+                let visited = w.lane.st.visited;
+                match w.ctx.crossing(tet, (f_in, 0.0), out) {
+                    Found::Hit(hit) => {
+                        return Err(IsoOutcome::Hit {
+                            hit,
+                            tets_visited: visited,
+                        });
+                    }
+                    Found::Beyond => {
+                        return Err(IsoOutcome::Miss {
+                            tets_visited: visited,
+                        });
+                    }
+                    Found::None => {}
+                }
+            }
+        }
+        Ok(w)
+    }
+
+    /// One step of the walk: enter the next tet, test it; `Some` when the
+    /// walk ended.
+    #[inline(always)]
+    pub(super) fn step<T: Topology>(
+        &self,
+        topo: &T,
+        w: &mut WalkState,
+        stats: &mut IsoStats,
+    ) -> Option<IsoOutcome> {
+        let points = &self.mesh.points[..];
+        let vals = self.values;
+        let lane = &mut w.lane;
+        let tet = lane.next;
+        let entry_ids = lane.st.ids;
+        let adv = advance(points, topo, lane, self.cap);
+        let failed = |failure| {
+            Some(IsoOutcome::Failed {
+                failure,
+                tets_visited: lane.st.visited,
+            })
+        };
+        match adv {
+            Advance::Go | Advance::Face => {}
+            Advance::Cap => return failed(Failure::StepCap),
+            Advance::Lost => return failed(Failure::Lost),
+        }
+        let exit_ids = lane.st.ids;
+        // The slot the new vertex replaced, branch-free (which slot it is
+        // varies unpredictably from step to step).
+        let changed = (exit_ids[0] != entry_ids[0]) as u32
+            | ((exit_ids[1] != entry_ids[1]) as u32) << 1
+            | ((exit_ids[2] != entry_ids[2]) as u32) << 2
+            | 8;
+        let slot = (changed.trailing_zeros() as usize).min(2);
+        let d = exit_ids[slot];
+        let vd = vals[d as usize];
+        let v = [w.fv[0], w.fv[1], w.fv[2], vd];
+        w.fv[slot] = vd;
+        let entry_cache = w.cached.take();
+        let visited = lane.st.visited;
+        if w.ctx.active4(v) {
+            // The entry face's projections are recomputed when the previous
+            // tet did not compute its value: a pure function of the vertex,
+            // so the same bits.
+            let f_in = entry_cache.unwrap_or_else(|| {
+                let p = entry_ids.map(|i| lane.proj.project(points[i as usize]));
+                w.ctx.face(entry_ids, &Face2::new(p))
+            });
+            let out = w.ctx.face(exit_ids, &lane.st.p);
+            w.cached = Some(out);
+            stats.isopolygon_tests += 1;
+            match w.ctx.crossing(tet, f_in, out) {
+                Found::Hit(hit) => {
+                    return Some(IsoOutcome::Hit {
+                        hit,
+                        tets_visited: visited,
+                    });
+                }
+                Found::Beyond => {
+                    return Some(IsoOutcome::Miss {
+                        tets_visited: visited,
+                    });
+                }
+                Found::None => {}
+            }
+        }
+        // The boundary (constrained faces were removed).
+        (adv == Advance::Face).then_some(IsoOutcome::Miss {
+            tets_visited: visited,
+        })
+    }
+}
+
+/// One walk in flight: the tet walk's lane, the entry face's values, the
+/// cached face value and the ray's constants.
+pub(super) struct WalkState<'a> {
+    lane: Lane<DuffF32>,
+    fv: [f32; 3],
+    cached: Option<(f32, f32)>,
+    ctx: Ctx<'a>,
+    /// Tets visited when the walk loop began.
+    opened: u32,
+}
+
+/// The walk's outcome before any walk, as an [`IsoOutcome`].
+fn converted(out: TraceOutcome) -> IsoOutcome {
+    match out {
+        TraceOutcome::Failed {
+            failure,
+            tets_visited,
+        } => IsoOutcome::Failed {
+            failure,
+            tets_visited,
+        },
+        other => IsoOutcome::Miss {
+            tets_visited: other.tets_visited(),
+        },
+    }
+}
+
+/// What one tet holds.
+enum Found {
+    Hit(IsoHit),
+    /// A crossing beyond `t_max`: every later one is too.
+    Beyond,
+    None,
+}
+
+/// Per-ray constants of a walk.
+struct Ctx<'a> {
+    mesh: &'a TetMesh,
+    values: &'a [f32],
+    ray: &'a Ray,
+    query: &'a IsoQuery<'a>,
+    inv_dd: f32,
+    /// Smallest and largest isovalue.
+    iso_lo: f32,
+    iso_hi: f32,
+}
+
+impl<'a> Ctx<'a> {
+    fn new(mesh: &'a TetMesh, values: &'a [f32], ray: &'a Ray, query: &'a IsoQuery<'a>) -> Self {
+        Ctx {
+            mesh,
+            values,
+            ray,
+            query,
+            inv_dd: 1.0 / ray.direction.length_squared(),
+            iso_lo: query
+                .isovalues
+                .iter()
+                .copied()
+                .fold(f32::INFINITY, f32::min),
+            iso_hi: query
+                .isovalues
+                .iter()
+                .copied()
+                .fold(f32::NEG_INFINITY, f32::max),
+        }
+    }
+
+    #[inline(always)]
+    fn active4(&self, v: [f32; 4]) -> bool {
+        let lo = v[0].min(v[1]).min(v[2].min(v[3]));
+        let hi = v[0].max(v[1]).max(v[2].max(v[3]));
+        // Most tets lie on one side of every isovalue: two comparisons.
+        if hi < self.iso_lo || lo >= self.iso_hi {
+            return false;
+        }
+        self.query.active(lo, hi)
+    }
+
+    /// Depth of point `i` along the ray (a pure function of the point).
+    #[inline(always)]
+    fn depth(&self, i: u32) -> f32 {
+        (self.mesh.points[i as usize] - self.ray.origin).dot(self.ray.direction) * self.inv_dd
+    }
+
+    /// Field value and ray parameter where the ray crosses the face `ids`
+    /// (projected points `p`), computed in id order (see the module docs).
+    #[inline(always)]
+    fn face(&self, ids: [u32; 3], p: &Face2) -> (f32, f32) {
+        let mut k = [
+            (ids[0], p.point(0)),
+            (ids[1], p.point(1)),
+            (ids[2], p.point(2)),
+        ];
+        if k[0].0 > k[1].0 {
+            k.swap(0, 1);
+        }
+        if k[1].0 > k[2].0 {
+            k.swap(1, 2);
+        }
+        if k[0].0 > k[1].0 {
+            k.swap(0, 1);
+        }
+        let det = |a: Vec2, b: Vec2| a.x * b.y - a.y * b.x;
+        let w = [
+            det(k[1].1, k[2].1),
+            det(k[2].1, k[0].1),
+            det(k[0].1, k[1].1),
+        ];
+        let v = k.map(|(i, _)| self.values[i as usize]);
+        let z = k.map(|(i, _)| self.depth(i));
+        let s = w[0] + w[1] + w[2];
+        if s == 0.0 || !s.is_finite() {
+            return (v[0], z[0]);
+        }
+        let f = (w[0] * v[0] + w[1] * v[1] + w[2] * v[2]) / s;
+        let t = (w[0] * z[0] + w[1] * z[1] + w[2] * z[2]) / s;
+        let (vlo, vhi) = (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
+        let (zlo, zhi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
+        (f.clamp(vlo, vhi), t.clamp(zlo, zhi))
+    }
+
+    /// Field value at the ray origin inside `tet`, clamped to its range.
+    fn value_at_origin(&self, tet: u32) -> f32 {
+        let ids = self.mesh.tets[tet as usize];
+        let v = ids.map(|i| self.values[i as usize]);
+        let (lo, hi) = (
+            v[0].min(v[1]).min(v[2].min(v[3])),
+            v[0].max(v[1]).max(v[2].max(v[3])),
+        );
+        let (f0, _) = linear_along(self.mesh, self.values, tet, self.ray);
+        (f0 as f32).clamp(lo, hi)
+    }
+
+    /// The start tet when the ray leaves the volume through its exit face:
+    /// the crossing of the linear field (f64) ahead of the origin.
+    fn start_tet_alone(&self, tet: u32) -> Option<IsoHit> {
+        let (f0, f1, exit) = linear_and_exit(self.mesh, self.values, tet, self.ray);
+        let ids = self.mesh.tets[tet as usize];
+        let v = ids.map(|i| self.values[i as usize]);
+        if !self.active4(v) || f1 == 0.0 {
+            return None;
+        }
+        let mut best: Option<IsoHit> = None;
+        for (k, &iso) in self.query.isovalues.iter().enumerate() {
+            let t64 = (iso as f64 - f0) / f1;
+            let t = t64 as f32;
+            // Beyond the exit the ray is outside the volume.
+            let inside = t64 <= exit * (1.0 + 1e-9);
+            if inside && t >= self.ray.t_min.max(0.0) && t <= self.ray.t_max && self.keeps(t) {
+                let hit = self.hit(tet, k, t);
+                if best.is_none_or(|b| hit.before(&b)) {
+                    best = Some(hit);
+                }
+            }
+        }
+        best
+    }
+
+    #[inline]
+    fn keeps(&self, t: f32) -> bool {
+        self.query.keeps(self.ray.at(t))
+    }
+
+    fn hit(&self, tet: u32, k: usize, t: f32) -> IsoHit {
+        let ids = self.mesh.tets[tet as usize];
+        IsoHit {
+            t,
+            tet,
+            isovalue_index: k as u8,
+            normal: gradient(
+                ids.map(|i| self.mesh.points[i as usize]),
+                ids.map(|i| self.values[i as usize]),
+            ),
+        }
+    }
+
+    /// The nearest accepted crossing between the entry `(F_in, t_in)` and
+    /// the exit `(F_out, t_out)` of `tet`.
+    #[inline]
+    fn crossing(&self, tet: u32, (fa, ta): (f32, f32), (fb, tb): (f32, f32)) -> Found {
+        let mut best: Option<IsoHit> = None;
+        let mut beyond = false;
+        for (k, &iso) in self.query.isovalues.iter().enumerate() {
+            if (fa >= iso) == (fb >= iso) {
+                continue;
+            }
+            let s = (iso - fa) / (fb - fa);
+            let t = (ta + s * (tb - ta)).clamp(ta.min(tb), ta.max(tb));
+            if t > self.ray.t_max {
+                beyond = true;
+                continue;
+            }
+            if t < self.ray.t_min || !self.keeps(t) {
+                continue;
+            }
+            let hit = self.hit(tet, k, t);
+            if best.is_none_or(|b| hit.before(&b)) {
+                best = Some(hit);
+            }
+        }
+        match best {
+            Some(h) => Found::Hit(h),
+            None if beyond => Found::Beyond,
+            None => Found::None,
+        }
+    }
+}
+
+/// The linear field of `tet` along `ray` in f64: `f(t) = f0 + f1·t`.
+fn linear_along(mesh: &TetMesh, values: &[f32], tet: u32, ray: &Ray) -> (f64, f64) {
+    let (f0, f1, _) = linear_and_exit(mesh, values, tet, ray);
+    (f0, f1)
+}
+
+/// [`linear_along`] and the ray parameter where the ray leaves the tet
+/// (f64; infinite for a flat tet).
+fn linear_and_exit(mesh: &TetMesh, values: &[f32], tet: u32, ray: &Ray) -> (f64, f64, f64) {
+    let ids = mesh.tets[tet as usize];
+    let p = ids.map(|i| mesh.points[i as usize].as_dvec3());
+    let v = ids.map(|i| values[i as usize] as f64);
+    let m = glam::DMat3::from_cols(p[1] - p[0], p[2] - p[0], p[3] - p[0]);
+    if m.determinant() == 0.0 {
+        return (v[0], 0.0, f64::INFINITY);
+    }
+    let inv = m.inverse();
+    let g = inv.transpose() * DVec3::new(v[1] - v[0], v[2] - v[0], v[3] - v[0]);
+    let o = ray.origin.as_dvec3();
+    let d = ray.direction.as_dvec3();
+    // Barycentrics along the ray: λ(t) = a + b·t; the exit is the first
+    // t > 0 where a decreasing one reaches 0.
+    let (la, lb) = (inv * (o - p[0]), inv * d);
+    let a = [1.0 - la.x - la.y - la.z, la.x, la.y, la.z];
+    let b = [-lb.x - lb.y - lb.z, lb.x, lb.y, lb.z];
+    let exit = (0..4)
+        .filter(|&i| b[i] < 0.0)
+        .map(|i| -a[i] / b[i])
+        .fold(f64::INFINITY, f64::min);
+    (v[0] + g.dot(o - p[0]), g.dot(d), exit)
+}
