@@ -49,6 +49,7 @@ use tet_trace_cpu::reference::{
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Start;
 
+use crate::bvh::unit_scale;
 use crate::cli::{BuildFlags, Method, Precision};
 use crate::extremes;
 use crate::load::Loaded;
@@ -178,6 +179,8 @@ pub struct Reference<'m> {
     sharing: EdgeSharing,
     /// Grazing tolerance (world units).
     pub tol: f64,
+    /// The power of two the BVH was built at ([`unit_scale`]).
+    scale: f32,
 }
 
 /// `v` in obvhs's vector type.
@@ -197,12 +200,14 @@ impl<'m> Reference<'m> {
     /// Builds the reference over `mesh.constrained`.
     pub fn new(mesh: &'m TetMesh) -> Self {
         let tol = tolerance(mesh);
-        let pad = Vec3A::splat((tol * 2.0) as f32);
+        // Built on the scene scaled by a power of two (see `unit_scale`).
+        let scale = unit_scale(mesh);
+        let pad = Vec3A::splat((tol * 2.0) as f32 * scale);
         let boxes: Vec<Aabb> = mesh
             .constrained
             .iter()
             .map(|cf| {
-                let p = cf.vertices.map(|v| a3(mesh.points[v as usize]));
+                let p = cf.vertices.map(|v| a3(mesh.points[v as usize] * scale));
                 Aabb {
                     min: p[0].min(p[1]).min(p[2]) - pad,
                     max: p[0].max(p[1]).max(p[2]) + pad,
@@ -219,6 +224,7 @@ impl<'m> Reference<'m> {
             bvh,
             sharing: EdgeSharing::new(mesh),
             tol,
+            scale,
         }
     }
 
@@ -234,7 +240,9 @@ impl<'m> Reference<'m> {
         // below f32::EPSILON as zero): traverse with the unit direction,
         // whose parameter is `t · dlen`.
         let unit = (ray.direction.as_dvec3() / dlen).as_vec3();
-        let r = BvhRay::new(a3(ray.origin), a3(unit), 0.0, f32::INFINITY);
+        let r = BvhRay::new(a3(ray.origin * self.scale), a3(unit), 0.0, f32::INFINITY);
+        // The BVH's parameter of a point at `t` along `ray`.
+        let bvh_t = dlen * self.scale as f64;
         let mut hit = RayHit::none();
         self.bvh.ray_traverse(r, &mut hit, |_, id| {
             let face = self.bvh.primitive_indices[id];
@@ -256,7 +264,7 @@ impl<'m> Reference<'m> {
                 }
             }
             // Keep looking a little beyond the closest hit for the gap test.
-            (((best.unwrap().0 + 2.0 * tol_t) * dlen) as f32) * (1.0 + 1e-6)
+            (((best.unwrap().0 + 2.0 * tol_t) * bvh_t) as f32) * (1.0 + 1e-6)
         });
         let (t, face) = best?;
         let cf = &mesh.constrained[face as usize];

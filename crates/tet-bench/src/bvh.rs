@@ -42,6 +42,29 @@ pub struct BvhTracer<'m> {
     /// Trace with [`BvhTracer::count_trace`] (nodes visited reported as
     /// `tets_visited`) instead of obvhs's traversal.
     count_nodes: bool,
+    /// The power of two the BVH's triangles were scaled by ([`unit_scale`]).
+    scale: f32,
+}
+
+/// A power of two that brings a mesh's largest coordinate near 1 when it
+/// lies outside `[2⁻¹⁶, 2¹⁶]` (else 1): obvhs's surface areas and inverse
+/// directions over- or underflow f32 for scenes at 1e30 or 1e-30, so its
+/// BVHs are built on the scene scaled exactly and traversed with rays
+/// scaled the same way (the same `t`).
+pub fn unit_scale(mesh: &TetMesh) -> f32 {
+    let m = mesh
+        .points
+        .iter()
+        .map(|p| p.abs().max_element())
+        .fold(0.0f32, f32::max);
+    if !(m.is_finite() && m > 0.0) || (1.0 / 65536.0..=65536.0).contains(&m) {
+        return 1.0;
+    }
+    let e = (m as f64).log2().floor() as i32;
+    let s = (2.0f64).powi(-e.clamp(-126, 126)) as f32;
+    // Exact unless a coordinate falls into the subnormals: then unscaled.
+    let exact = mesh.points.iter().all(|&p| (p * s) / s == p);
+    if exact { s } else { 1.0 }
 }
 
 /// `v` in obvhs's vector type.
@@ -52,11 +75,12 @@ fn a(v: Vec3) -> Vec3A {
 impl<'m> BvhTracer<'m> {
     /// Builds the BVH over `mesh.constrained`.
     pub fn new(mesh: &'m TetMesh) -> Self {
+        let scale = unit_scale(mesh);
         let source: Vec<Triangle> = mesh
             .constrained
             .iter()
             .map(|cf| {
-                let [v0, v1, v2] = cf.vertices.map(|v| a(mesh.points[v as usize]));
+                let [v0, v1, v2] = cf.vertices.map(|v| a(mesh.points[v as usize] * scale));
                 Triangle { v0, v1, v2 }
             })
             .collect();
@@ -76,6 +100,7 @@ impl<'m> BvhTracer<'m> {
             tris,
             faces,
             count_nodes: false,
+            scale,
         }
     }
 
@@ -254,10 +279,10 @@ impl Tracer for BvhTracer<'_> {
         // obvhs treats direction components below f32::EPSILON as zero: a
         // ray of a tiny (or huge) scene traverses with its direction
         // scaled by a power of two `k` (exact; `t` is then `t' · k`).
-        let k = direction_scale(ray.direction);
+        let k = direction_scale(ray.direction * self.scale);
         let mut r = BvhRay::new(
-            a(ray.origin),
-            a(ray.direction * k),
+            a(ray.origin * self.scale),
+            a(ray.direction * self.scale * k),
             ray.t_min.max(0.0) / k,
             ray.t_max / k,
         );

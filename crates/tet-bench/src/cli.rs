@@ -31,6 +31,13 @@ pub enum Command {
     Accuracy(AccuracyArgs),
     /// Run the whole reproduction and write Markdown, CSV and JSON tables.
     Tables(TablesArgs),
+    /// Trace isosurfaces of a tetrahedral volume (a VTK, TetGen or mesh
+    /// file with point scalars, or a synthetic volume's name).
+    Iso(IsoArgs),
+    /// Convert a tet mesh between formats: our mesh file (`.tmesh`), VTK
+    /// (`.vtk`, `.vtu`, `.pvd`) and TetGen (`.node`/`.ele`/`.face`/`.neigh`,
+    /// named by the `.node` path); a synthetic volume's name is an input.
+    Convert(ConvertArgs),
     /// Internal: serve one TetGen request on stdin/stdout (isolated builds).
     #[command(hide = true)]
     TetgenWorker,
@@ -461,6 +468,93 @@ mod tests {
         );
         for bad in ["", "1,2", "1,2,3,4", "1,x,3", "1,inf,3", "NaN,0,0", "1;2;3"] {
             assert!(parse_vec3(bad).is_err(), "{bad}");
+        }
+    }
+}
+
+/// `iso` arguments.
+#[derive(Debug, Args)]
+pub struct IsoArgs {
+    /// Volume: a `.vtk`/`.vtu`/`.pvd`, TetGen `.node` or mesh file with a
+    /// scalar field, or a synthetic name (ell32p, feok, bucky, blunt,
+    /// buckycube, fusion, linear, marschner-lobb).
+    pub volume: String,
+    /// Isovalue (repeat for up to 4 at once; default: the synthetic
+    /// volume's own, else the middle of the field's range).
+    #[arg(long = "isovalue", allow_negative_numbers = true)]
+    pub isovalues: Vec<f32>,
+    /// Method.
+    #[arg(long, value_enum, default_value_t = IsoMethod::WalkTet20)]
+    pub method: IsoMethod,
+    /// Time step of the field (0-based).
+    #[arg(long, default_value_t = 0)]
+    pub time_step: usize,
+    /// Image width.
+    #[arg(long, default_value_t = 1024)]
+    pub width: u32,
+    /// Image height.
+    #[arg(long, default_value_t = 1024)]
+    pub height: u32,
+    /// Timed frames (after one warm-up frame).
+    #[arg(long, default_value_t = 3)]
+    pub frames: u32,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Write the image (PNG).
+    #[arg(short = 'o', long)]
+    pub output: Option<PathBuf>,
+}
+
+/// `convert` arguments.
+#[derive(Debug, Args)]
+pub struct ConvertArgs {
+    /// Input: a mesh file, VTK file, TetGen `.node` file or synthetic
+    /// volume name.
+    pub input: String,
+    /// Output, by extension: `.tmesh` (any other extension too), `.vtk`,
+    /// `.vtu`, `.pvd`, or `.node` (TetGen files beside it).
+    pub output: PathBuf,
+}
+
+/// Isosurface methods (`--method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IsoMethod {
+    /// The paper's implicit min-max BVH, BIH-style build, single rays.
+    Ibvh,
+    /// The same with the SAH build.
+    IbvhSah,
+    /// The BIH-built IBVH traced by 16×16 packets.
+    IbvhPackets,
+    /// The iso walk over Tet20 (no BVH).
+    WalkTet20,
+    /// The iso walk over Tet16.
+    WalkTet16,
+    /// The iso walk over Tet32.
+    WalkTet32,
+}
+
+impl IsoMethod {
+    /// Every method, in table order.
+    pub const ALL: [IsoMethod; 6] = [
+        IsoMethod::Ibvh,
+        IsoMethod::IbvhSah,
+        IsoMethod::IbvhPackets,
+        IsoMethod::WalkTet20,
+        IsoMethod::WalkTet16,
+        IsoMethod::WalkTet32,
+    ];
+
+    /// Name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            IsoMethod::Ibvh => "ibvh",
+            IsoMethod::IbvhSah => "ibvh-sah",
+            IsoMethod::IbvhPackets => "ibvh-packets",
+            IsoMethod::WalkTet20 => "walk-tet20",
+            IsoMethod::WalkTet16 => "walk-tet16",
+            IsoMethod::WalkTet32 => "walk-tet32",
         }
     }
 }

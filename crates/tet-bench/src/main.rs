@@ -3,11 +3,13 @@
 //!
 //! The modules lie in layers; each uses only the layers below it:
 //!
-//! 1. commands — [`commands`] (`build`, `info`, `render`, `accuracy`) and
+//! 1. commands — [`commands`] (`build`, `info`, `render`, `accuracy`,
+//!    `iso`, `convert`) and
 //!    [`tables`] (one module per paper table, the driver, and the report
 //!    writers: Markdown, CSV, JSON, SVG figures);
 //! 2. measurement, returning plain serialisable data — [`timing`], [`gpu`],
-//!    [`layouts`], [`accuracy`], [`extremes`], [`exitface`], [`outofcore`];
+//!    [`layouts`], [`accuracy`], [`extremes`], [`exitface`], [`outofcore`],
+//!    [`iso`];
 //! 3. plumbing — [`load`] (scenes and mesh files), [`camera`] (the default
 //!    view and the view flags), [`methods`] with the tracers that are not
 //!    in `tet-trace-cpu` ([`bvh`], [`strips`], [`brute`], `embree`), [`plots`] (SVG
@@ -30,6 +32,7 @@ mod embree;
 mod exitface;
 mod extremes;
 mod gpu;
+mod iso;
 mod layouts;
 mod load;
 mod methods;
@@ -56,6 +59,8 @@ fn main() -> ExitCode {
         Command::Render(a) => commands::render::run(a, cli.json),
         Command::Accuracy(a) => commands::accuracy::run(a, cli.json),
         Command::Tables(a) => tables::run(a, cli.json),
+        Command::Iso(a) => commands::iso::run(a, cli.json),
+        Command::Convert(a) => commands::convert::run(a, cli.json),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

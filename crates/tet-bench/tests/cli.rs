@@ -847,3 +847,86 @@ fn accuracy_counters_partition_the_rays_and_leaks_are_failures() {
         assert_eq!(n(m, "rays"), 1000 + 16 * 16);
     }
 }
+
+/// `iso`: the paper's IBVH (BIH and SAH, single rays and 16×16 packets)
+/// and the iso walks over three layouts find the isosurface on the same
+/// pixels of a synthetic volume (to a handful of grazing pixels), none
+/// fails, and a time step the field does not have is an error.
+#[test]
+fn iso_methods_agree() {
+    let mut hits = Vec::new();
+    for m in [
+        "ibvh",
+        "ibvh-sah",
+        "ibvh-packets",
+        "walk-tet20",
+        "walk-tet16",
+        "walk-tet32",
+    ] {
+        let d = json(&[
+            "iso",
+            "linear",
+            "--method",
+            m,
+            "--width",
+            "48",
+            "--height",
+            "40",
+            "--frames",
+            "1",
+            "--threads",
+            "1",
+        ]);
+        assert_eq!(d["failures"], 0, "{m}");
+        assert_eq!(d["rays"], 48 * 40, "{m}");
+        assert!(d["bytes"].as_u64().unwrap() > 0, "{m}");
+        hits.push(d["hits"].as_u64().unwrap());
+    }
+    let h0 = hits[0];
+    assert!(h0 > 200, "{hits:?}");
+    assert!(hits.iter().all(|&h| h.abs_diff(h0) <= h0 / 100), "{hits:?}");
+    let out = bench(&[
+        "iso",
+        "linear",
+        "--time-step",
+        "3",
+        "--width",
+        "8",
+        "--height",
+        "8",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("time step 3"));
+}
+
+/// `convert`: a volume with a scalar field goes to `.vtu`, back to a mesh
+/// file, to TetGen's files and back again, and arrives unchanged (points,
+/// tets, neighbours and the field's values, bit for bit).
+#[test]
+fn convert_round_trips_through_vtk_and_tetgen() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    for (from, to) in [
+        ("linear".to_string(), p("a.tmesh")),
+        (p("a.tmesh"), p("a.vtu")),
+        (p("a.vtu"), p("b.tmesh")),
+        (p("b.tmesh"), p("c.vtk")),
+        (p("c.vtk"), p("c.tmesh")),
+        (p("c.tmesh"), p("d.node")),
+        (p("d.node"), p("e.tmesh")),
+    ] {
+        let d = json(&["convert", &from, &to]);
+        assert_eq!(d["scalar_steps"], 1, "{from} -> {to}");
+    }
+    let a = tet_core::format::load(p("a.tmesh")).unwrap();
+    let field = |m: &tet_core::TetMesh| m.attributes.scalars.as_ref().unwrap().steps.clone();
+    for other in ["b.tmesh", "c.tmesh", "e.tmesh"] {
+        let m = tet_core::format::load(p(other)).unwrap();
+        assert_eq!(m.points, a.points, "{other}");
+        assert_eq!(m.tets, a.tets, "{other}");
+        assert_eq!(m.neighbors, a.neighbors, "{other}");
+        assert_eq!(field(&m), field(&a), "{other}");
+    }
+    let out = bench(&["convert", &p("missing.vtu"), &p("x.tmesh")]);
+    assert!(!out.status.success());
+}

@@ -117,7 +117,9 @@ fn sample_meshes() -> Vec<(&'static str, TetMesh)> {
         name: "density".into(),
         steps: vec![
             (0..n).map(|i| i as f32 - 3.5).collect(),
-            (0..n).map(|i| if i % 2 == 0 { -0.0 } else { 1e-30 }).collect(),
+            (0..n)
+                .map(|i| if i % 2 == 0 { -0.0 } else { 1e-30 })
+                .collect(),
         ],
     });
     vec![

@@ -4,6 +4,8 @@
 
 pub mod accuracy;
 pub mod build;
+pub mod convert;
 pub mod info;
+pub mod iso;
 pub mod render;
 mod text;

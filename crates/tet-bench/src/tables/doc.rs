@@ -148,6 +148,9 @@ pub struct TablesDoc {
     /// Speed against accuracy per method and precision on the first scene,
     /// as given and at the extremes (scaled, translated, slivers).
     pub speed_accuracy: Option<SpeedAccuracy>,
+    /// Isosurfaces of tet volumes (seed 004 Tables 1, 2, 4), per synthetic
+    /// volume.
+    pub isosurfaces: Vec<IsoRow>,
     /// Why there is no out-of-core table, if there is none.
     pub out_of_core_note: Option<String>,
     /// SVG figures written (paths).
@@ -210,4 +213,15 @@ pub struct StripsRow {
     pub bvh_geometry_bytes: usize,
     /// `strips-packets` render of the same view.
     pub packets: RenderDoc,
+}
+
+/// The isosurface methods on one synthetic volume (JSON `isosurfaces[]`).
+#[derive(Clone, Debug, Serialize)]
+pub struct IsoRow {
+    /// Synthetic volume name.
+    pub volume: String,
+    /// One `iso` document per method.
+    pub docs: Vec<crate::iso::IsoDoc>,
+    /// Why the volume failed, if it did.
+    pub error: Option<String>,
 }

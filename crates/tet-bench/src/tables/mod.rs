@@ -22,6 +22,9 @@
 //! * speed vs accuracy — Mrays/s beside the failure rate per method and
 //!   precision, as given and at the extremes ([`speed_accuracy`]);
 //! * seed 001 Table 5 — exit-face search cost per method ([`exit_face`]);
+//! * Wald et al. (seed 004) Tables 1, 2, 4 — isosurfaces of tet volumes:
+//!   the implicit min-max BVH (BIH and SAH builds, single rays, 16×16
+//!   packets) beside the iso walk over our layouts ([`isosurfaces`]);
 //! * Erkoç et al. (seed 003) Tables 2–3 — out of core: build time, parts
 //!   and peaks under limits of ½ and ⅓ of the in-core TetGen peak, full
 //!   mode ([`out_of_core`]).
@@ -40,6 +43,7 @@ mod entry;
 mod exit_face;
 mod figures;
 mod gpu;
+mod isosurfaces;
 mod memory;
 mod out_of_core;
 mod paper;
@@ -188,11 +192,13 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
         eprintln!("speed vs accuracy: {spec}, f32 and f64, as given and at the extremes");
         speed_accuracy::measure(spec, args.quick, args.min_time_s())
     });
+    let isosurfaces = isosurfaces::measure_all(args.quick, &pool);
     let mut doc = TablesDoc {
         setup,
         scenes,
         exit_face,
         speed_accuracy,
+        isosurfaces,
         out_of_core_note: args.quick.then(|| {
             "skipped in --quick mode: each scene is built twice more, in parts (run without --quick)"
                 .to_string()

@@ -1,0 +1,77 @@
+//! `tet-bench iso`: one volume, one method, timed frames, the image on
+//! request.
+
+use anyhow::{Result, bail};
+use tet_trace_cpu::render::{Frame, FrameStats};
+
+use crate::cli::IsoArgs;
+use crate::iso::{IsoFrames, load_iso_volume, measure, shade};
+use crate::output::{outln, print_json};
+use crate::timing::pool;
+
+/// `tet-bench iso`.
+pub fn run(args: &IsoArgs, json: bool) -> Result<()> {
+    let volume = load_iso_volume(&args.volume)?;
+    let isovalues = if args.isovalues.is_empty() {
+        vec![volume.default_isovalue]
+    } else {
+        args.isovalues.clone()
+    };
+    if args.width == 0 || args.height == 0 {
+        bail!("the image needs a width and a height of at least 1");
+    }
+    let pool = pool(args.threads)?;
+    let frames = IsoFrames {
+        width: args.width,
+        height: args.height,
+        frames: args.frames,
+        time_step: args.time_step,
+    };
+    let (doc, image) = measure(&volume, &isovalues, args.method, frames, &pool)?;
+    if let Some(path) = &args.output {
+        let frame = Frame {
+            width: args.width,
+            height: args.height,
+            color: shade(&image, &volume.mesh, args.width, args.height),
+            tets: vec![0; image.len()],
+            triangle: vec![u32::MAX; image.len()],
+            stats: FrameStats::default(),
+        };
+        frame.save_png(path)?;
+    }
+    if json {
+        print_json(&doc)?;
+    } else {
+        outln!(
+            "{} {} (step {} of {}, isovalues {:?}) {} tets, {}x{} {} threads: build {:.1} ms, best {:.1} ms ({:.1} fps), median {:.1} ms, {:.2} Mrays/s, {} hits, {} failures, {:.2} MB",
+            doc.volume,
+            doc.method.name(),
+            doc.time_step,
+            doc.steps,
+            doc.isovalues,
+            doc.tets,
+            doc.width,
+            doc.height,
+            doc.threads,
+            doc.build_ms,
+            doc.best_ms,
+            doc.fps,
+            doc.median_ms,
+            doc.mrays_per_s,
+            doc.hits,
+            doc.failures,
+            doc.bytes as f64 / 1e6
+        )?;
+        let c = &doc.per_ray;
+        outln!(
+            "  per ray: {:.1} nodes, {:.1} box tests, {:.1} range tests, {:.2} isopolygons, {:.2} isopolygon tests, {:.2} interval culls",
+            c.nodes_visited,
+            c.box_tests,
+            c.range_tests,
+            c.isopolygons,
+            c.isopolygon_tests,
+            c.frustum_culls
+        )?;
+    }
+    Ok(())
+}

@@ -1,0 +1,190 @@
+//! Isosurfaces of tetrahedral volumes (Wald et al., seed 004 Tables 1, 2
+//! and 4) on the synthetic stand-ins for the paper's data sets (same tet
+//! counts; the originals are not public): IBVH build time BIH vs SAH and
+//! render speed, 16×16 packets, and the iso walk over our compact layouts
+//! beside them, every method on the same rays and camera. `--quick`
+//! measures `ell32p` alone at 256²; the full run the four static sets at
+//! 1024².
+
+use std::fmt::Write as _;
+
+use anyhow::Result;
+
+use super::doc::{IsoRow, TablesDoc};
+use crate::iso::{IsoFrames, IsoMethod, load_iso_volume, measure};
+
+/// The paper's figures per data set: tets (Table 1), BIH and SAH build
+/// ms (Table 1, dual Core 2 Duo), laptop fps at 1024² (Table 2, 2 cores),
+/// 16×16 ray-box and ray-isopolygon tests per ray (Table 4).
+struct Paper {
+    /// Data set.
+    name: &'static str,
+    /// Tets.
+    tets: u64,
+    /// BIH build, ms.
+    bih_ms: f64,
+    /// SAH build, ms.
+    sah_ms: f64,
+    /// Laptop fps (Core Duo 2.33 GHz, 2 cores).
+    laptop_fps: f64,
+    /// 16×16 packets: ray-box tests per ray.
+    box_tests: f64,
+    /// 16×16 packets: ray-isopolygon tests per ray.
+    isopolygon_tests: f64,
+}
+
+/// The paper's four static data sets.
+const PAPER: [Paper; 4] = [
+    Paper {
+        name: "ell32p",
+        tets: 148_955,
+        bih_ms: 46.0,
+        sah_ms: 2432.0,
+        laptop_fps: 14.2,
+        box_tests: 1.11,
+        isopolygon_tests: 3.39,
+    },
+    Paper {
+        name: "feok",
+        tets: 121_668,
+        bih_ms: 42.0,
+        sah_ms: 1854.0,
+        laptop_fps: 12.6,
+        box_tests: 1.10,
+        isopolygon_tests: 3.86,
+    },
+    Paper {
+        name: "bucky",
+        tets: 224_874,
+        bih_ms: 61.0,
+        sah_ms: 2932.0,
+        laptop_fps: 13.3,
+        box_tests: 1.8,
+        isopolygon_tests: 4.42,
+    },
+    Paper {
+        name: "blunt",
+        tets: 176_856,
+        bih_ms: 87.0,
+        sah_ms: 3887.0,
+        laptop_fps: 18.9,
+        box_tests: 0.94,
+        isopolygon_tests: 3.19,
+    },
+];
+
+/// Every method on the stand-ins (`quick`: ell32p at 256²).
+pub fn measure_all(quick: bool, pool: &rayon::ThreadPool) -> Vec<IsoRow> {
+    let (names, side, frames): (&[&str], u32, u32) = if quick {
+        (&["ell32p"], 256, 2)
+    } else {
+        (&["ell32p", "feok", "bucky", "blunt"], 1024, 3)
+    };
+    let mut rows = Vec::new();
+    for name in names {
+        eprintln!("isosurfaces: {name}, {side}², every method");
+        let row = (|| -> Result<IsoRow> {
+            let volume = load_iso_volume(name)?;
+            let iso = [volume.default_isovalue];
+            let f = IsoFrames {
+                width: side,
+                height: side,
+                frames,
+                time_step: 0,
+            };
+            let docs = IsoMethod::ALL
+                .iter()
+                .map(|&m| measure(&volume, &iso, m, f, pool).map(|x| x.0))
+                .collect::<Result<Vec<_>>>()?;
+            Ok(IsoRow {
+                volume: name.to_string(),
+                docs,
+                error: None,
+            })
+        })();
+        rows.push(row.unwrap_or_else(|e| IsoRow {
+            volume: name.to_string(),
+            docs: Vec::new(),
+            error: Some(format!("{e:#}")),
+        }));
+    }
+    rows
+}
+
+/// The tables.
+pub fn markdown(m: &mut String, doc: &TablesDoc) {
+    if doc.isosurfaces.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        m,
+        "\n## Isosurfaces of tet volumes (seed 004 Tables 1, 2, 4)\n"
+    );
+    let _ = writeln!(
+        m,
+        "Synthetic stand-ins with the paper's tet counts (`tet_build::volume`; the originals are not public), one isovalue, the same camera and rays for every method; {} threads here. `ibvh`/`ibvh-sah`: the implicit min-max BVH built BIH-style or by SAH, single rays; `ibvh-packets`: 16×16 packets; `walk-*`: the iso walk over our compact layouts (no BVH). Paper: build ms on a dual Core 2 Duo (Table 1), fps at 1024² on a 2-core laptop (Table 2), 16×16 tests per ray (Table 4).\n",
+        doc.setup.threads
+    );
+    let _ = writeln!(
+        m,
+        "| volume | tets (paper) | method | build ms | paper build ms | fps | Mrays/s | paper laptop fps | MB | box tests/ray | isopolygon tests/ray | paper 16×16 box / isopolygon tests |"
+    );
+    let _ = writeln!(
+        m,
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for row in &doc.isosurfaces {
+        if let Some(e) = &row.error {
+            let _ = writeln!(m, "| {} | | failed: {e} | | | | | | | | | |", row.volume);
+            continue;
+        }
+        let paper = PAPER.iter().find(|p| p.name == row.volume);
+        for d in &row.docs {
+            let dash = || "–".to_string();
+            let build = paper.map_or_else(dash, |p| match d.method {
+                IsoMethod::Ibvh | IsoMethod::IbvhPackets => format!("{:.0}", p.bih_ms),
+                IsoMethod::IbvhSah => format!("{:.0}", p.sah_ms),
+                _ => dash(),
+            });
+            let tests = paper
+                .filter(|_| d.method == IsoMethod::IbvhPackets)
+                .map_or_else(dash, |p| {
+                    format!("{} / {}", p.box_tests, p.isopolygon_tests)
+                });
+            let _ = writeln!(
+                m,
+                "| {} | {} ({}) | {} | {:.1} | {build} | {:.1} | {:.2} | {} | {:.2} | {:.2} | {:.2} | {tests} |",
+                row.volume,
+                d.tets,
+                paper.map_or_else(dash, |p| p.tets.to_string()),
+                d.method.name(),
+                d.build_ms,
+                d.fps,
+                d.mrays_per_s,
+                paper.map_or_else(dash, |p| format!("{:.1}", p.laptop_fps)),
+                d.bytes as f64 / 1e6,
+                d.per_ray.box_tests,
+                d.per_ray.isopolygon_tests,
+            );
+        }
+        let speed = |m: IsoMethod| {
+            row.docs
+                .iter()
+                .find(|d| d.method == m)
+                .map(|d| d.mrays_per_s)
+        };
+        if let (Some(w), Some(b), Some(p)) = (
+            speed(IsoMethod::WalkTet20),
+            speed(IsoMethod::Ibvh),
+            speed(IsoMethod::IbvhPackets),
+        ) {
+            let _ = writeln!(
+                m,
+                "| {} | | walk-tet20 ÷ ibvh = {:.2}, ÷ ibvh-packets = {:.2} | | | | | | | | | |",
+                row.volume,
+                w / b,
+                w / p
+            );
+        }
+    }
+}
