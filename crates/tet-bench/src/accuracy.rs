@@ -191,8 +191,11 @@ fn a3(v: Vec3) -> Vec3A {
 /// Grazing tolerance of a mesh (see the module docs).
 pub fn tolerance(mesh: &TetMesh) -> f64 {
     let (lo, hi) = mesh.point_bounds();
-    let diag = (hi - lo).length() as f64;
-    let mag = lo.abs().max(hi.abs()).max_element() as f64;
+    // In f64: the diagonal of a scene at 1e30 overflows f32, one at 1e-30
+    // underflows.
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    let diag = (hi - lo).length();
+    let mag = lo.abs().max(hi.abs()).max_element();
     (1e-5 * diag).max(4e-7 * mag)
 }
 
@@ -202,7 +205,7 @@ impl<'m> Reference<'m> {
         let tol = tolerance(mesh);
         // Built on the scene scaled by a power of two (see `unit_scale`).
         let scale = unit_scale(mesh);
-        let pad = Vec3A::splat((tol * 2.0) as f32 * scale);
+        let pad = Vec3A::splat((tol * 2.0 * scale as f64) as f32);
         let boxes: Vec<Aabb> = mesh
             .constrained
             .iter()
@@ -489,7 +492,7 @@ pub fn adversarial_rays(mesh: &TetMesh, n: usize, seed: u64) -> Vec<(Ray, Option
             4 => (on_face, random_direction(&mut rng), near),
             _ => (tri[0], random_direction(&mut rng), near),
         };
-        if dir.length_squared() == 0.0 || !dir.is_finite() {
+        if dir == Vec3::ZERO || !dir.is_finite() {
             continue;
         }
         let hint = if hint < mesh.tets.len() as u32 {

@@ -172,9 +172,15 @@ pub fn enclosing_box(scene: &Scene, extra: &[Vec3], wide: bool) -> tet_build::bb
             (a.min(*p), b.max(*p))
         });
     let relative = if wide { 0.1 } else { TIGHT_BOX_MARGIN };
-    let margin = ((max - min).max_element() * relative)
-        .max(1e-3 * max.abs().max(min.abs()).max_element())
-        .max(1e-6);
+    // Relative to the scene only: an absolute floor would dwarf a scene at
+    // 1e-30 (its box would be 1e24 times its size).
+    let margin =
+        ((max - min).max_element() * relative).max(1e-3 * max.abs().max(min.abs()).max_element());
+    let margin = if margin > 0.0 && margin.is_finite() {
+        margin
+    } else {
+        1e-6
+    };
     tet_build::bbox::BoxSpec::Fixed {
         min: min - Vec3::splat(margin),
         max: max + Vec3::splat(margin),
