@@ -16,71 +16,25 @@ use std::path::Path;
 use tet_core::TetMesh;
 
 use super::model::{
-    Array, Grid, KIND_ARRAY, TRIANGLE_ARRAY, TRIANGLE_COUNT_FIELD, step_array_name,
+    Array, DataType, Grid, KIND_ARRAY, TRIANGLE_ARRAY, TRIANGLE_COUNT_FIELD, step_array_name,
 };
 use super::{VTK_TETRA, VTK_TRIANGLE, VtkEncoding, VtkError};
 
-/// Element types of legacy data sections.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum DataType {
-    F32,
-    F64,
-    I8,
-    U8,
-    I16,
-    U16,
-    I32,
-    U32,
-    I64,
-    U64,
-}
-
-impl DataType {
-    fn parse(name: &str) -> Option<DataType> {
-        Some(match name.to_ascii_lowercase().as_str() {
-            "float" => DataType::F32,
-            "double" => DataType::F64,
-            "char" | "vtktypeint8" => DataType::I8,
-            "unsigned_char" | "vtktypeuint8" => DataType::U8,
-            "short" | "vtktypeint16" => DataType::I16,
-            "unsigned_short" | "vtktypeuint16" => DataType::U16,
-            "int" | "vtktypeint32" | "vtkidtype" => DataType::I32,
-            "unsigned_int" | "vtktypeuint32" => DataType::U32,
-            "long" | "vtktypeint64" => DataType::I64,
-            "unsigned_long" | "vtktypeuint64" => DataType::U64,
-            _ => return None,
-        })
-    }
-
-    fn size(self) -> usize {
-        match self {
-            DataType::I8 | DataType::U8 => 1,
-            DataType::I16 | DataType::U16 => 2,
-            DataType::F32 | DataType::I32 | DataType::U32 => 4,
-            DataType::F64 | DataType::I64 | DataType::U64 => 8,
-        }
-    }
-
-    /// The big-endian value in `b` (`b.len() == self.size()`).
-    fn decode_be(self, b: &[u8]) -> f64 {
-        let a = |n: usize| -> [u8; 8] {
-            let mut x = [0u8; 8];
-            x[..n].copy_from_slice(&b[..n]);
-            x
-        };
-        match self {
-            DataType::F32 => f64::from(f32::from_be_bytes(a(4)[..4].try_into().unwrap())),
-            DataType::F64 => f64::from_be_bytes(a(8)),
-            DataType::I8 => f64::from(b[0] as i8),
-            DataType::U8 => f64::from(b[0]),
-            DataType::I16 => f64::from(i16::from_be_bytes([b[0], b[1]])),
-            DataType::U16 => f64::from(u16::from_be_bytes([b[0], b[1]])),
-            DataType::I32 => f64::from(i32::from_be_bytes(a(4)[..4].try_into().unwrap())),
-            DataType::U32 => f64::from(u32::from_be_bytes(a(4)[..4].try_into().unwrap())),
-            DataType::I64 => i64::from_be_bytes(a(8)) as f64,
-            DataType::U64 => u64::from_be_bytes(a(8)) as f64,
-        }
-    }
+/// A legacy data section's type name (`float`, `vtktypeint64`, …).
+fn legacy_type(name: &str) -> Option<DataType> {
+    Some(match name.to_ascii_lowercase().as_str() {
+        "float" => DataType::F32,
+        "double" => DataType::F64,
+        "char" | "vtktypeint8" => DataType::I8,
+        "unsigned_char" | "vtktypeuint8" => DataType::U8,
+        "short" | "vtktypeint16" => DataType::I16,
+        "unsigned_short" | "vtktypeuint16" => DataType::U16,
+        "int" | "vtktypeint32" | "vtkidtype" => DataType::I32,
+        "unsigned_int" | "vtktypeuint32" => DataType::U32,
+        "long" | "vtktypeint64" => DataType::I64,
+        "unsigned_long" | "vtktypeuint64" => DataType::U64,
+        _ => return None,
+    })
 }
 
 /// A position in the file: byte offset and 1-based line.
@@ -181,7 +135,10 @@ impl<'a> Cursor<'a> {
             let data = &self.bytes[self.pos..self.pos + needed];
             self.pos += needed;
             self.line += data.iter().filter(|&&b| b == b'\n').count();
-            let out: Vec<f64> = data.chunks_exact(size).map(|c| ty.decode_be(c)).collect();
+            let out: Vec<f64> = data
+                .chunks_exact(size)
+                .map(|c| ty.decode(c, true))
+                .collect();
             if let Some(i) = out.iter().position(|v| !v.is_finite()) {
                 return Err(self.err(start_line, format!("{what}: value {i} is {}", out[i])));
             }
@@ -222,7 +179,7 @@ impl<'a> Cursor<'a> {
         let w = words
             .get(i)
             .ok_or_else(|| self.err(line, "missing data type"))?;
-        DataType::parse(w).ok_or_else(|| self.err(line, format!("unknown data type {w:?}")))
+        legacy_type(w).ok_or_else(|| self.err(line, format!("unknown data type {w:?}")))
     }
 }
 

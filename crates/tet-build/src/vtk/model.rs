@@ -310,3 +310,53 @@ fn field_of(arrays: &[Array], n: usize, path: &Path) -> Result<Option<ScalarFiel
     })?;
     Ok(Some(ScalarField { name, steps }))
 }
+
+/// Element types of VTK data arrays (legacy and XML name them differently:
+/// see each reader's `data_type`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum DataType {
+    F32,
+    F64,
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    I64,
+    U64,
+}
+
+impl DataType {
+    /// Bytes per value.
+    pub(super) fn size(self) -> usize {
+        match self {
+            DataType::I8 | DataType::U8 => 1,
+            DataType::I16 | DataType::U16 => 2,
+            DataType::F32 | DataType::I32 | DataType::U32 => 4,
+            DataType::F64 | DataType::I64 | DataType::U64 => 8,
+        }
+    }
+
+    /// The value in `b` (`self.size()` bytes) in byte order `big`.
+    pub(super) fn decode(self, b: &[u8], big: bool) -> f64 {
+        let mut x = [0u8; 8];
+        x[..b.len()].copy_from_slice(b);
+        if big {
+            x[..b.len()].reverse();
+        }
+        let w4 = [x[0], x[1], x[2], x[3]];
+        match self {
+            DataType::F32 => f64::from(f32::from_le_bytes(w4)),
+            DataType::F64 => f64::from_le_bytes(x),
+            DataType::I8 => f64::from(x[0] as i8),
+            DataType::U8 => f64::from(x[0]),
+            DataType::I16 => f64::from(i16::from_le_bytes([x[0], x[1]])),
+            DataType::U16 => f64::from(u16::from_le_bytes([x[0], x[1]])),
+            DataType::I32 => f64::from(i32::from_le_bytes(w4)),
+            DataType::U32 => f64::from(u32::from_le_bytes(w4)),
+            DataType::I64 => i64::from_le_bytes(x) as f64,
+            DataType::U64 => u64::from_le_bytes(x) as f64,
+        }
+    }
+}

@@ -15,72 +15,25 @@ use tet_core::TetMesh;
 
 use super::base64;
 use super::model::{
-    Array, Grid, KIND_ARRAY, TRIANGLE_ARRAY, TRIANGLE_COUNT_FIELD, step_array_name,
+    Array, DataType, Grid, KIND_ARRAY, TRIANGLE_ARRAY, TRIANGLE_COUNT_FIELD, step_array_name,
 };
 use super::{VTK_TETRA, VTK_TRIANGLE, VtkEncoding, VtkError};
 
-/// Element types of XML data arrays.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum DataType {
-    F32,
-    F64,
-    I8,
-    U8,
-    I16,
-    U16,
-    I32,
-    U32,
-    I64,
-    U64,
-}
-
-impl DataType {
-    fn parse(name: &str) -> Option<DataType> {
-        Some(match name {
-            "Float32" => DataType::F32,
-            "Float64" => DataType::F64,
-            "Int8" => DataType::I8,
-            "UInt8" => DataType::U8,
-            "Int16" => DataType::I16,
-            "UInt16" => DataType::U16,
-            "Int32" => DataType::I32,
-            "UInt32" => DataType::U32,
-            "Int64" => DataType::I64,
-            "UInt64" => DataType::U64,
-            _ => return None,
-        })
-    }
-
-    fn size(self) -> usize {
-        match self {
-            DataType::I8 | DataType::U8 => 1,
-            DataType::I16 | DataType::U16 => 2,
-            DataType::F32 | DataType::I32 | DataType::U32 => 4,
-            DataType::F64 | DataType::I64 | DataType::U64 => 8,
-        }
-    }
-
-    /// The value in `b` (`self.size()` bytes) in byte order `big`.
-    fn decode(self, b: &[u8], big: bool) -> f64 {
-        let mut x = [0u8; 8];
-        x[..b.len()].copy_from_slice(b);
-        if big {
-            x[..b.len()].reverse();
-        }
-        let w4 = [x[0], x[1], x[2], x[3]];
-        match self {
-            DataType::F32 => f64::from(f32::from_le_bytes(w4)),
-            DataType::F64 => f64::from_le_bytes(x),
-            DataType::I8 => f64::from(x[0] as i8),
-            DataType::U8 => f64::from(x[0]),
-            DataType::I16 => f64::from(i16::from_le_bytes([x[0], x[1]])),
-            DataType::U16 => f64::from(u16::from_le_bytes([x[0], x[1]])),
-            DataType::I32 => f64::from(i32::from_le_bytes(w4)),
-            DataType::U32 => f64::from(u32::from_le_bytes(w4)),
-            DataType::I64 => i64::from_le_bytes(x) as f64,
-            DataType::U64 => u64::from_le_bytes(x) as f64,
-        }
-    }
+/// An XML data array's type name (`Float32`, `Int64`, …).
+fn xml_type(name: &str) -> Option<DataType> {
+    Some(match name {
+        "Float32" => DataType::F32,
+        "Float64" => DataType::F64,
+        "Int8" => DataType::I8,
+        "UInt8" => DataType::U8,
+        "Int16" => DataType::I16,
+        "UInt16" => DataType::U16,
+        "Int32" => DataType::I32,
+        "UInt32" => DataType::U32,
+        "Int64" => DataType::I64,
+        "UInt64" => DataType::U64,
+        _ => return None,
+    })
 }
 
 /// The file-wide settings and the appended data.
@@ -137,7 +90,7 @@ impl Context<'_> {
     fn values(&self, node: Node, expected: usize) -> Result<Array, VtkError> {
         let name = node.attribute("Name").unwrap_or("").to_string();
         let ty_name = node.attribute("type").unwrap_or("");
-        let ty = DataType::parse(ty_name)
+        let ty = xml_type(ty_name)
             .ok_or_else(|| self.err(node, format!("{name}: unknown type {ty_name:?}")))?;
         let components = match node.attribute("NumberOfComponents") {
             Some(_) => self.count_attr(node, "NumberOfComponents")?,

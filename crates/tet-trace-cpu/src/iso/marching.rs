@@ -141,19 +141,11 @@ impl IsoPolygon {
     }
 }
 
-/// The walk's 2-D edge test with its tie rule, keyed by edge keys.
+/// The walk's 2-D edge test with its tie rule ([`crate::walk`]'s
+/// `left_2d!`), keyed by edge keys.
 #[inline(always)]
 fn left_key(a: Vec2, ka: u64, b: Vec2, kb: u64) -> bool {
-    let det = a.x * b.y - a.y * b.x;
-    if det != 0.0 {
-        det > 0.0
-    } else if a.y != b.y {
-        a.y > b.y
-    } else if a.x != b.x {
-        b.x > a.x
-    } else {
-        ka < kb
-    }
+    crate::walk::left_2d!(a, ka, b, kb)
 }
 
 /// Per-ray constants of the isopolygon test: the ray-centred projection

@@ -103,6 +103,7 @@ mod tests;
 
 pub use entry::{BoundaryEntry, EntryHint, ViewpointError};
 pub use lanes::{LANES, Starts, trace_interleaved};
+pub(crate) use projection::left_2d;
 pub(crate) use projection::left_f32;
 pub(crate) use projection::simd_face;
 pub use projection::{

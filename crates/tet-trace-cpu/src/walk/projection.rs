@@ -176,6 +176,7 @@ macro_rules! left_2d {
         }
     }};
 }
+pub(crate) use left_2d;
 
 /// The tie rule of the module docs on f32 2-D points (shared by every f32
 /// 2-D projection).
