@@ -10,6 +10,8 @@
 //! broken by tet and isovalue index), whatever order leaves are visited in:
 //! the packet traversal ([`super::packet`]) gives the same bits.
 
+use glam::Vec3;
+
 use super::ibvh::{Ibvh, Node};
 use super::marching::{IsoPolygon, RayPre};
 use super::{IsoHit, IsoQuery, IsoStats, gradient};
@@ -137,6 +139,29 @@ impl Ibvh {
         }
     }
 
+    /// Primitive `j`'s vertex ids, positions and values when some isovalue
+    /// of `query` lies in its value range (one range test counted), for
+    /// the single-ray and the packet leaf alike.
+    #[inline]
+    pub(crate) fn straddling_prim(
+        &self,
+        j: usize,
+        query: &IsoQuery,
+        stats: &mut IsoStats,
+    ) -> Option<([u32; 4], [Vec3; 4], [f32; 4])> {
+        let ids = self.prims[j];
+        let p4 = ids.map(|i| self.points[i as usize]);
+        let v = p4.map(|p| p.w);
+        stats.range_tests += 1;
+        let (lo, hi) = (
+            v[0].min(v[1]).min(v[2].min(v[3])),
+            v[0].max(v[1]).max(v[2].max(v[3])),
+        );
+        query
+            .active(lo, hi)
+            .then(|| (ids, p4.map(|q| q.truncate()), v))
+    }
+
     /// Tests primitive `j` against one ray, keeping the best crossing.
     #[inline]
     pub(crate) fn leaf_prim(
@@ -147,18 +172,9 @@ impl Ibvh {
         best: &mut Option<IsoHit>,
         stats: &mut IsoStats,
     ) {
-        let ids = self.prims[j];
-        let p4 = ids.map(|i| self.points[i as usize]);
-        let v = p4.map(|p| p.w);
-        stats.range_tests += 1;
-        let (lo, hi) = (
-            v[0].min(v[1]).min(v[2].min(v[3])),
-            v[0].max(v[1]).max(v[2].max(v[3])),
-        );
-        if !query.active(lo, hi) {
+        let Some((ids, p, v)) = self.straddling_prim(j, query, stats) else {
             return;
-        }
-        let p = p4.map(|q| q.truncate());
+        };
         for (k, &iso) in query.isovalues.iter().enumerate() {
             let Some(poly) = IsoPolygon::new(ids, p, v, iso) else {
                 continue;

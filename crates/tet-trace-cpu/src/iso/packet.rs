@@ -254,18 +254,9 @@ impl Ibvh {
     ) -> bool {
         let mut changed = false;
         for j in from..from + count {
-            let ids = self.prims[j];
-            let p4 = ids.map(|i| self.points[i as usize]);
-            let v = p4.map(|p| p.w);
-            stats.range_tests += 1;
-            let (lo, hi) = (
-                v[0].min(v[1]).min(v[2].min(v[3])),
-                v[0].max(v[1]).max(v[2].max(v[3])),
-            );
-            if !query.active(lo, hi) {
+            let Some((ids, p, v)) = self.straddling_prim(j, query, stats) else {
                 continue;
-            }
-            let p = p4.map(|q| q.truncate());
+            };
             for (k, &iso) in query.isovalues.iter().enumerate() {
                 let Some(poly) = IsoPolygon::new(ids, p, v, iso) else {
                     continue;
