@@ -27,7 +27,7 @@ use obvhs::triangle::Triangle;
 use tet_core::TetMesh;
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Hit, Ray, TraceOutcome};
-use tet_trace_cpu::walk::Start;
+use tet_trace_cpu::walk::{Start, walk_scale};
 
 /// A BVH2 over the constrained faces of a mesh (the scene triangles).
 pub struct BvhTracer<'m> {
@@ -57,11 +57,10 @@ pub fn unit_scale(mesh: &TetMesh) -> f32 {
         .iter()
         .map(|p| p.abs().max_element())
         .fold(0.0f32, f32::max);
-    if !(m.is_finite() && m > 0.0) || (1.0 / 65536.0..=65536.0).contains(&m) {
+    let s = walk_scale(m as f64);
+    if s == 1.0 {
         return 1.0;
     }
-    let e = (m as f64).log2().floor() as i32;
-    let s = (2.0f64).powi(-e.clamp(-126, 126)) as f32;
     // Exact unless a coordinate falls into the subnormals: then unscaled.
     let exact = mesh.points.iter().all(|&p| (p * s) / s == p);
     if exact { s } else { 1.0 }
@@ -210,15 +209,11 @@ impl<'m> BvhTracer<'m> {
     }
 }
 
-/// A power of two that brings the largest component of a (valid)
-/// direction into `[1, 2)` when it lies outside `[2⁻⁸, 2⁸]`, else 1.
+/// The power of two that brings the largest component of a (valid)
+/// direction near 1 when it lies outside `[2⁻¹⁶, 2¹⁶]`, else 1 (the walks'
+/// [`walk_scale`]): obvhs treats components below `f32::EPSILON` as zero.
 fn direction_scale(d: Vec3) -> f32 {
-    let m = d.abs().max_element();
-    if (1.0 / 256.0..=256.0).contains(&m) {
-        return 1.0;
-    }
-    let e = (m as f64).log2().floor() as i32;
-    (2.0f64).powi(-e.clamp(-126, 126)) as f32
+    walk_scale(d.abs().max_element() as f64)
 }
 
 /// The hit record of a BVH-style tracer that found constrained face `face`
