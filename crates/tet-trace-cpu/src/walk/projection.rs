@@ -194,8 +194,12 @@ pub(crate) fn left_f32(a: Vec2, ia: u32, b: Vec2, ib: u32) -> bool {
 /// coordinates near 1 and their determinants far from f32's limits. Only
 /// the walk's signs depend on the projection, and a power of two keeps
 /// them, so any such factor gives the same walk.
+#[inline]
 pub fn walk_scale(magnitude: f64) -> f32 {
-    if !(magnitude.is_finite() && magnitude > 0.0) {
+    // Two comparisons for ordinary scenes (every ray sets up its scale):
+    // no logarithm on the hot path.
+    if (1.0 / 65536.0..131072.0).contains(&magnitude) || !(magnitude.is_finite() && magnitude > 0.0)
+    {
         return 1.0;
     }
     let e = magnitude.log2().floor() as i32;
