@@ -376,9 +376,33 @@ pub struct TablesArgs {
     /// repeated passes (default: 0.5, or 0.2 with `--quick`).
     #[arg(long)]
     pub min_time: Option<f64>,
+    /// Sizes of the large-model table (Torus Knots tessellated to about
+    /// this many triangles; `k`/`m` suffixes; `none` for no table).
+    /// Default: 1m,10m,30m, or none with `--quick`.
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_size)]
+    pub large_models: Option<Vec<u64>>,
+}
+
+/// A `--large-models` entry: a count (`1m`, `300k`, `250000`) or `none` (0).
+fn parse_size(text: &str) -> Result<u64, String> {
+    if text.trim().eq_ignore_ascii_case("none") {
+        return Ok(0);
+    }
+    tet_build::procedural::parse_count(text).ok_or_else(|| {
+        format!("`{text}` is not a count (digits, optionally with k or m) or `none`")
+    })
 }
 
 impl TablesArgs {
+    /// Sizes of the large-model table (see `--large-models`).
+    pub fn large_model_sizes(&self) -> Vec<u64> {
+        match &self.large_models {
+            Some(sizes) => sizes.iter().copied().filter(|&n| n > 0).collect(),
+            None if self.quick => Vec::new(),
+            None => vec![1_000_000, 10_000_000, 30_000_000],
+        }
+    }
+
     /// Seconds each method is timed over the accuracy rays, at least.
     pub fn min_time_s(&self) -> f64 {
         self.min_time.unwrap_or(if self.quick { 0.2 } else { 0.5 })

@@ -469,6 +469,8 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
         plots.to_str().unwrap(),
         "--scene",
         obj.to_str().unwrap(),
+        "--large-models",
+        "1k",
     ]);
     let sc = doc["scenes"].as_array().unwrap();
     assert_eq!(sc.len(), 4, "three scenes of --scenes, one of --scene");
@@ -521,7 +523,7 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
         .iter()
         .map(|f| f.as_str().unwrap())
         .collect();
-    assert_eq!(figures.len(), 3);
+    assert_eq!(figures.len(), 4);
     let marks = |name: &str| {
         let path = plots.join(name);
         assert!(figures.contains(&path.to_str().unwrap()), "{figures:?}");
@@ -549,6 +551,39 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
     assert_eq!(marks("speed_vs_accuracy.svg"), (accuracy_points, 0));
     assert_eq!(marks("mrays_per_method.svg"), (0, 4 * methods));
     assert_eq!(marks("figure8_sorted_vs_unsorted.svg"), (0, 2 * 4));
+
+    // Large models: the smallest dense knots are Torus Knots themselves
+    // (77,760 triangles); Ray-Strips, the BVH and Tet20 see the same
+    // image, and Ray-Strips is the smaller of the two triangle structures.
+    let large = doc["large_models"].as_array().unwrap();
+    assert_eq!(large.len(), 1);
+    assert!(large[0]["error"].is_null(), "{}", large[0]["error"]);
+    assert_eq!(large[0]["triangles"], 77_760);
+    let structures = large[0]["structures"].as_array().unwrap();
+    let names: Vec<&str> = structures
+        .iter()
+        .map(|s| s["structure"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["strips", "obvhs", "tet20"]);
+    for s in structures {
+        assert_eq!(s["render"]["failures"], 0, "{s}");
+        assert_eq!(s["render"]["hits"], structures[0]["render"]["hits"], "{s}");
+    }
+    assert!(structures[0]["render"]["hits"].as_u64().unwrap() > 0);
+    let bpt = |i: usize| structures[i]["bytes_per_triangle"].as_f64().unwrap();
+    assert!(
+        bpt(0) < bpt(1),
+        "Ray-Strips {} B/tri, BVH {}",
+        bpt(0),
+        bpt(1)
+    );
+    assert!(md.contains("Large models (seed 002 §6)"));
+    // One mark per structure with bytes and a render: tet20, tet16, tet32,
+    // Ray-Strips and obvhs per scene, plus the large model's three.
+    assert_eq!(
+        marks("bytes_per_triangle_vs_mrays.svg"),
+        (4 * 5 + structures.len(), 0)
+    );
 }
 
 /// `build` stores the scene's camera and lights in the mesh file, and

@@ -46,7 +46,12 @@ pub const NAMES: &[&str] = &[
     "thin-slab",
 ];
 
-/// Build a procedural scene by name (see [`NAMES`]).
+/// Parameterised names accepted by [`by_name`] besides [`NAMES`]:
+/// `dense-knots:N` is "Torus Knots" with about `N` triangles
+/// ([`dense_torus_knots`]; `N` may end in `k` or `m`).
+pub const PATTERNS: &[&str] = &["dense-knots:N"];
+
+/// Build a procedural scene by name (see [`NAMES`] and [`PATTERNS`]).
 pub fn by_name(name: &str) -> Option<Scene> {
     let single = |n: &str, mesh: MeshData| single_object_scene(n, &mesh);
     Some(match name {
@@ -58,8 +63,65 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "sphere" => single("sphere", icosphere(2)),
         "two-quads" => single("two-quads", two_quads(0.5)),
         "thin-slab" => single("thin-slab", thin_slab(0.01)),
-        _ => return None,
+        _ => return dense_knots_by_name(name),
     })
+}
+
+/// `dense-knots:N`: [`dense_torus_knots`] with about `N` triangles
+/// ([`parse_count`]), e.g. `dense-knots:10m`.
+fn dense_knots_by_name(name: &str) -> Option<Scene> {
+    let n = parse_count(name.strip_prefix("dense-knots:")?)?;
+    Some(dense_torus_knots(n))
+}
+
+/// A count written as digits with an optional `k` or `m` suffix
+/// (thousands, millions; fractions allowed: `0.5m`), from 1 to 10⁹.
+pub fn parse_count(text: &str) -> Option<u64> {
+    let text = text.trim().to_ascii_lowercase();
+    let (digits, unit) = match text.as_bytes().last()? {
+        b'k' => (&text[..text.len() - 1], 1_000.0),
+        b'm' => (&text[..text.len() - 1], 1_000_000.0),
+        _ => (text.as_str(), 1.0),
+    };
+    let n = digits.parse::<f64>().ok()? * unit;
+    (n.is_finite() && (1.0..=1e9).contains(&n)).then_some(n.round() as u64)
+}
+
+/// "Torus Knots" at any size: the same 27 knots, grid, camera and light,
+/// each knot's tube subdivided by a factor `s` in both directions
+/// (`⌈120·s⌉` segments of `⌈12·s⌉` sides) so that the scene has about
+/// `triangles` triangles (never fewer than the original 77,760). It is the
+/// large model of the Ray-Strips comparison (Lauterbach et al., seed 002
+/// §6: Ray-Strips against a BVH as the model outgrows memory): the same
+/// view and shape at every size, only the tessellation grows.
+pub fn dense_torus_knots(triangles: u64) -> Scene {
+    let base = TorusKnotParams::default();
+    let per_knot = triangles as f64 / 27.0;
+    let s = (per_knot / f64::from(2 * base.segments * base.sides))
+        .sqrt()
+        .max(1.0);
+    let knot = torus_knot(&TorusKnotParams {
+        segments: (f64::from(base.segments) * s).ceil() as u32,
+        sides: (f64::from(base.sides) * s).ceil() as u32,
+        ..base
+    });
+    let placed: Vec<ObjectPlacement<'_>> = torus_knot_grid()
+        .into_iter()
+        .map(|t| ObjectPlacement {
+            name: "Torus Knot".into(),
+            mesh: &knot,
+            transform: Transform::translate(t),
+            pre_transform: None,
+        })
+        .collect();
+    let name = format!("Torus Knots, {} triangles", 27 * knot.triangles.len());
+    Scene::from_objects(
+        &name,
+        &placed,
+        Some(torus_knots_camera()),
+        vec![torus_knots_light()],
+    )
+    .expect("procedural meshes are finite")
 }
 
 fn single_object_scene(name: &str, mesh: &MeshData) -> Scene {

@@ -38,7 +38,12 @@ impl Scene {
             spec: spec.into(),
             message: format!(
                 "expected an .obj path, `scenes.json#Scene Name`, or one of the procedural scenes: {}",
-                procedural::NAMES.join(", ")
+                procedural::NAMES
+                    .iter()
+                    .chain(procedural::PATTERNS)
+                    .copied()
+                    .collect::<Vec<_>>()
+                    .join(", ")
             ),
         })
     }

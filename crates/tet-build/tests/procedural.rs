@@ -276,3 +276,44 @@ fn torus_knots_box_scene_does_not_self_intersect() {
     );
     assert!(r.pairs.is_empty());
 }
+
+#[test]
+fn dense_knots_at_the_original_size_are_torus_knots() {
+    let dense = procedural::dense_torus_knots(77_760);
+    let original = procedural::by_name("torus-knots").unwrap();
+    assert_eq!(dense.vertices, original.vertices);
+    assert_eq!(dense.triangles, original.triangles);
+    assert_eq!(dense.camera, original.camera);
+}
+
+#[test]
+fn dense_knots_reach_the_asked_size_closed_and_oriented() {
+    for (name, at_least) in [("dense-knots:300k", 300_000), ("dense-knots:0.5M", 500_000)] {
+        let s = procedural::by_name(name).unwrap_or_else(|| panic!("{name}"));
+        let n = s.triangles.len();
+        assert!(
+            n >= at_least && n < at_least * 11 / 10,
+            "{name}: {n} triangles"
+        );
+        assert_eq!(s.objects.len(), 27);
+        // Every knot closed and outward: positive volume close to the
+        // original tube's (same knot, finer tessellation).
+        let o = &s.objects[0];
+        let tris: Vec<[u32; 3]> = s.triangles
+            [o.first_triangle as usize..(o.first_triangle + o.triangle_count) as usize]
+            .to_vec();
+        assert_closed_oriented(&tris);
+        let fine = signed_volume(&s.vertices, &tris);
+        let coarse = torus_knot(&TorusKnotParams::default());
+        let coarse = signed_volume(&coarse.positions, &coarse.triangles);
+        assert!(fine > coarse && fine < 1.05 * coarse, "{fine} vs {coarse}");
+    }
+    for bad in [
+        "dense-knots:",
+        "dense-knots:x",
+        "dense-knots:-5",
+        "dense-knots:0",
+    ] {
+        assert!(procedural::by_name(bad).is_none(), "{bad}");
+    }
+}

@@ -153,6 +153,11 @@ pub struct TablesDoc {
     pub isosurfaces: Vec<IsoRow>,
     /// Why there is no out-of-core table, if there is none.
     pub out_of_core_note: Option<String>,
+    /// Large models (seed 002 §6): Ray-Strips, the BVH and Tet20 as the
+    /// Torus Knots' tessellation grows, one row per size.
+    pub large_models: Vec<LargeModelRow>,
+    /// Why there is no large-model table, if there is none.
+    pub large_models_note: Option<String>,
     /// SVG figures written (paths).
     pub figures: Vec<String>,
     /// Wall time of the whole run, s.
@@ -224,4 +229,34 @@ pub struct IsoRow {
     pub docs: Vec<crate::iso::IsoDoc>,
     /// Why the volume failed, if it did.
     pub error: Option<String>,
+}
+
+/// One size of the large-model table (JSON `large_models[]`).
+#[derive(Clone, Debug, Serialize)]
+pub struct LargeModelRow {
+    /// Scene spec (`dense-knots:N`).
+    pub scene: String,
+    /// Scene triangles.
+    pub triangles: usize,
+    /// Ray-Strips, obvhs and, where it was built, tet20.
+    pub structures: Vec<LargeStructure>,
+    /// Why a structure is missing (e.g. TetGen's predicted peak).
+    pub note: Option<String>,
+    /// Why the whole size failed or was skipped.
+    pub error: Option<String>,
+}
+
+/// One structure on one large model (JSON `large_models[].structures[]`).
+#[derive(Clone, Debug, Serialize)]
+pub struct LargeStructure {
+    /// `strips`, `obvhs` or `tet20` (the render method's name).
+    pub structure: String,
+    /// Bytes of the structure including the vertices.
+    pub bytes: usize,
+    /// `bytes` per scene triangle.
+    pub bytes_per_triangle: f64,
+    /// Build seconds (tet20: the whole pipeline, TetGen included).
+    pub build_s: f64,
+    /// The timed render.
+    pub render: RenderDoc,
 }

@@ -7,7 +7,11 @@
 //! * `figure8_sorted_vs_unsorted.svg` — Aman et al. (seed 000) Figure 8:
 //!   tet20 Mrays/s on the Hilbert-sorted and the unsorted (TetGen order)
 //!   mesh, per scene;
-//! * `mrays_per_method.svg` — Mrays/s per method, grouped by scene.
+//! * `mrays_per_method.svg` — Mrays/s per method, grouped by scene;
+//! * `bytes_per_triangle_vs_mrays.svg` — bytes per scene triangle against
+//!   Mrays/s, one mark per structure (Tet20, Tet16, Tet32, Ray-Strips,
+//!   obvhs) and scene, large models included: the memory–speed trade of
+//!   the compact tet layouts and of Ray-Strips (seed 002) in one picture.
 
 use anyhow::Result;
 
@@ -89,5 +93,70 @@ pub fn figures(doc: &TablesDoc) -> Result<Vec<(&'static str, String)>> {
             &groups,
         )?,
     ));
+    out.push((
+        "bytes_per_triangle_vs_mrays.svg",
+        scatter_svg(
+            "Memory against speed per structure (seed 000 Table 4, seed 002 Tables 1 and 3)",
+            "bytes per scene triangle (structure and vertices)",
+            "Mrays/s (primary rays)",
+            &bytes_vs_speed(doc),
+        )?,
+    ));
     Ok(out)
+}
+
+/// One point per structure and scene: its bytes per triangle (the memory
+/// table's, Ray-Strips' and the BVH's) and its render speed.
+fn bytes_vs_speed(doc: &TablesDoc) -> Vec<Point> {
+    let mut points = Vec::new();
+    let mut push = |structure: &str, scene: &str, bytes_per_triangle: f64, mrays: f64| {
+        points.push(Point {
+            series: structure.to_string(),
+            label: format!("{structure} ({scene})"),
+            x: bytes_per_triangle,
+            y: mrays,
+        });
+    };
+    for sc in &doc.scenes {
+        let mrays = |m: Method| {
+            sc.renders
+                .iter()
+                .find(|r| r.method == m)
+                .map(|r| (r.scene.clone(), r.mrays_per_s))
+        };
+        for (layout, method) in [
+            ("tet20", Method::Tet20),
+            ("tet16", Method::Tet16),
+            ("tet32", Method::Tet32),
+            ("ray-strips", Method::Strips),
+        ] {
+            let bytes = sc
+                .info
+                .as_ref()
+                .and_then(|i| i.layouts.iter().find(|l| l.name == layout));
+            if let (Some(b), Some((scene, m))) = (bytes, mrays(method)) {
+                push(method.name(), &scene, b.total_bytes_per_triangle, m);
+            }
+        }
+        if let (Some(s), Some((scene, m))) = (&sc.ray_strips, mrays(Method::Obvhs)) {
+            let bytes = (s.bvh_hierarchy_bytes + s.bvh_geometry_bytes) as f64;
+            push(
+                Method::Obvhs.name(),
+                &scene,
+                bytes / s.triangles.max(1) as f64,
+                m,
+            );
+        }
+    }
+    for row in &doc.large_models {
+        for s in &row.structures {
+            push(
+                &s.structure,
+                &row.scene,
+                s.bytes_per_triangle,
+                s.render.mrays_per_s,
+            );
+        }
+    }
+    points
 }

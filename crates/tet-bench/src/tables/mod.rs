@@ -25,6 +25,9 @@
 //! * Wald et al. (seed 004) Tables 1, 2, 4 — isosurfaces of tet volumes:
 //!   the implicit min-max BVH (BIH and SAH builds, single rays, 16×16
 //!   packets) beside the iso walk over our layouts ([`isosurfaces`]);
+//! * Lauterbach et al. (seed 002) §6 — large models: Ray-Strips, the BVH
+//!   and Tet20 on Torus Knots tessellated to 1 M, 10 M and 30 M triangles,
+//!   full mode ([`large_models`]);
 //! * Erkoç et al. (seed 003) Tables 2–3 — out of core: build time, parts
 //!   and peaks under limits of ½ and ⅓ of the in-core TetGen peak, full
 //!   mode ([`out_of_core`]).
@@ -44,6 +47,7 @@ mod exit_face;
 mod figures;
 mod gpu;
 mod isosurfaces;
+mod large_models;
 mod memory;
 mod out_of_core;
 mod paper;
@@ -204,6 +208,8 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
             speed_accuracy::measure(&spec, args.quick, args.min_time_s())
         });
     let isosurfaces = isosurfaces::measure_all(args.quick, &pool);
+    let large_sizes = args.large_model_sizes();
+    let large_models = large_models::measure_all(&large_sizes, &opts, frames, &pool);
     let mut doc = TablesDoc {
         setup,
         scenes,
@@ -213,6 +219,10 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
         out_of_core_note: args.quick.then(|| {
             "skipped in --quick mode: each scene is built twice more, in parts (run without --quick)"
                 .to_string()
+        }),
+        large_models,
+        large_models_note: large_sizes.is_empty().then(|| {
+            "skipped: no sizes (`--large-models 1m,10m,30m`; the default without --quick)".to_string()
         }),
         figures: Vec::new(),
         total_s: 0.0,

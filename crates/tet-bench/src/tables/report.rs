@@ -10,8 +10,8 @@ use anyhow::{Context, Result};
 
 use super::doc::TablesDoc;
 use super::{
-    construction, entry, exit_face, gpu, isosurfaces, memory, out_of_core, quality, render_speed,
-    robustness, sorting, speed_accuracy, strips_vs_bvh, zoom,
+    construction, entry, exit_face, gpu, isosurfaces, large_models, memory, out_of_core, quality,
+    render_speed, robustness, sorting, speed_accuracy, strips_vs_bvh, zoom,
 };
 
 /// The Markdown report (`tables.md`, and stdout without `--json`).
@@ -62,6 +62,7 @@ pub fn markdown(doc: &TablesDoc) -> String {
         exit_face::markdown(&mut m, x);
     }
     isosurfaces::markdown(&mut m, doc);
+    large_models::markdown(&mut m, doc);
     out_of_core::markdown(&mut m, doc);
     if !doc.figures.is_empty() {
         let _ = writeln!(m, "\n## Figures\n");
