@@ -38,7 +38,9 @@ impl Default for BuildOptions {
     /// work per ray than a plain BVH (the paper's Ray-Strips took about
     /// twice the time of its BVH on the bunny, Table 3). With several strips
     /// per leaf (a deviation from the paper), `chunk_triangles: 64,
-    /// strips_per_leaf: 4` is both smaller and faster than this default.
+    /// strips_per_leaf: 4` is smaller (22.1 against 26.8 bytes per
+    /// triangle on the bunny: within the paper's 1.5 MB) at 8 % more
+    /// instructions per ray.
     fn default() -> Self {
         Self {
             chunk_triangles: 128,
