@@ -58,7 +58,7 @@ use crate::output::error_chain;
 
 /// The f64 reference hit of one ray.
 #[derive(Clone, Copy, Debug)]
-struct RefHit {
+pub(crate) struct RefHit {
     /// Constrained face hit.
     face: u32,
     /// Its scene triangle.
@@ -83,7 +83,7 @@ struct RefHit {
 impl RefHit {
     /// Grazing by the reference alone: near an edge, a second hit within
     /// `tol`, or near the ray origin.
-    fn ambiguous(&self) -> bool {
+    pub(crate) fn ambiguous(&self) -> bool {
         self.near_edge || self.second_close || self.near_origin
     }
 
@@ -396,6 +396,21 @@ pub struct RaySet {
     view: Option<Viewpoint>,
 }
 
+impl RaySet {
+    /// Rays in the set.
+    pub fn len(&self) -> usize {
+        self.rays.len()
+    }
+
+    /// The reference's hit of every ray, in parallel.
+    pub(crate) fn reference_hits(&self, reference: &Reference) -> Vec<Option<RefHit>> {
+        self.rays
+            .par_iter()
+            .map(|(r, _)| reference.closest(r))
+            .collect()
+    }
+}
+
 /// Camera rays of a `side × side` image plus `n` rays from random interior
 /// points: 70 % random directions, 10 % aimed at vertices, 10 % at edge
 /// midpoints, 10 % at face centroids; then `adversarial` rays of
@@ -526,7 +541,7 @@ pub struct RayPlan {
 }
 
 /// Traces every ray of `set` once with `t`, in parallel.
-fn trace_all(t: &dyn Tracer, set: &RaySet) -> Vec<TraceOutcome> {
+pub(crate) fn trace_all(t: &dyn Tracer, set: &RaySet) -> Vec<TraceOutcome> {
     set.rays
         .par_iter()
         .map(|(r, s)| {
@@ -568,36 +583,55 @@ fn check(
         debug_assert_eq!(again.len(), outcomes.len());
         passes += 1;
     }
-    let secs = best;
     let mut m = MethodAccuracy {
         method: t.name(),
         precision,
-        rays: set.rays.len() as u64,
-        mrays_per_s: set.rays.len() as f64 / secs.max(1e-9) / 1e6,
+        mrays_per_s: set.rays.len() as f64 / best.max(1e-9) / 1e6,
         ..Default::default()
     };
-    for (((ray, _), o), e) in set.rays.iter().zip(&outcomes).zip(expected) {
-        // The method's own hit grazes an edge of its triangle, or lies
-        // within the tolerance of the origin (a ray started on a surface
-        // may count it or not): the reference may rightly have decided
-        // otherwise.
-        let own_hit_grazes = |h: &Hit| {
-            let d = ray.direction.as_dvec3();
-            (h.t as f64).abs() * d.length() < reference.tol
-                || reference.near_edge(h.face, ray.origin.as_dvec3() + d * h.t as f64)
-        };
-        m.count(classify(o, e.as_ref(), own_hit_grazes));
-    }
-    m.failures = m.leaks
-        + m.wrong_triangle
-        + m.false_misses
-        + m.false_hits
-        + m.step_cap
-        + m.lost
-        + m.invalid
-        + m.nans;
-    m.failures_per_1024_squared = m.failures as f64 * (1024.0 * 1024.0) / m.rays.max(1) as f64;
+    m.tally(reference, set, &outcomes, expected);
+    m.finish();
     m
+}
+
+impl MethodAccuracy {
+    /// Judges `outcomes` (of the rays of `set`) against the reference's
+    /// `expected` hits and adds them to the counters.
+    pub(crate) fn tally(
+        &mut self,
+        reference: &Reference,
+        set: &RaySet,
+        outcomes: &[TraceOutcome],
+        expected: &[Option<RefHit>],
+    ) {
+        self.rays += set.rays.len() as u64;
+        for (((ray, _), o), e) in set.rays.iter().zip(outcomes).zip(expected) {
+            // The method's own hit grazes an edge of its triangle, or lies
+            // within the tolerance of the origin (a ray started on a surface
+            // may count it or not): the reference may rightly have decided
+            // otherwise.
+            let own_hit_grazes = |h: &Hit| {
+                let d = ray.direction.as_dvec3();
+                (h.t as f64).abs() * d.length() < reference.tol
+                    || reference.near_edge(h.face, ray.origin.as_dvec3() + d * h.t as f64)
+            };
+            self.count(classify(o, e.as_ref(), own_hit_grazes));
+        }
+    }
+
+    /// Sums the failures and their rate per 1024² rays from the counters.
+    pub(crate) fn finish(&mut self) {
+        self.failures = self.leaks
+            + self.wrong_triangle
+            + self.false_misses
+            + self.false_hits
+            + self.step_cap
+            + self.lost
+            + self.invalid
+            + self.nans;
+        self.failures_per_1024_squared =
+            self.failures as f64 * (1024.0 * 1024.0) / self.rays.max(1) as f64;
+    }
 }
 
 /// How one method's result on one ray compares with the reference.
@@ -693,11 +727,7 @@ pub fn run_case(
         plan.adversarial,
         plan.seed,
     )?;
-    let expected: Vec<Option<RefHit>> = set
-        .rays
-        .par_iter()
-        .map(|(r, _)| reference.closest(r))
-        .collect();
+    let expected = set.reference_hits(&reference);
     let mut out = Vec::new();
     let mut left_out = Vec::new();
     for &m in methods {

@@ -381,6 +381,11 @@ pub struct TablesArgs {
     /// Default: 1m,10m,30m, or none with `--quick`.
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_size)]
     pub large_models: Option<Vec<u64>>,
+    /// Rays of the robustness table on the first scene, in batches (camera
+    /// image, random and adversarial rays; `k`/`m` suffixes; `none` for the
+    /// plain 1024² + 100 k rays). Default: 100m, or none with `--quick`.
+    #[arg(long, value_name = "N", value_parser = parse_size)]
+    pub robustness_rays: Option<u64>,
 }
 
 /// A `--large-models` entry: a count (`1m`, `300k`, `250000`) or `none` (0).
@@ -394,6 +399,17 @@ fn parse_size(text: &str) -> Result<u64, String> {
 }
 
 impl TablesArgs {
+    /// Rays of the first scene's robustness table, when streamed (see
+    /// `--robustness-rays`).
+    pub fn streamed_robustness_rays(&self) -> Option<u64> {
+        match self.robustness_rays {
+            Some(0) => None,
+            Some(n) => Some(n),
+            None if self.quick => None,
+            None => Some(100_000_000),
+        }
+    }
+
     /// Sizes of the large-model table (see `--large-models`).
     pub fn large_model_sizes(&self) -> Vec<u64> {
         match &self.large_models {

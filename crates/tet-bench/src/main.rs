@@ -22,6 +22,7 @@
 #![deny(clippy::print_stdout)]
 
 mod accuracy;
+mod accuracy_scale;
 mod brute;
 mod bvh;
 mod camera;

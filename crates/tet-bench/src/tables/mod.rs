@@ -83,6 +83,7 @@ fn measure_scene(
     opts: &RenderOptions,
     frames: u32,
     pool: &rayon::ThreadPool,
+    streamed_rays: Option<u64>,
 ) -> Result<SceneResult> {
     let spec = planned.spec.as_str();
     let (loaded, mesh_reused) = cache.load(planned, &TABLE_FLAGS, false)?;
@@ -95,8 +96,14 @@ fn measure_scene(
     let (info, bvh_build_s) = construction::measure(&loaded)?;
     let renders = render_speed::measure(spec, &loaded, opts, frames, pool)?;
     let ray_strips = Some(strips_vs_bvh::measure(spec, &loaded, opts, frames, pool)?);
-    let accuracy =
-        robustness::measure(spec, &loaded, &cpu_methods(), args.quick, args.min_time_s())?;
+    let accuracy = robustness::measure(
+        spec,
+        &loaded,
+        &cpu_methods(),
+        args.quick,
+        args.min_time_s(),
+        streamed_rays,
+    )?;
     let unsorted_tet20 = Some(sorting::measure(planned, cache, opts, frames, pool)?);
     let wide_box_tet20 = Some(entry::measure(planned, cache, opts, frames, pool)?);
     let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames);
@@ -158,10 +165,12 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
     };
     let mut scenes = Vec::new();
     let mut cache = MeshCache::default();
-    for planned in plan(&scene_specs(args)?) {
+    for (index, planned) in plan(&scene_specs(args)?).into_iter().enumerate() {
         let spec = planned.spec.clone();
         eprintln!("scene {spec}");
-        let result = measure_scene(&planned, &mut cache, args, &opts, frames, &pool);
+        // The robustness table's 10⁸ rays: on the first scene only.
+        let streamed = args.streamed_robustness_rays().filter(|_| index == 0);
+        let result = measure_scene(&planned, &mut cache, args, &opts, frames, &pool, streamed);
         if planned.last
             && let Some(key) = planned.key
         {

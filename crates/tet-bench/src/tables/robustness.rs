@@ -8,19 +8,27 @@ use anyhow::Result;
 
 use super::doc::TablesDoc;
 use crate::accuracy::{CaseAccuracy, RayPlan, run_case};
+use crate::accuracy_scale::run_streamed;
 use crate::cli::{Method, Precision};
 use crate::load::Loaded;
 
 /// Every CPU method (`methods`) in f32 on the scene's camera image and
 /// random interior rays (256² + 20,000 with `--quick`, else 1024² +
-/// 100,000), each method timed for at least `min_time_s`.
+/// 100,000), each method timed for at least `min_time_s`; or, with
+/// `streamed`, that many rays in batches (camera image, random and
+/// adversarial rays: [`crate::accuracy_scale`]).
 pub fn measure(
     spec: &str,
     loaded: &Loaded,
     methods: &[Method],
     quick: bool,
     min_time_s: f64,
+    streamed: Option<u64>,
 ) -> Result<CaseAccuracy> {
+    if let Some(total) = streamed {
+        eprintln!("  {spec}: accuracy over {total} rays (camera, random and adversarial)");
+        return run_streamed("as-is", loaded, methods, Precision::F32, total, 1, false);
+    }
     let (side, rays) = if quick {
         (256, 20_000)
     } else {
@@ -45,7 +53,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     );
     let _ = writeln!(
         m,
-        "Failures = leaks + wrong triangle + false miss + false hit + step cap + lost + NaN, beyond the grazing tolerance, per 1024² rays, against an f64 reference. A leak is a ray that misses, or hits something farther along, where the reference hit grazes only closed edges (shared by two or more faces): it slipped through a watertight surface. Grazing rays (not failures) hit one of the triangles they graze, or graze an open edge. Seed 001 reports 0 for its Plücker method in f32.\n"
+        "Failures = leaks + wrong triangle + false miss + false hit + step cap + lost + NaN, beyond the grazing tolerance, per 1024² rays, against an f64 reference. A leak is a ray that misses, or hits something farther along, where the reference hit grazes only closed edges (shared by two or more faces): it slipped through a watertight surface. Grazing rays (not failures) hit one of the triangles they graze, or graze an open edge. Seed 001 reports 0 for its Plücker method in f32. Without `--quick` the first scene is checked over 10⁸ rays (`--robustness-rays`): its 1024² camera image, then random interior rays and adversarial rays (aimed at vertices, edges and faces of the tetrahedralization, along edges, started on faces) in equal parts; its Mrays/s column is the render's, the other scenes' 1024² + 100 k rays likewise.\n"
     );
     let _ = writeln!(
         m,
