@@ -365,17 +365,19 @@ impl JobManifest {
         // rather than as a field error.
         let head: serde_json::Value =
             serde_json::from_str(text).map_err(|e| bad(format!("not JSON: {e}")))?;
-        match head.get("schema").and_then(|s| s.as_str()) {
-            Some(JOB_SCHEMA) => {}
-            other => return Err(bad(format!("schema {other:?}, expected {JOB_SCHEMA:?}"))),
+        match head.get("schema") {
+            Some(serde_json::Value::String(s)) if s == JOB_SCHEMA => {}
+            Some(s) => return Err(bad(format!("schema {s}, expected {JOB_SCHEMA:?}"))),
+            None => return Err(bad("no schema field: not a job description".into())),
         }
-        match head.get("version").and_then(|v| v.as_u64()) {
-            Some(v) if v == u64::from(JOB_VERSION) => {}
-            other => {
+        match head.get("version") {
+            Some(v) if v.as_u64() == Some(u64::from(JOB_VERSION)) => {}
+            Some(v) => {
                 return Err(bad(format!(
-                    "version {other:?}, this reader knows version {JOB_VERSION}"
+                    "version {v}, this reader knows version {JOB_VERSION}"
                 )));
             }
+            None => return Err(bad("no version field".into())),
         }
         let m: JobManifest = serde_json::from_value(head).map_err(|e| bad(e.to_string()))?;
         m.check().map_err(bad)?;

@@ -19,11 +19,10 @@ use super::records::write_atomic;
 use crate::bbox::EnclosingBox;
 use crate::clean::clean_scene;
 use crate::outofcore::error::SeamError;
-use crate::outofcore::memory_model::predict_peak_memory;
 use crate::outofcore::merge::PartInputs;
 use crate::outofcore::parts::{FacetKind, PartPlc, SeamOptions, SeamReport};
 use crate::outofcore::seam::slab_part_inputs;
-use crate::outofcore::split::{SplitOptions, plan_slabs};
+use crate::outofcore::split::{SlabPlan, SplitOptions, plan_slabs};
 use crate::outofcore::tree::{plan_tree_with_moves, tree_part_inputs};
 use crate::scene::Scene;
 
@@ -47,8 +46,9 @@ pub struct PlanOptions {
     pub seam: SeamOptions,
     /// Every part's predicted TetGen peak stays under this (bytes).
     pub limit_bytes: Option<u64>,
-    /// At least about this many parts: each part is predicted under the
-    /// whole scene's prediction divided by it (and under the limit).
+    /// At least this many parts: a tree is split down to depth
+    /// `⌈log2 parts⌉` at least; slabs are planned under lower limits until
+    /// there are as many.
     pub parts: usize,
     /// How to cut.
     pub planner: Planner,
@@ -91,14 +91,34 @@ pub fn scene_digest(scene: &Scene) -> String {
     format_digest(h.finish())
 }
 
-/// The per-part budget: the limit, and the whole scene's prediction
-/// divided by the parts asked for (no budget for one part without a limit).
-fn budget(options: &PlanOptions, in_core: u64) -> u64 {
-    let by_count = match options.parts {
-        0 | 1 => u64::MAX,
-        n => in_core / n as u64,
+/// Depth a tree must reach to have at least `parts` leaves.
+fn min_depth(parts: usize) -> usize {
+    parts.max(1).next_power_of_two().trailing_zeros() as usize
+}
+
+/// Slabs under `limit`, at least `parts` of them: the limit is lowered
+/// below the largest slab's prediction until there are enough (`None`
+/// when no plan fits).
+fn slabs_for(
+    vertices: &[glam::Vec3],
+    triangles: &[[u32; 3]],
+    bounds: (glam::Vec3, glam::Vec3),
+    limit: u64,
+    parts: usize,
+) -> Option<SlabPlan> {
+    let mut split = SplitOptions {
+        limit_bytes: limit,
+        ..SplitOptions::default()
     };
-    options.limit_bytes.unwrap_or(u64::MAX).min(by_count)
+    for _ in 0..64 {
+        let plan = plan_slabs(vertices, triangles, bounds, &split)?;
+        if plan.values.len() + 1 >= parts {
+            return Some(plan);
+        }
+        let largest = plan.predicted_bytes.iter().copied().max()?;
+        split.limit_bytes = largest - largest / 8;
+    }
+    None
 }
 
 /// Cuts `scene` into parts (see [`PlanOptions`]), writes every part's
@@ -112,10 +132,10 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
     }
     let b = EnclosingBox::new(cleaned.bounds(), options.seam.enclosing_box)
         .map_err(|e| JobError::Plan(SeamError::from(e)))?;
-    let in_core = predict_peak_memory(cleaned.vertices.len() + 8, cleaned.triangles.len() + 12);
-    let limit = budget(options, in_core);
+    let limit = options.limit_bytes.unwrap_or(u64::MAX);
     let split = SplitOptions {
         limit_bytes: limit,
+        min_depth: min_depth(options.parts),
         ..SplitOptions::default()
     };
     let seam = &options.seam;
@@ -143,11 +163,12 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
     let (inputs, report, partition) = match tree {
         Some(t) => t,
         None => {
-            let plan = plan_slabs(
+            let plan = slabs_for(
                 &cleaned.vertices,
                 &cleaned.triangles,
                 (b.min, b.max),
-                &split,
+                limit,
+                options.parts,
             )
             .ok_or(JobError::LimitTooSmall { limit_bytes: limit })?;
             let (inputs, report) =
@@ -178,7 +199,7 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
             time_limit_s: options.time_limit_s,
             sort_parts: options.sort_parts,
             resolve: seam.resolve.is_some(),
-            limit_bytes: (limit != u64::MAX).then_some(limit),
+            limit_bytes: options.limit_bytes,
             box_min: b.min.to_array().map(ExactF32),
             box_max: b.max.to_array().map(ExactF32),
         },
