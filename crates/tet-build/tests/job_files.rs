@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use glam::Vec3;
-use tet_build::outofcore::job::digest::{digest, xxh64};
+use tet_build::outofcore::job::digest::{Xxh64, digest, xxh64};
 use tet_build::outofcore::job::manifest::{ExactF32, JobManifest, Partition};
 use tet_build::outofcore::job::part_input::{PartInput, SEAM_FACET, decode, encode};
 use tet_build::outofcore::job::{
@@ -332,4 +332,30 @@ fn the_part_index_comes_from_the_flag_or_the_engine() {
             ..
         })
     ));
+}
+
+/// Values of the reference implementation (python-xxhash 3,
+/// `xxhash.xxh64(data).hexdigest()`).
+#[test]
+fn digests_match_the_reference_xxh64() {
+    let long: Vec<u8> = (0..3).flat_map(|_| 0..=255u8).chain(*b"xyz").collect();
+    let cases: [(&[u8], u64); 5] = [
+        (b"", 0xef46_db37_51d8_e999),
+        (b"a", 0xd24e_c4f1_a98c_6e5b),
+        (b"abc", 0x44bc_2cf5_ad77_0999),
+        (&long, 0xe921_a1b4_5bd7_79f8),
+        (&b"tetrays".repeat(13), 0xce8b_edd4_3d4f_fff9),
+    ];
+    for (data, expected) in cases {
+        assert_eq!(xxh64(data), expected, "{} bytes", data.len());
+        // Any split into updates gives the same hash.
+        for cut in [1, 7, 31, 32, 33, 100] {
+            let mut h = Xxh64::new();
+            for piece in data.chunks(cut) {
+                h.update(piece);
+            }
+            assert_eq!(h.finish(), expected, "{} bytes in pieces of {cut}", data.len());
+        }
+    }
+    assert_eq!(digest(b"abc"), "xxh64:44bc2cf5ad770999");
 }
