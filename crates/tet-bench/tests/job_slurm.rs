@@ -1,6 +1,6 @@
 //! A job on a real Slurm: `scripts/slurm/single-node.sh` starts a
-//! one-node cluster on 127.0.0.1, a procedural scene of 360 000 triangles
-//! is planned, submitted as an array of parts and a merge depending on
+//! one-node cluster on 127.0.0.1, a grid of 27 torus knots (311 040
+//! triangles, written as an OBJ file) is planned, submitted as an array of parts and a merge depending on
 //! it; one array task is cancelled while it builds (the merge is then
 //! cancelled by Slurm), `submit` again runs only that part and the merge.
 //! The merged mesh is byte for byte the single-process out-of-core build
@@ -24,11 +24,24 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
-const SCENE: &str = "torus-knots";
 const TIMEOUT: Duration = Duration::from_secs(900);
 
 fn scripts() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scripts/slurm")
+}
+
+/// Writes the 3×3×3 knot grid of the memory model's measurements as an OBJ file.
+fn write_scene(path: &Path) {
+    use std::fmt::Write;
+    let scene = tet_build::outofcore::memory_model::knot_grid(3, 240, 24);
+    let mut obj = String::new();
+    for v in &scene.vertices {
+        let _ = writeln!(obj, "v {:?} {:?} {:?}", v.x, v.y, v.z);
+    }
+    for t in &scene.triangles {
+        let _ = writeln!(obj, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    std::fs::write(path, obj).unwrap();
 }
 
 fn slurm_conf() -> PathBuf {
@@ -105,11 +118,14 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
     println!("cluster up after {:.1} s", start.elapsed().as_secs_f64());
 
     let dir = tempfile::tempdir().unwrap();
+    let scene_file = dir.path().join("knots27.obj");
+    write_scene(&scene_file);
+    let scene = scene_file.to_str().unwrap();
     let jobdir = dir.path().join("job");
     let j = jobdir.to_str().unwrap();
     let out = dir.path().join("slurm.tmesh");
     let limit = "300M";
-    let plan = json(&["build", SCENE, "--plan", j, "--memory-limit", limit]);
+    let plan = json(&["build", scene, "--plan", j, "--memory-limit", limit]);
     let n = plan["parts"].as_u64().unwrap() as usize;
     assert!(n >= 4, "{plan}");
     println!("planned {n} parts after {:.1} s", start.elapsed().as_secs_f64());
@@ -168,7 +184,7 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
     let local = dir.path().join("local.tmesh");
     json(&[
         "build",
-        SCENE,
+        scene,
         "-o",
         local.to_str().unwrap(),
         "--memory-limit",
