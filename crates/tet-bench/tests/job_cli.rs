@@ -105,7 +105,10 @@ fn a_planned_job_runs_part_by_part_and_merges_into_the_local_build() {
         "1",
     ]);
     assert_eq!(b["memory"]["parts"], n);
-    assert_eq!(std::fs::read(&merged).unwrap(), std::fs::read(&local).unwrap());
+    assert_eq!(
+        std::fs::read(&merged).unwrap(),
+        std::fs::read(&local).unwrap()
+    );
     let r = json(&[
         "render",
         merged.to_str().unwrap(),
@@ -131,9 +134,20 @@ fn a_planned_job_runs_part_by_part_and_merges_into_the_local_build() {
     let out = bench(&["merge", j, "-o", merged.to_str().unwrap()], &[]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains(&format!("run again {last} (missing {last})")), "{err}");
+    assert!(
+        err.contains(&format!("run again {last} (missing {last})")),
+        "{err}"
+    );
 
-    let s = json(&["submit", j, "--engine", "slurm", "--dry-run", "--partition", "debug"]);
+    let s = json(&[
+        "submit",
+        j,
+        "--engine",
+        "slurm",
+        "--dry-run",
+        "--partition",
+        "debug",
+    ]);
     assert_eq!(s["parts"], serde_json::json!([last]));
     assert_eq!(s["parts_job"], Value::Null);
     let job: Value = serde_json::from_str(&read(&jobdir.join("job.json"))).unwrap();
@@ -147,21 +161,41 @@ fn a_planned_job_runs_part_by_part_and_merges_into_the_local_build() {
     let mib = (2 * max_predicted + (64 << 20)).div_ceil(1 << 20);
     assert_eq!(s["mem_mib"], mib);
     let parts = read(Path::new(s["parts_script"].as_str().unwrap()));
-    assert!(parts.contains(&format!("#SBATCH --array={last}\n")), "{parts}");
-    assert!(parts.contains(&format!("#SBATCH --mem={mib}M\n")), "{parts}");
+    assert!(
+        parts.contains(&format!("#SBATCH --array={last}\n")),
+        "{parts}"
+    );
+    assert!(
+        parts.contains(&format!("#SBATCH --mem={mib}M\n")),
+        "{parts}"
+    );
     assert!(parts.contains("#SBATCH --partition=debug\n"), "{parts}");
     assert!(parts.contains("build-part"), "{parts}");
     let merge = read(Path::new(s["merge_script"].as_str().unwrap()));
-    assert!(merge.contains(" merge ") && merge.contains("mesh.tmesh"), "{merge}");
+    assert!(
+        merge.contains(" merge ") && merge.contains("mesh.tmesh"),
+        "{merge}"
+    );
     let submit = read(Path::new(s["submit_script"].as_str().unwrap()));
     assert!(submit.contains("--dependency=afterok:$parts"), "{submit}");
     // With every part missing, the array covers 0..n.
     for k in 0..n {
         std::fs::remove_file(jobdir.join(format!("part-{k}.done.json"))).ok();
     }
-    let s = json(&["submit", j, "--engine", "slurm", "--dry-run", "--mem-per-part", "3G"]);
+    let s = json(&[
+        "submit",
+        j,
+        "--engine",
+        "slurm",
+        "--dry-run",
+        "--mem-per-part",
+        "3G",
+    ]);
     let parts = read(Path::new(s["parts_script"].as_str().unwrap()));
-    assert!(parts.contains(&format!("#SBATCH --array=0-{}\n", n - 1)), "{parts}");
+    assert!(
+        parts.contains(&format!("#SBATCH --array=0-{}\n", n - 1)),
+        "{parts}"
+    );
     assert!(parts.contains("#SBATCH --mem=3072M\n"), "{parts}");
 }
 
@@ -172,9 +206,16 @@ fn a_broken_job_is_a_clear_error() {
     let out = bench(&["job", "status", j], &[]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("job.json"));
-    std::fs::write(dir.path().join("job.json"), "{\"schema\": \"tet-job\", \"version\": 9}").unwrap();
+    std::fs::write(
+        dir.path().join("job.json"),
+        "{\"schema\": \"tet-job\", \"version\": 9}",
+    )
+    .unwrap();
     let out = bench(&["build-part", j, "--index", "0"], &[]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("version 9, this reader knows version 1"), "{err}");
+    assert!(
+        err.contains("version 9, this reader knows version 1"),
+        "{err}"
+    );
 }

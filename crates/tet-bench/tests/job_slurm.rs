@@ -128,9 +128,19 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
     let plan = json(&["build", scene, "--plan", j, "--memory-limit", limit]);
     let n = plan["parts"].as_u64().unwrap() as usize;
     assert!(n >= 4, "{plan}");
-    println!("planned {n} parts after {:.1} s", start.elapsed().as_secs_f64());
+    println!(
+        "planned {n} parts after {:.1} s",
+        start.elapsed().as_secs_f64()
+    );
 
-    let s = json(&["submit", j, "--engine", "slurm", "-o", out.to_str().unwrap()]);
+    let s = json(&[
+        "submit",
+        j,
+        "--engine",
+        "slurm",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     let parts_job = s["parts_job"].as_str().unwrap().to_string();
     let merge_job = s["merge_job"].as_str().unwrap().to_string();
     let mem_mib = s["mem_mib"].as_u64().unwrap();
@@ -142,7 +152,11 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
         queued(&task).is_some_and(|s| s.contains("RUNNING"))
     });
     let cancel = run("scancel", &[&task]);
-    assert!(cancel.status.success(), "{}", String::from_utf8_lossy(&cancel.stderr));
+    assert!(
+        cancel.status.success(),
+        "{}",
+        String::from_utf8_lossy(&cancel.stderr)
+    );
     wait_until("the array and the merge to leave the queue", start, || {
         queued(&parts_job).is_none() && queued(&merge_job).is_none()
     });
@@ -159,7 +173,14 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
     );
 
     // Submit again: only the cancelled part, then the merge.
-    let again = json(&["submit", j, "--engine", "slurm", "-o", out.to_str().unwrap()]);
+    let again = json(&[
+        "submit",
+        j,
+        "--engine",
+        "slurm",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert_eq!(again["parts"], serde_json::json!([victim]));
     let (p2, m2) = (
         again["parts_job"].as_str().unwrap().to_string(),
@@ -177,7 +198,11 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
     assert_eq!(status["done"], n);
     for p in status["parts"].as_array().unwrap() {
         let used = p["tetgen_peak_kib"].as_u64().unwrap() + p["process_peak_kib"].as_u64().unwrap();
-        assert!(used <= mem_mib * 1024, "part {}: {used} KiB of {mem_mib} MiB", p["index"]);
+        assert!(
+            used <= mem_mib * 1024,
+            "part {}: {used} KiB of {mem_mib} MiB",
+            p["index"]
+        );
     }
 
     // The single-process build of the same scene and limit, one worker.

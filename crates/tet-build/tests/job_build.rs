@@ -12,8 +12,8 @@ use std::path::Path;
 use std::time::Duration;
 
 use tet_build::outofcore::job::{
-    JobError, JobManifest, PartOutcome, PartState, PlanOptions, build_part, job_status,
-    merge_job, plan_job,
+    JobError, JobManifest, PartOutcome, PartState, PlanOptions, build_part, job_status, merge_job,
+    plan_job,
 };
 use tet_build::outofcore::memory_model::knot_grid;
 use tet_build::outofcore::seam::SeamOptions;
@@ -144,7 +144,10 @@ fn broken_parts_are_named_and_rebuilt_alone() {
     std::fs::write(jobdir.join("part-2.tmesh.tmp999"), b"partial").unwrap();
     let states = job_status(&jobdir, &job, false).unwrap();
     assert!(matches!(states[0], PartState::Done(_)));
-    assert!(matches!(states[1], PartState::Stale(ref why) if why.contains("bytes")), "{states:?}");
+    assert!(
+        matches!(states[1], PartState::Stale(ref why) if why.contains("bytes")),
+        "{states:?}"
+    );
     assert_eq!(states[2], PartState::Missing);
     let (missing, failed, stale) = not_ready(merge_job(&jobdir, &job, &out).unwrap_err());
     assert_eq!((missing, failed, stale), (vec![2], vec![], vec![1]));
@@ -157,8 +160,14 @@ fn broken_parts_are_named_and_rebuilt_alone() {
     let at = bad.len() - 5;
     bad[at] ^= 1;
     std::fs::write(paths(0).result, &bad).unwrap();
-    assert!(matches!(job_status(&jobdir, &job, false).unwrap()[0], PartState::Done(_)));
-    assert!(matches!(job_status(&jobdir, &job, true).unwrap()[0], PartState::Stale(_)));
+    assert!(matches!(
+        job_status(&jobdir, &job, false).unwrap()[0],
+        PartState::Done(_)
+    ));
+    assert!(matches!(
+        job_status(&jobdir, &job, true).unwrap()[0],
+        PartState::Stale(_)
+    ));
     let (_, _, stale) = not_ready(merge_job(&jobdir, &job, &out).unwrap_err());
     assert_eq!(stale, vec![0, 1]);
 

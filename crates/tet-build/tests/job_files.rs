@@ -26,7 +26,11 @@ fn sample() -> PartInput {
             ),
             ([Vec3::Y, Vec3::Z, Vec3::ONE], SEAM_FACET),
         ],
-        box_faces: vec![[Vec3::splat(-3.0), Vec3::splat(3.0), Vec3::new(3.0, -3.0, 0.5)]],
+        box_faces: vec![[
+            Vec3::splat(-3.0),
+            Vec3::splat(3.0),
+            Vec3::new(3.0, -3.0, 0.5),
+        ]],
     }
 }
 
@@ -243,7 +247,11 @@ fn job_json_round_trips_and_describes_its_parts() {
             .collect();
         ids.sort_unstable();
         ids.dedup();
-        assert!(!ids.is_empty() && ids.len() < 720, "part {k}: {} of 720", ids.len());
+        assert!(
+            !ids.is_empty() && ids.len() < 720,
+            "part {k}: {} of 720",
+            ids.len()
+        );
     }
     // Planning the same scene again writes the same inputs (digests are
     // reproducible, so finished parts stay valid).
@@ -289,13 +297,22 @@ fn broken_job_json_gives_typed_errors() {
     expect(&text[..text.len() / 2], "not JSON");
     expect(&text.replace("\"version\": 1", "\"version\": 2"), "version");
     expect(&text.replace("\"tet-job\"", "\"other\""), "schema");
-    expect(&text.replace("\"index\": 1", "\"index\": 7"), "parts[1].index");
+    expect(
+        &text.replace("\"index\": 1", "\"index\": 7"),
+        "parts[1].index",
+    );
     expect(
         &text.replace("\"part-0.input\"", "\"../part-0.input\""),
         "plain file name",
     );
-    expect(&text.replace("\"order\": [\n      0,", "\"order\": [\n      1,"), "order");
-    expect(&text.replacen("\"input_bytes\"", "\"extra\": 1, \"input_bytes\"", 1), "extra");
+    expect(
+        &text.replace("\"order\": [\n      0,", "\"order\": [\n      1,"),
+        "order",
+    );
+    expect(
+        &text.replacen("\"input_bytes\"", "\"extra\": 1, \"input_bytes\"", 1),
+        "extra",
+    );
     std::fs::remove_file(&path).unwrap();
     assert!(matches!(
         JobManifest::load(dir.path()),
@@ -313,9 +330,18 @@ fn the_part_index_comes_from_the_flag_or_the_engine() {
                 .map(|(_, v)| v.to_string())
         }
     };
-    assert_eq!(part_index(Some(4), env(&[("SLURM_ARRAY_TASK_ID", "2")])).unwrap(), 4);
-    assert_eq!(part_index(None, env(&[("SLURM_ARRAY_TASK_ID", "2")])).unwrap(), 2);
-    assert_eq!(part_index(None, env(&[("JOB_COMPLETION_INDEX", "5")])).unwrap(), 5);
+    assert_eq!(
+        part_index(Some(4), env(&[("SLURM_ARRAY_TASK_ID", "2")])).unwrap(),
+        4
+    );
+    assert_eq!(
+        part_index(None, env(&[("SLURM_ARRAY_TASK_ID", "2")])).unwrap(),
+        2
+    );
+    assert_eq!(
+        part_index(None, env(&[("JOB_COMPLETION_INDEX", "5")])).unwrap(),
+        5
+    );
     assert_eq!(
         part_index(
             None,
@@ -354,7 +380,12 @@ fn digests_match_the_reference_xxh64() {
             for piece in data.chunks(cut) {
                 h.update(piece);
             }
-            assert_eq!(h.finish(), expected, "{} bytes in pieces of {cut}", data.len());
+            assert_eq!(
+                h.finish(),
+                expected,
+                "{} bytes in pieces of {cut}",
+                data.len()
+            );
         }
     }
     assert_eq!(digest(b"abc"), "xxh64:44bc2cf5ad770999");

@@ -127,10 +127,7 @@ fn print_status(doc: &StatusDoc) -> Result<()> {
         )?;
     }
     if !doc.rerun.is_empty() {
-        outln!(
-            "  to run: {}",
-            super::slurm::array_ranges(&doc.rerun)
-        )?;
+        outln!("  to run: {}", super::slurm::array_ranges(&doc.rerun))?;
     }
     Ok(())
 }
