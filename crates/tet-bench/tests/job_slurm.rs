@@ -197,7 +197,19 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
     let status = json(&["job", "status", j, "--verify"]);
     assert_eq!(status["done"], n);
     for p in status["parts"].as_array().unwrap() {
-        let used = p["tetgen_peak_kib"].as_u64().unwrap() + p["process_peak_kib"].as_u64().unwrap();
+        let (tetgen, process) = (
+            p["tetgen_peak_kib"].as_u64().unwrap(),
+            p["process_peak_kib"].as_u64().unwrap(),
+        );
+        println!(
+            "part {}: predicted TetGen peak {:.1} MiB, measured TetGen {:.1} MiB + build-part {:.1} MiB, asked {mem_mib} MiB, {:.1} s",
+            p["index"],
+            p["predicted_peak_bytes"].as_u64().unwrap() as f64 / (1 << 20) as f64,
+            tetgen as f64 / 1024.0,
+            process as f64 / 1024.0,
+            p["seconds"].as_f64().unwrap()
+        );
+        let used = tetgen + process;
         assert!(
             used <= mem_mib * 1024,
             "part {}: {used} KiB of {mem_mib} MiB",

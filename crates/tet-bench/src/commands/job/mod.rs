@@ -8,6 +8,7 @@
 mod parts;
 #[cfg(feature = "tetgen")]
 mod planning;
+#[cfg(feature = "tetgen")]
 pub mod slurm;
 #[cfg(feature = "tetgen")]
 mod status;
@@ -23,6 +24,7 @@ pub use status::job;
 #[cfg(feature = "tetgen")]
 pub use submit::submit;
 
+/// The job commands of a tet-bench built without TetGen: errors.
 #[cfg(not(feature = "tetgen"))]
 mod without_tetgen {
     use std::path::Path;

@@ -72,6 +72,7 @@ fn job_name(kind: &str, scene: &str) -> String {
     format!("tet-{kind}-{clean}")
 }
 
+/// The `#SBATCH` lines both scripts share.
 fn header(out: &mut String, plan: &SlurmPlan, kind: &str, mem_mib: u64, log: &str) {
     let _ = writeln!(out, "#!/bin/bash");
     let _ = writeln!(out, "#SBATCH --job-name={}", job_name(kind, &plan.name));

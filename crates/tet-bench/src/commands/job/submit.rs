@@ -48,6 +48,7 @@ pub struct SubmitDoc {
     pub merge_job: Option<String>,
 }
 
+/// `p` made absolute (the scripts run in another directory).
 fn absolute(p: &Path) -> Result<PathBuf> {
     std::path::absolute(p).with_context(|| format!("cannot make {} absolute", p.display()))
 }

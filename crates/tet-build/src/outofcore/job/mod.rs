@@ -33,12 +33,12 @@
 //! * [`digest`]: XXH64 content digests.
 //! * [`error`]: [`JobError`], [`InputFault`].
 //! * [`part_input`]: a part's input file.
-//! * [`manifest`]: `job.json`.
+//! * [`manifest`]: the job description, `job.json`.
 //! * [`records`]: done and error records, atomic writes.
-//! * [`plan`]: [`plan_job`].
+//! * [`plan`]: planning, [`plan_job`].
 //! * [`run`]: [`build_part`], the part index from Slurm or Kubernetes.
 //! * [`status`]: each part's state from the directory.
-//! * [`merge`]: [`merge_job`].
+//! * [`merge`]: the merge, [`merge_job`].
 
 pub mod digest;
 pub mod error;
