@@ -38,6 +38,18 @@ pub enum Command {
     /// (`.vtk`, `.vtu`, `.pvd`) and TetGen (`.node`/`.ele`/`.face`/`.neigh`,
     /// named by the `.node` path); a synthetic volume's name is an input.
     Convert(ConvertArgs),
+    // Jobs: a build planned into a directory (`build --plan`), run by any
+    // engine part by part, then merged.
+    /// Build one part of a planned job (`build SCENE --plan JOB_DIR`); the
+    /// part index defaults from Slurm or Kubernetes.
+    BuildPart(BuildPartArgs),
+    /// Merge the finished parts of a planned job into one mesh file.
+    Merge(MergeArgs),
+    /// Inspect a planned job (`job status JOB_DIR`).
+    Job(JobArgs),
+    /// Submit a planned job to a batch system: an array of part tasks and
+    /// a merge that waits for them.
+    Submit(SubmitArgs),
     /// Internal: serve one TetGen request on stdin/stdout (isolated builds).
     #[command(hide = true)]
     TetgenWorker,
@@ -79,8 +91,8 @@ pub struct BuildFlags {
 pub struct BuildArgs {
     /// Scene: a procedural name (`torus-knots`, …), an OBJ path, or `FILE.json#Name`.
     pub scene: String,
-    /// Output mesh file (required unless `--predict-memory`).
-    #[arg(short, long, required_unless_present = "predict_memory")]
+    /// Output mesh file (required unless `--predict-memory` or `--plan`).
+    #[arg(short, long, required_unless_present_any = ["predict_memory", "plan"])]
     pub output: Option<PathBuf>,
     /// Print TetGen's predicted peak memory for this scene (the memory
     /// model of Erkoç et al., seed 003 §3.2) and exit without building.
@@ -110,9 +122,115 @@ pub struct BuildArgs {
     /// frames, all cores) and report its speed (`tet20` in `--json`).
     #[arg(long)]
     pub tet20: bool,
+    /// Plan the build as a job in this directory instead of building:
+    /// `job.json` and one input file per part; each part is then built by
+    /// `build-part` (any order, any machine) and the results merged by
+    /// `merge`. With `--memory-limit`, every part's predicted TetGen peak
+    /// fits it.
+    #[arg(long, value_name = "JOB_DIR", conflicts_with_all = ["output", "predict_memory", "tet20"])]
+    pub plan: Option<PathBuf>,
+    /// With `--plan`: cut into at least this many parts (the paper's tree
+    /// is split down to depth ⌈log2 N⌉ at least; slabs until there are N).
+    #[arg(long, requires = "plan")]
+    pub parts: Option<usize>,
     /// Build options.
     #[command(flatten)]
     pub build: BuildFlags,
+}
+
+/// `build-part` arguments.
+#[derive(Debug, Args)]
+pub struct BuildPartArgs {
+    /// The job directory (`build --plan`).
+    pub job_dir: PathBuf,
+    /// The part to build; default: `SLURM_ARRAY_TASK_ID` (a Slurm array
+    /// task), else `JOB_COMPLETION_INDEX` (a Kubernetes Indexed Job).
+    #[arg(long)]
+    pub index: Option<usize>,
+}
+
+/// `merge` arguments.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The job directory.
+    pub job_dir: PathBuf,
+    /// The merged mesh file (`.tmesh`).
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// `job` arguments.
+#[derive(Debug, Args)]
+pub struct JobArgs {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: JobCommand,
+}
+
+/// `job` subcommands.
+#[derive(Debug, Subcommand)]
+pub enum JobCommand {
+    /// Each part: done, failed, stale or missing, with predicted and
+    /// measured peak memory.
+    Status(JobStatusArgs),
+}
+
+/// `job status` arguments.
+#[derive(Debug, Args)]
+pub struct JobStatusArgs {
+    /// The job directory.
+    pub job_dir: PathBuf,
+    /// Also read every result file and check its digest (slower).
+    #[arg(long)]
+    pub verify: bool,
+}
+
+/// Batch systems `submit` writes scripts for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Engine {
+    /// Slurm: one job array of parts, a merge job depending on it.
+    Slurm,
+}
+
+/// `submit` arguments.
+#[derive(Debug, Args)]
+pub struct SubmitArgs {
+    /// The job directory.
+    pub job_dir: PathBuf,
+    /// The batch system.
+    #[arg(long, value_enum)]
+    pub engine: Engine,
+    /// The partition (queue) to submit to; default: the cluster's.
+    #[arg(long)]
+    pub partition: Option<String>,
+    /// Memory per part task: `auto` (from the plan's largest predicted
+    /// part) or a size (`2G`, `512M`).
+    #[arg(long, default_value = "auto", value_parser = parse_mem_per_part)]
+    pub mem_per_part: MemPerPart,
+    /// The merged mesh file (default: `JOB_DIR/mesh.tmesh`).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Write the scripts only, submit nothing.
+    #[arg(long)]
+    pub dry_run: bool,
+}
+
+/// Memory per part task.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MemPerPart {
+    /// From the plan's predictions.
+    Auto,
+    /// This many bytes.
+    Bytes(u64),
+}
+
+/// Parses `auto` or a memory size ([`parse_memory_limit`]).
+pub fn parse_mem_per_part(s: &str) -> Result<MemPerPart, String> {
+    if s.trim().eq_ignore_ascii_case("auto") {
+        Ok(MemPerPart::Auto)
+    } else {
+        parse_memory_limit(s).map(MemPerPart::Bytes)
+    }
 }
 
 /// `info` arguments.

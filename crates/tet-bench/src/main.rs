@@ -4,7 +4,8 @@
 //! The modules lie in layers; each uses only the layers below it:
 //!
 //! 1. commands — [`commands`] (`build`, `info`, `render`, `accuracy`,
-//!    `iso`, `convert`) and
+//!    `iso`, `convert`, and the job commands `build --plan`, `build-part`,
+//!    `merge`, `job status`, `submit`) and
 //!    [`tables`] (one module per paper table, the driver, and the report
 //!    writers: Markdown, CSV, JSON, SVG figures);
 //! 2. measurement, returning plain serialisable data — [`timing`], [`gpu`],
@@ -62,6 +63,10 @@ fn main() -> ExitCode {
         Command::Tables(a) => tables::run(a, cli.json),
         Command::Iso(a) => commands::iso::run(a, cli.json),
         Command::Convert(a) => commands::convert::run(a, cli.json),
+        Command::BuildPart(a) => commands::job::build_part(a, cli.json),
+        Command::Merge(a) => commands::job::merge(a, cli.json),
+        Command::Job(a) => commands::job::job(a, cli.json),
+        Command::Submit(a) => commands::job::submit(a, cli.json),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -79,6 +79,9 @@ pub fn run(args: &BuildArgs, json: bool) -> Result<()> {
     if args.predict_memory {
         return run_predict(args, json);
     }
+    if let Some(dir) = &args.plan {
+        return super::job::plan(args, dir, json);
+    }
     let Some(output) = &args.output else {
         bail!("give the output mesh file with -o FILE.{MESH_EXTENSION}");
     };

@@ -7,5 +7,6 @@ pub mod build;
 pub mod convert;
 pub mod info;
 pub mod iso;
+pub mod job;
 pub mod render;
 mod text;

@@ -56,6 +56,10 @@
 //!   [`tree::build_tree_to_file`],
 //!   [`tree::build_tree_with_memory_limit_to_file`] stream).
 //! * [`report`]: tet quality at the seams vs elsewhere.
+//! * [`job`]: the same build as a job any engine can run: a plan and one
+//!   input file per part in a directory, each part built by its own
+//!   process in any order ([`job::build_part`]), then the streamed merge
+//!   ([`job::merge_job`]).
 //!
 //! | paper (seed 003)                       | code                                   |
 //! |----------------------------------------|----------------------------------------|
@@ -86,6 +90,7 @@
 //!   [`tree::build_tree_with_memory_limit`] moves them.
 
 pub mod error;
+pub mod job;
 pub mod memory_model;
 mod merge;
 mod parts;

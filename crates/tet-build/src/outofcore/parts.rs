@@ -114,49 +114,90 @@ pub(super) struct PartMesh {
     pub(super) stats: PartStats,
 }
 
+/// A part's PLC as TetGen receives it: its facets' points deduplicated by
+/// their exact bits, facets marked `1..` in order, box faces unmarked.
+pub(super) struct PartPlc {
+    pub(super) points: Vec<Vec3>,
+    pub(super) input: TetgenInput,
+    /// Points used by no scene facet.
+    pub(super) wall_points: usize,
+    /// Facets that are not scene pieces (seam-only and box faces).
+    pub(super) wall_triangles: usize,
+}
+
+impl PartPlc {
+    /// The PLC of a part's `facets` and `box_faces`.
+    pub(super) fn new(facets: &[([Vec3; 3], FacetKind)], box_faces: &[[Vec3; 3]]) -> PartPlc {
+        let mut index: HashMap<[u32; 3], u32> = HashMap::new();
+        let mut points: Vec<Vec3> = Vec::new();
+        let mut id = |p: Vec3| {
+            *index.entry(key(p)).or_insert_with(|| {
+                points.push(p);
+                points.len() as u32 - 1
+            })
+        };
+        let mut triangles = Vec::new();
+        let mut markers = Vec::new();
+        for (i, (t, _)) in facets.iter().enumerate() {
+            triangles.push(t.map(&mut id));
+            markers.push(i as i32 + 1);
+        }
+        for t in box_faces {
+            triangles.push(t.map(&mut id));
+            markers.push(0);
+        }
+        let mut on_scene = vec![false; points.len()];
+        for ((_, k), t) in facets.iter().zip(&triangles) {
+            if matches!(k, FacetKind::Scene(_)) {
+                for &v in t {
+                    on_scene[v as usize] = true;
+                }
+            }
+        }
+        let wall_points = on_scene.iter().filter(|&&s| !s).count();
+        let wall_triangles = facets
+            .iter()
+            .filter(|(_, k)| matches!(k, FacetKind::Seam))
+            .count()
+            + box_faces.len();
+        let input = TetgenInput {
+            points: points.iter().map(|p| p.as_dvec3().to_array()).collect(),
+            triangles,
+            markers,
+        };
+        PartPlc {
+            points,
+            input,
+            wall_points,
+            wall_triangles,
+        }
+    }
+
+    /// The memory model's prediction of TetGen's peak on this PLC
+    /// ([`super::memory_model::predict_part_peak_memory`], bytes).
+    pub(super) fn predicted_peak_bytes(&self) -> u64 {
+        let (points, triangles) = (self.input.points.len(), self.input.triangles.len());
+        super::memory_model::predict_part_peak_memory(
+            points - self.wall_points,
+            triangles - self.wall_triangles,
+            self.wall_points,
+            self.wall_triangles,
+        )
+    }
+}
+
 pub(super) fn run_part(
     part: usize,
     facets: &[([Vec3; 3], FacetKind)],
     box_faces: &[[Vec3; 3]],
     options: &SeamOptions,
 ) -> Result<PartMesh, SeamError> {
-    let mut index: HashMap<[u32; 3], u32> = HashMap::new();
-    let mut points: Vec<Vec3> = Vec::new();
-    let mut id = |p: Vec3| {
-        *index.entry(key(p)).or_insert_with(|| {
-            points.push(p);
-            points.len() as u32 - 1
-        })
-    };
-    let mut triangles = Vec::new();
-    let mut markers = Vec::new();
-    for (i, (t, _)) in facets.iter().enumerate() {
-        triangles.push(t.map(&mut id));
-        markers.push(i as i32 + 1);
-    }
-    for t in box_faces {
-        triangles.push(t.map(&mut id));
-        markers.push(0);
-    }
-    let mut on_scene = vec![false; points.len()];
-    for ((_, k), t) in facets.iter().zip(&triangles) {
-        if matches!(k, FacetKind::Scene(_)) {
-            for &v in t {
-                on_scene[v as usize] = true;
-            }
-        }
-    }
-    let wall_points = on_scene.iter().filter(|&&s| !s).count();
-    let wall_triangles = facets
-        .iter()
-        .filter(|(_, k)| matches!(k, FacetKind::Seam))
-        .count()
-        + box_faces.len();
-    let input = TetgenInput {
-        points: points.iter().map(|p| p.as_dvec3().to_array()).collect(),
-        triangles,
-        markers,
-    };
+    let PartPlc {
+        points,
+        input,
+        wall_points,
+        wall_triangles,
+    } = PartPlc::new(facets, box_faces);
     let mut topts = options.tetgen.clone();
     topts.preserve_surface = true;
     let out = match tetrahedralize(&input, &topts, &options.isolation) {

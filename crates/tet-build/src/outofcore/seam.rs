@@ -103,6 +103,19 @@ fn build_slabs_with<M: Merge>(
     options: &SeamOptions,
     merge: &M,
 ) -> Result<(M::Output, SeamReport), SeamError> {
+    let (inputs, report) = slab_part_inputs(scene, axis, values, options)?;
+    finish_parts(inputs, report, options, merge)
+}
+
+/// Every slab's PLC of `scene` cut by the planes `x[axis] = values[i]`
+/// (see [`build_slabs`]), in slab order, and the report's seam fields; no
+/// TetGen run.
+pub(super) fn slab_part_inputs(
+    scene: &Scene,
+    axis: usize,
+    values: &[f32],
+    options: &SeamOptions,
+) -> Result<(PartInputs, SeamReport), SeamError> {
     let Prepared {
         scene: cleaned,
         map: cm,
@@ -254,7 +267,7 @@ fn build_slabs_with<M: Merge>(
         triangle_source: cm.triangle_source,
         triangle_count: scene.triangles.len() as u32,
     };
-    finish_parts(inputs, report, options, merge)
+    Ok((inputs, report))
 }
 
 /// Builds `scene` so that every TetGen run's *predicted* peak fits

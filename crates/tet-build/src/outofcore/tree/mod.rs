@@ -104,6 +104,17 @@ fn build_tree_with<M: Merge>(
     options: &SeamOptions,
     merge: &M,
 ) -> Result<(M::Output, SeamReport), SeamError> {
+    let (inputs, report) = tree_part_inputs(scene, tree, options)?;
+    finish_parts(inputs, report, options, merge)
+}
+
+/// Every leaf's PLC of `scene` split by `tree` (see the module docs), in
+/// leaf order, and the report's seam fields; no TetGen run.
+pub(in crate::outofcore) fn tree_part_inputs(
+    scene: &Scene,
+    tree: &CutTree,
+    options: &SeamOptions,
+) -> Result<(PartInputs, SeamReport), SeamError> {
     let Prepared {
         scene: cleaned,
         map: cm,
@@ -197,7 +208,7 @@ fn build_tree_with<M: Merge>(
         triangle_source: cm.triangle_source,
         triangle_count: scene.triangles.len() as u32,
     };
-    finish_parts(inputs, report, options, merge)
+    Ok((inputs, report))
 }
 
 /// The plan [`build_tree_with_memory_limit`] built.
@@ -250,6 +261,23 @@ fn build_tree_with_memory_limit_with<M: Merge>(
     options: &SeamOptions,
     merge: &M,
 ) -> Result<(M::Output, SeamReport, TreePlan), SeamError> {
+    let ((output, report), plan) = plan_tree_with_moves(scene, split, options, |tree| {
+        build_tree_with(scene, tree, options, merge)
+    })?;
+    Ok((output, report, plan))
+}
+
+/// Plans the recursive split of `scene` under `split.limit_bytes` and
+/// calls `build` on its cut tree; a plane meeting a degenerate
+/// configuration ([`SeamError::PlaneNearPoint`],
+/// [`SeamError::DegenerateCut`]) is moved and `build` called again (see
+/// [`build_tree_with_memory_limit`]).
+pub(in crate::outofcore) fn plan_tree_with_moves<T>(
+    scene: &Scene,
+    split: &super::split::SplitOptions,
+    options: &SeamOptions,
+    mut build: impl FnMut(&CutTree) -> Result<T, SeamError>,
+) -> Result<(T, TreePlan), SeamError> {
     let (cleaned, _) = clean_scene(scene)?;
     if cleaned.triangles.is_empty() {
         return Err(SeamError::EmptyScene);
@@ -266,11 +294,10 @@ fn build_tree_with_memory_limit_with<M: Merge>(
     drop(cleaned);
     let mut moves = 0;
     loop {
-        match build_tree_with(scene, &tree, options, merge) {
-            Ok((mesh, report)) => {
+        match build(&tree) {
+            Ok(output) => {
                 return Ok((
-                    mesh,
-                    report,
+                    output,
                     TreePlan {
                         plan,
                         cuts: tree,

@@ -1,0 +1,267 @@
+//! Planning a job ([`plan_job`]): the scene cut exactly as the
+//! single-process builders cut it ([`crate::outofcore::tree`] or
+//! [`crate::outofcore::seam`]), every part's PLC written to its own input
+//! file, and `job.json` written last (so a job directory with a
+//! `job.json` has all its inputs).
+
+use std::path::Path;
+
+use tet_core::scene::SceneInfo;
+
+use super::digest::{Xxh64, format_digest};
+use super::error::JobError;
+use super::manifest::{
+    BuildRecord, ExactF32, JOB_FILE, JOB_SCHEMA, JOB_VERSION, JobManifest, MergePlan, PartRecord,
+    Partition, SceneRecord, SeamRecord, TreeNode,
+};
+use super::part_input::{PartInput, SEAM_FACET, encode};
+use super::records::write_atomic;
+use crate::bbox::EnclosingBox;
+use crate::clean::clean_scene;
+use crate::outofcore::error::SeamError;
+use crate::outofcore::merge::PartInputs;
+use crate::outofcore::parts::{FacetKind, PartPlc, SeamOptions, SeamReport};
+use crate::outofcore::seam::slab_part_inputs;
+use crate::outofcore::split::{SlabPlan, SplitOptions, plan_slabs};
+use crate::outofcore::tree::{plan_tree_with_moves, tree_part_inputs};
+use crate::scene::Scene;
+
+/// How to cut the scene.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Planner {
+    /// The paper's recursive tree; parallel slabs when no tree fits.
+    #[default]
+    Auto,
+    /// The recursive tree only.
+    Tree,
+    /// Parallel slabs only.
+    Slabs,
+}
+
+/// What [`plan_job`] is asked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanOptions {
+    /// Enclosing box, TetGen switches, resolution (isolation and
+    /// parallelism are the part runner's business and ignored here).
+    pub seam: SeamOptions,
+    /// Every part's predicted TetGen peak stays under this (bytes).
+    pub limit_bytes: Option<u64>,
+    /// At least this many parts: a tree is split down to depth
+    /// `⌈log2 parts⌉` at least; slabs are planned under lower limits until
+    /// there are as many.
+    pub parts: usize,
+    /// How to cut.
+    pub planner: Planner,
+    /// Hilbert-sort each part before writing its result.
+    pub sort_parts: bool,
+    /// Seconds a part's TetGen worker may run.
+    pub time_limit_s: f64,
+    /// Camera and lights stored with the merged mesh.
+    pub scene_info: SceneInfo,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        PlanOptions {
+            seam: SeamOptions::default(),
+            limit_bytes: None,
+            parts: 1,
+            planner: Planner::Auto,
+            sort_parts: true,
+            time_limit_s: 600.0,
+            scene_info: SceneInfo::default(),
+        }
+    }
+}
+
+/// Digest of a scene's geometry: vertex count, vertices' bits, triangles.
+pub fn scene_digest(scene: &Scene) -> String {
+    let mut h = Xxh64::new();
+    h.update(&(scene.vertices.len() as u64).to_le_bytes());
+    for v in &scene.vertices {
+        for c in v.to_array() {
+            h.update(&c.to_bits().to_le_bytes());
+        }
+    }
+    for t in &scene.triangles {
+        for i in t {
+            h.update(&i.to_le_bytes());
+        }
+    }
+    format_digest(h.finish())
+}
+
+/// Depth a tree must reach to have at least `parts` leaves.
+fn min_depth(parts: usize) -> usize {
+    parts.max(1).next_power_of_two().trailing_zeros() as usize
+}
+
+/// Slabs under `limit`, at least `parts` of them: the limit is lowered
+/// below the largest slab's prediction until there are enough (`None`
+/// when no plan fits).
+fn slabs_for(
+    vertices: &[glam::Vec3],
+    triangles: &[[u32; 3]],
+    bounds: (glam::Vec3, glam::Vec3),
+    limit: u64,
+    parts: usize,
+) -> Option<SlabPlan> {
+    let mut split = SplitOptions {
+        limit_bytes: limit,
+        ..SplitOptions::default()
+    };
+    for _ in 0..64 {
+        let plan = plan_slabs(vertices, triangles, bounds, &split)?;
+        if plan.values.len() + 1 >= parts {
+            return Some(plan);
+        }
+        let largest = plan.predicted_bytes.iter().copied().max()?;
+        split.limit_bytes = largest - largest / 8;
+    }
+    None
+}
+
+/// Cuts `scene` into parts (see [`PlanOptions`]), writes every part's
+/// input file and `job.json` into `dir` (made if missing) and returns the
+/// plan. Results of an earlier plan in `dir` stay; a part whose input is
+/// unchanged keeps its result (its digest still matches).
+pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobManifest, JobError> {
+    let (cleaned, _) = clean_scene(scene).map_err(|e| JobError::Plan(SeamError::from(e)))?;
+    if cleaned.triangles.is_empty() {
+        return Err(JobError::Plan(SeamError::EmptyScene));
+    }
+    let b = EnclosingBox::new(cleaned.bounds(), options.seam.enclosing_box)
+        .map_err(|e| JobError::Plan(SeamError::from(e)))?;
+    let limit = options.limit_bytes.unwrap_or(u64::MAX);
+    let split = SplitOptions {
+        limit_bytes: limit,
+        min_depth: min_depth(options.parts),
+        ..SplitOptions::default()
+    };
+    let seam = &options.seam;
+    let tree = match options.planner {
+        Planner::Slabs => None,
+        _ => {
+            match plan_tree_with_moves(scene, &split, seam, |t| tree_part_inputs(scene, t, seam)) {
+                Ok(((inputs, report), plan)) => {
+                    let mut next = 0;
+                    let node = TreeNode::from_cut_tree(&plan.cuts, &mut next);
+                    let partition = Partition::Tree {
+                        tree: node,
+                        plane_moves: plan.plane_moves,
+                    };
+                    Some((inputs, report, partition))
+                }
+                Err(SeamError::LimitTooSmall { .. }) if options.planner == Planner::Auto => None,
+                Err(SeamError::LimitTooSmall { limit_bytes }) => {
+                    return Err(JobError::LimitTooSmall { limit_bytes });
+                }
+                Err(e) => return Err(JobError::Plan(e)),
+            }
+        }
+    };
+    let (inputs, report, partition) = match tree {
+        Some(t) => t,
+        None => {
+            let plan = slabs_for(
+                &cleaned.vertices,
+                &cleaned.triangles,
+                (b.min, b.max),
+                limit,
+                options.parts,
+            )
+            .ok_or(JobError::LimitTooSmall { limit_bytes: limit })?;
+            let (inputs, report) =
+                slab_part_inputs(scene, plan.axis, &plan.values, seam).map_err(JobError::Plan)?;
+            let partition = Partition::Slabs {
+                axis: plan.axis,
+                values: plan.values.iter().map(|&v| ExactF32(v)).collect(),
+            };
+            (inputs, report, partition)
+        }
+    };
+    drop(cleaned);
+    std::fs::create_dir_all(dir).map_err(JobError::io(dir))?;
+    let parts = write_inputs(&inputs, dir)?;
+    let (camera, lights) = MergePlan::scene_records(&options.scene_info);
+    let manifest = JobManifest {
+        schema: JOB_SCHEMA.into(),
+        version: JOB_VERSION,
+        scene: SceneRecord {
+            name: scene.name.clone(),
+            digest: scene_digest(scene),
+            vertices: scene.vertices.len(),
+            triangles: inputs.triangle_count,
+        },
+        build: BuildRecord {
+            quality: seam.tetgen.quality,
+            max_steiner: seam.tetgen.max_steiner,
+            time_limit_s: options.time_limit_s,
+            sort_parts: options.sort_parts,
+            resolve: seam.resolve.is_some(),
+            limit_bytes: options.limit_bytes,
+            box_min: b.min.to_array().map(ExactF32),
+            box_max: b.max.to_array().map(ExactF32),
+        },
+        partition,
+        merge: merge_plan(&report, parts.len(), camera, lights),
+        parts,
+    };
+    write_atomic(&dir.join(JOB_FILE), manifest.to_json().as_bytes())?;
+    Ok(manifest)
+}
+
+fn merge_plan(
+    report: &SeamReport,
+    parts: usize,
+    camera: Option<super::manifest::CameraRecord>,
+    lights: Vec<super::manifest::LightRecord>,
+) -> MergePlan {
+    MergePlan {
+        seams: report.seams.iter().map(SeamRecord::new).collect(),
+        order: (0..parts).collect(),
+        camera,
+        lights,
+    }
+}
+
+/// Writes every part's input file; the parts' plan records.
+fn write_inputs(inputs: &PartInputs, dir: &Path) -> Result<Vec<PartRecord>, JobError> {
+    let mut records = Vec::with_capacity(inputs.parts.len());
+    for (k, (facets, box_faces)) in inputs.parts.iter().zip(&inputs.faces).enumerate() {
+        // Facets carry the *input* scene triangle, so that a part needs no
+        // map back from the cleaned scene.
+        let input = PartInput {
+            part: k as u32,
+            triangle_count: inputs.triangle_count,
+            facets: facets
+                .iter()
+                .map(|(t, kind)| {
+                    let id = match kind {
+                        FacetKind::Scene(s) => inputs.triangle_source[*s as usize],
+                        FacetKind::Seam => SEAM_FACET,
+                    };
+                    (*t, id)
+                })
+                .collect(),
+            box_faces: box_faces.clone(),
+        };
+        let plc = PartPlc::new(facets, box_faces);
+        let (bytes, sum) = encode(&input);
+        let name = format!("part-{k}.input");
+        write_atomic(&dir.join(&name), &bytes)?;
+        records.push(PartRecord {
+            index: k,
+            input: name,
+            input_digest: format_digest(sum),
+            input_bytes: bytes.len() as u64,
+            result: format!("part-{k}.tmesh"),
+            points: plc.input.points.len(),
+            triangles: plc.input.triangles.len(),
+            wall_points: plc.wall_points,
+            wall_triangles: plc.wall_triangles,
+            predicted_peak_bytes: plc.predicted_peak_bytes(),
+        });
+    }
+    Ok(records)
+}

@@ -1,0 +1,206 @@
+//! A job end to end: plan, parts built in reverse order by separate calls
+//! (as separate processes would), merge, against the single-process
+//! streamed build of the same plan; failed, stale, half-written and
+//! killed parts are named, rebuilt alone, and the merge comes out byte for
+//! byte the same.
+
+#![cfg(feature = "tetgen")]
+
+mod common;
+
+use std::path::Path;
+use std::time::Duration;
+
+use tet_build::outofcore::job::{
+    JobError, JobManifest, PartOutcome, PartState, PlanOptions, build_part, job_status, merge_job,
+    plan_job,
+};
+use tet_build::outofcore::memory_model::knot_grid;
+use tet_build::outofcore::seam::SeamOptions;
+use tet_build::outofcore::stream::StreamOptions;
+use tet_build::outofcore::tree::build_tree_to_file;
+use tet_build::tetgen::{Isolation, WorkerCommand};
+
+fn worker() -> Isolation {
+    Isolation::Worker(WorkerCommand {
+        program: env!("CARGO_BIN_EXE_tet-build-worker").into(),
+        args: vec![],
+        timeout: Some(Duration::from_secs(600)),
+    })
+}
+
+fn build_all(dir: &Path, job: &JobManifest, order: impl Iterator<Item = usize>) {
+    for k in order {
+        match build_part(dir, job, k, &worker()).unwrap() {
+            PartOutcome::Built(r) => {
+                assert_eq!(r.part, k);
+                assert!(r.tets > 0);
+                assert!(r.tetgen_peak_kib.is_some_and(|kib| kib > 0), "{r:?}");
+            }
+            PartOutcome::Skipped(r) => panic!("part {k} skipped on its first run: {r:?}"),
+        }
+    }
+}
+
+fn not_ready(e: JobError) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    match e {
+        JobError::PartsNotReady {
+            missing,
+            failed,
+            stale,
+        } => (missing, failed, stale),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn parts_in_any_order_merge_into_the_single_process_build() {
+    let scene = knot_grid(1, 120, 12);
+    let dir = tempfile::tempdir().unwrap();
+    let jobdir = dir.path().join("job");
+    let job = plan_job(
+        &scene,
+        &PlanOptions {
+            parts: 4,
+            ..PlanOptions::default()
+        },
+        &jobdir,
+    )
+    .unwrap();
+    let n = job.parts.len();
+    assert!(n >= 4, "{n} parts");
+
+    // Nothing built yet: the merge names every part.
+    let out = dir.path().join("job.tmesh");
+    let (missing, _, _) = not_ready(merge_job(&jobdir, &job, &out).unwrap_err());
+    assert_eq!(missing, (0..n).collect::<Vec<_>>());
+    assert!(!out.exists());
+
+    build_all(&jobdir, &job, (0..n).rev());
+    let summary = merge_job(&jobdir, &job, &out).unwrap();
+    let merged = tet_core::format::load(&out).unwrap();
+    assert_eq!(summary.tets, merged.tets.len() as u64);
+
+    // The single-process streamed build of the same cut tree.
+    let tree = match &job.partition {
+        tet_build::outofcore::job::manifest::Partition::Tree { tree, .. } => tree.cut_tree(),
+        other => panic!("{other:?}"),
+    };
+    let local_out = dir.path().join("local.tmesh");
+    let options = SeamOptions {
+        isolation: worker(),
+        ..SeamOptions::default()
+    };
+    build_tree_to_file(&scene, &tree, &options, &StreamOptions::new(&local_out)).unwrap();
+    let local = tet_core::format::load(&local_out).unwrap();
+    assert!(
+        common::canonical(&merged) == common::canonical(&local),
+        "the job's mesh differs from the single-process build's"
+    );
+    // Same parts, same order, same sort: the very same file.
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        std::fs::read(&local_out).unwrap()
+    );
+
+    // Running a finished part again does nothing.
+    assert!(matches!(
+        build_part(&jobdir, &job, 0, &worker()).unwrap(),
+        PartOutcome::Skipped(_)
+    ));
+}
+
+#[test]
+fn broken_parts_are_named_and_rebuilt_alone() {
+    let scene = knot_grid(1, 60, 8);
+    let dir = tempfile::tempdir().unwrap();
+    let jobdir = dir.path().join("job");
+    let options = PlanOptions {
+        parts: 4,
+        ..PlanOptions::default()
+    };
+    let job = plan_job(&scene, &options, &jobdir).unwrap();
+    let n = job.parts.len();
+    assert!(n >= 4, "{n} parts");
+    build_all(&jobdir, &job, 0..n);
+    let first = dir.path().join("first.tmesh");
+    merge_job(&jobdir, &job, &first).unwrap();
+    let reference = std::fs::read(&first).unwrap();
+    let out = dir.path().join("again.tmesh");
+    let paths = |k| job.part_paths(&jobdir, k);
+    let mtime = |k| {
+        std::fs::metadata(paths(k).result)
+            .unwrap()
+            .modified()
+            .unwrap()
+    };
+
+    // Part 1 half-written (a result cut short under its done record), part
+    // 2 killed before its record (result and temporary file left, no
+    // done record).
+    let r1 = std::fs::read(paths(1).result).unwrap();
+    std::fs::write(paths(1).result, &r1[..r1.len() / 2]).unwrap();
+    std::fs::remove_file(paths(2).done).unwrap();
+    std::fs::write(jobdir.join("part-2.tmesh.tmp999"), b"partial").unwrap();
+    let states = job_status(&jobdir, &job, false).unwrap();
+    assert!(matches!(states[0], PartState::Done(_)));
+    assert!(
+        matches!(states[1], PartState::Stale(ref why) if why.contains("bytes")),
+        "{states:?}"
+    );
+    assert_eq!(states[2], PartState::Missing);
+    let (missing, failed, stale) = not_ready(merge_job(&jobdir, &job, &out).unwrap_err());
+    assert_eq!((missing, failed, stale), (vec![2], vec![], vec![1]));
+    assert!(!out.exists());
+
+    // A result with the right length but other bytes: only the digest
+    // tells (the merge checks it; the quick status does not).
+    let r0 = std::fs::read(paths(0).result).unwrap();
+    let mut bad = r0.clone();
+    let at = bad.len() - 5;
+    bad[at] ^= 1;
+    std::fs::write(paths(0).result, &bad).unwrap();
+    assert!(matches!(
+        job_status(&jobdir, &job, false).unwrap()[0],
+        PartState::Done(_)
+    ));
+    assert!(matches!(
+        job_status(&jobdir, &job, true).unwrap()[0],
+        PartState::Stale(_)
+    ));
+    let (_, _, stale) = not_ready(merge_job(&jobdir, &job, &out).unwrap_err());
+    assert_eq!(stale, vec![0, 1]);
+
+    // A part whose input is damaged fails with a typed error and a record.
+    let input = std::fs::read(paths(3).input).unwrap();
+    let mut broken = input.clone();
+    broken[60] ^= 0xff;
+    std::fs::write(paths(3).input, &broken).unwrap();
+    std::fs::remove_file(paths(3).done).unwrap();
+    match build_part(&jobdir, &job, 3, &worker()) {
+        Err(JobError::PartInput { part, .. }) => assert_eq!(part, 3),
+        other => panic!("{other:?}"),
+    }
+    match &job_status(&jobdir, &job, false).unwrap()[3] {
+        PartState::Failed(e) => {
+            assert_eq!((e.part, e.kind.as_str()), (3, "input"));
+            assert!(e.message.contains("checksum"), "{}", e.message);
+        }
+        other => panic!("{other:?}"),
+    }
+    std::fs::write(paths(3).input, &input).unwrap();
+
+    // Re-running every part rebuilds exactly the broken ones.
+    let untouched = (4..n).map(|k| (k, mtime(k))).collect::<Vec<_>>();
+    for k in 0..n {
+        let outcome = build_part(&jobdir, &job, k, &worker()).unwrap();
+        let rebuilt = matches!(outcome, PartOutcome::Built(_));
+        assert_eq!(rebuilt, k <= 3, "part {k}: {outcome:?}");
+    }
+    for (k, t) in untouched {
+        assert_eq!(mtime(k), t, "part {k} was rewritten");
+    }
+    assert!(!paths(3).error.exists(), "the error record is removed");
+    merge_job(&jobdir, &job, &out).unwrap();
+    assert_eq!(std::fs::read(&out).unwrap(), reference);
+}
