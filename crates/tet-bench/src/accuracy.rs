@@ -44,11 +44,12 @@ use tet_trace_cpu::Viewpoint;
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Failure, Hit, Ray, TraceOutcome};
 use tet_trace_cpu::reference::{
-    Aim, edge_distance, line_triangle, random_direction, random_ray, ray_triangle, segment_distance,
+    Aim, edge_distance, line_triangle, random_ray, ray_triangle, segment_distance,
 };
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Start;
 
+pub use crate::adversarial::adversarial_rays;
 use crate::bvh::unit_scale;
 use crate::cli::{BuildFlags, Method, Precision};
 use crate::extremes;
@@ -450,76 +451,6 @@ pub fn ray_set(
     }
     rays.extend(adversarial_rays(mesh, adversarial, seed));
     Ok(RaySet { rays, view })
-}
-
-/// `n` rays (`accuracy --adversarial`) aimed at or started on the mesh's
-/// features, where a floating-point walk must decide ties: in turn, from a
-/// random interior point exactly at a vertex, at a point of an edge, at a
-/// point of a face; along an edge (from one vertex of a tet towards
-/// another); from a point of a face, and from a vertex, in a random
-/// direction. The triangle each ray uses is a scene triangle every other
-/// ray and a face of a random tet (a scene triangle or not) otherwise.
-/// Points of edges and faces are random combinations rounded to f32 (on
-/// the feature up to that rounding). Each ray starts in a tet holding its
-/// origin (exact location).
-pub fn adversarial_rays(mesh: &TetMesh, n: usize, seed: u64) -> Vec<(Ray, Option<Start>)> {
-    let mut rng = SplitMix64(seed ^ 0xad5e_7a71);
-    let mut out = Vec::with_capacity(n);
-    if mesh.tets.is_empty() {
-        return out;
-    }
-    let (tets, scene) = (mesh.tets.len() as u64, mesh.constrained.len() as u64);
-    for k in 0..n {
-        let t = (rng.next_u64() % tets) as u32;
-        let p = mesh.tet_points(t);
-        let (tri, near) = if k % 2 == 0 && scene > 0 {
-            let cf = &mesh.constrained[(rng.next_u64() % scene) as usize];
-            let near = if cf.front.exists() {
-                cf.front.tet
-            } else {
-                cf.back.tet
-            };
-            (cf.vertices.map(|v| mesh.points[v as usize]), near)
-        } else {
-            let f = tet_core::FACE_VERTICES[(rng.next_u64() % 4) as usize];
-            (f.map(|s| p[s]), t)
-        };
-        let (a, b) = (rng.next_f64(), rng.next_f64());
-        let on_edge = tri[0].as_dvec3().lerp(tri[1].as_dvec3(), a).as_vec3();
-        let (a, b) = if a + b > 1.0 {
-            (1.0 - a, 1.0 - b)
-        } else {
-            (a, b)
-        };
-        let d = tri.map(|v| v.as_dvec3());
-        let on_face = (d[0] + (d[1] - d[0]) * a + (d[2] - d[0]) * b).as_vec3();
-        let (origin, dir, hint) = match k % 6 {
-            0..=2 => {
-                let (o, at) = tet_trace_cpu::reference::random_point_inside(mesh, &mut rng);
-                let target = [tri[0], on_edge, on_face][k % 6];
-                (o, target - o, at)
-            }
-            3 => {
-                let r = rng.next_u64() as usize;
-                let (i, j) = (r % 4, (r % 4 + 1 + r / 4 % 3) % 4);
-                (p[i], p[j] - p[i], t)
-            }
-            4 => (on_face, random_direction(&mut rng), near),
-            _ => (tri[0], random_direction(&mut rng), near),
-        };
-        if dir == Vec3::ZERO || !dir.is_finite() {
-            continue;
-        }
-        let hint = if hint < mesh.tets.len() as u32 {
-            hint
-        } else {
-            t
-        };
-        if let Ok(start) = tet_trace_cpu::locate(mesh, origin, hint) {
-            out.push((Ray::new(origin, dir), Some(Start::Tet(start))));
-        }
-    }
-    out
 }
 
 /// Timed passes per measurement, at least (the best is reported).

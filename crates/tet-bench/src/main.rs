@@ -24,6 +24,7 @@
 
 mod accuracy;
 mod accuracy_scale;
+mod adversarial;
 mod brute;
 mod bvh;
 mod camera;
