@@ -7,7 +7,9 @@
 //! Methods: the paper's implicit min-max BVH built BIH-style (`ibvh`) or by
 //! SAH (`ibvh-sah`), traced one ray at a time, or the BIH one by 16×16
 //! packets (`ibvh-packets`); and the iso walk over our compact layouts
-//! (`walk-tet20`, `walk-tet16`, `walk-tet32`), which needs no BVH at all.
+//! (`walk-tet20`, `walk-tet16`, `walk-tet32`), which needs no BVH at all
+//! (each 16×16 tile's walks interleaved on one thread,
+//! [`IsoWalk::trace_tile`]).
 //! Every method sees the same rays of the same camera, which frames the
 //! volume's bounds the same way for all of them.
 
@@ -23,7 +25,6 @@ use tet_core::scene::Camera;
 use tet_trace_cpu::Ray;
 use tet_trace_cpu::iso::{Ibvh, IsoHit, IsoOutcome, IsoQuery, IsoStats, IsoWalk, WalkLayout};
 use tet_trace_cpu::render::PinholeCamera;
-use tet_trace_cpu::walk::EntryHint;
 
 pub use crate::cli::IsoMethod;
 
@@ -251,17 +252,13 @@ pub fn measure(
                         }
                         Traced::Walk(w) => {
                             let vp = vp.as_ref().expect("located above");
-                            let mut hint = EntryHint::default();
-                            rays.iter()
-                                .map(
-                                    |r| match w.trace_from(vp, r, &query, &mut hint, &mut stats) {
-                                        IsoOutcome::Hit { hit, .. } => Some(hit),
-                                        o => {
-                                            failures += o.is_failure() as u64;
-                                            None
-                                        }
-                                    },
-                                )
+                            let mut out = vec![IsoOutcome::Miss { tets_visited: 0 }; rays.len()];
+                            w.trace_tile(vp, &rays, &query, &mut out, &mut stats);
+                            out.iter()
+                                .map(|o| {
+                                    failures += o.is_failure() as u64;
+                                    o.hit().copied()
+                                })
                                 .collect()
                         }
                     };
