@@ -504,6 +504,52 @@ pub struct IsoArgs {
     /// Write the image (PNG).
     #[arg(short = 'o', long)]
     pub output: Option<PathBuf>,
+    /// Trace a shadow ray from every hit to the light (`--light` or
+    /// `--light-dir`; default: a point light at the eye); clipped-away
+    /// surface casts no shadow.
+    #[arg(long)]
+    pub shadows: bool,
+    /// Point light `X,Y,Z` of the shadow rays.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, conflicts_with = "light_dir")]
+    pub light: Option<glam::Vec3>,
+    /// Directional light: the direction `X,Y,Z` its light travels in.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub light_dir: Option<glam::Vec3>,
+    /// Clip box `X0,Y0,Z0,X1,Y1,Z1` (two opposite corners): only crossings
+    /// inside it count, or, with `--clip-mode cut`, crossings strictly
+    /// inside it are cut away.
+    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_box, allow_hyphen_values = true)]
+    pub clip: Option<(glam::Vec3, glam::Vec3)>,
+    /// What the clip box keeps.
+    #[arg(long, value_enum, default_value_t = IsoClipMode::Keep)]
+    pub clip_mode: IsoClipMode,
+    /// View (replaces parts of the default camera, which frames the
+    /// volume's bounds from an oblique direction).
+    #[command(flatten)]
+    pub view: ViewArgs,
+}
+
+/// What an `iso` clip box keeps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum IsoClipMode {
+    /// Crossings inside the box.
+    Keep,
+    /// Crossings outside the box (the box is cut away).
+    Cut,
+}
+
+/// Parses `X0,Y0,Z0,X1,Y1,Z1` (six finite numbers) into the box's lower and
+/// upper corners.
+pub fn parse_box(s: &str) -> Result<(glam::Vec3, glam::Vec3), String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 6 {
+        return Err(format!(
+            "`{s}` is not a box: give six numbers X0,Y0,Z0,X1,Y1,Z1 separated by commas"
+        ));
+    }
+    let a = parse_vec3(&parts[..3].join(","))?;
+    let b = parse_vec3(&parts[3..].join(","))?;
+    Ok((a.min(b), a.max(b)))
 }
 
 /// `convert` arguments.
