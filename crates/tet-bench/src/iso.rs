@@ -425,9 +425,8 @@ fn shadows(
     query: &IsoQuery,
     diagonal: f32,
 ) -> Vec<bool> {
-    let shadow = |(r, h): (&Ray, &Option<IsoHit>)| {
-        h.map(|h| (light.shadow_ray(r.at(h.t), diagonal), h.tet))
-    };
+    let shadow =
+        |(r, h): (&Ray, &Option<IsoHit>)| h.map(|h| (light.shadow_ray(r.at(h.t), diagonal), h.tet));
     let todo: Vec<(usize, Ray, u32)> = rays
         .iter()
         .zip(hits)
@@ -528,7 +527,14 @@ mod tests {
     /// under `view`, at 40², two isovalues.
     fn frames_of(view: impl Fn(&TetMesh) -> IsoView) -> (IsoVolume, Vec<f32>, Vec<Vec<IsoPixel>>) {
         let volume = load_iso_volume("linear").unwrap();
-        let (lo, hi) = volume.mesh.attributes.scalars.as_ref().unwrap().range().unwrap();
+        let (lo, hi) = volume
+            .mesh
+            .attributes
+            .scalars
+            .as_ref()
+            .unwrap()
+            .range()
+            .unwrap();
         let isos = vec![lo + 0.35 * (hi - lo), lo + 0.6 * (hi - lo)];
         let pool = crate::timing::pool(Some(1)).unwrap();
         let f = IsoFrames {
@@ -568,7 +574,10 @@ mod tests {
         });
         let hits = images[0].iter().filter(|p| p.hit.is_some()).count();
         let shadowed = images[0].iter().filter(|p| p.shadowed).count();
-        assert!(hits > 200 && shadowed > 50 && shadowed < hits, "{hits} {shadowed}");
+        assert!(
+            hits > 200 && shadowed > 50 && shadowed < hits,
+            "{hits} {shadowed}"
+        );
         for (m, im) in IsoMethod::ALL.iter().zip(&images) {
             let d = differing(&images[0], im);
             assert!(d <= 4, "{}: {d} pixels differ", m.name());
@@ -605,7 +614,14 @@ mod tests {
         }
         // The reference, f64 brute force, on every pixel.
         let camera = PinholeCamera::new(&iso_camera(&volume.mesh), 40, 40, true);
-        let values = volume.mesh.attributes.scalars.as_ref().unwrap().step(0).unwrap();
+        let values = volume
+            .mesh
+            .attributes
+            .scalars
+            .as_ref()
+            .unwrap()
+            .step(0)
+            .unwrap();
         let q = IsoQuery {
             isovalues: &isos,
             clip: Some(clip),

@@ -20,8 +20,8 @@
 use tet_build::vtk::{VtkEncoding, write_vtk};
 use tet_core::synthetic::{GridSpec, kuhn_grid};
 use tet_core::{ScalarField, TetMesh};
-use vtkio::model::{Attribute, CellType, DataSet, IOBuffer, Piece, VertexNumbers};
 use vtkio::Vtk;
+use vtkio::model::{Attribute, CellType, DataSet, IOBuffer, Piece};
 
 fn mesh() -> TetMesh {
     let mut m = kuhn_grid(&GridSpec {
@@ -33,7 +33,11 @@ fn mesh() -> TetMesh {
     let n = m.points.len();
     m.attributes.scalars = Some(ScalarField {
         name: "density".into(),
-        steps: vec![(0..n).map(|i| (i as f32 * 0.37).sin() * 1e3 + 0.25).collect()],
+        steps: vec![
+            (0..n)
+                .map(|i| (i as f32 * 0.37).sin() * 1e3 + 0.25)
+                .collect(),
+        ],
     });
     m.validate().unwrap();
     m
@@ -99,7 +103,10 @@ fn check(vtk: Vtk, m: &TetMesh, what: &str) {
     }
     let want: Vec<Vec<u32>> = m.tets.iter().map(|t| t.to_vec()).collect();
     assert_eq!(got, want, "{what}: connectivity");
-    assert!(p.cells.types.iter().all(|&t| t == CellType::Tetra), "{what}");
+    assert!(
+        p.cells.types.iter().all(|&t| t == CellType::Tetra),
+        "{what}"
+    );
     let field = m.attributes.scalars.as_ref().unwrap();
     let data = p
         .data
@@ -136,4 +143,3 @@ fn vtkio_reads_our_vtu_and_legacy_files() {
         }
     }
 }
-

@@ -535,7 +535,13 @@ fn entry_from_a_carried_hint_is_entry_from_scratch() {
     let (mut entered, mut hits) = (0, 0);
     for ray in &rays {
         let carried = w.trace_from(&vp, ray, &q, &mut hint, &mut Default::default());
-        let fresh = w.trace_from(&vp, ray, &q, &mut Default::default(), &mut Default::default());
+        let fresh = w.trace_from(
+            &vp,
+            ray,
+            &q,
+            &mut Default::default(),
+            &mut Default::default(),
+        );
         assert_eq!(carried, fresh, "{ray:?}");
         entered += (carried.tets_visited() > 0) as usize;
         hits += carried.hit().is_some() as usize;

@@ -34,10 +34,8 @@ pub fn run(args: &IsoArgs, json: bool) -> Result<()> {
             IsoClipMode::Cut => ClipMode::CutAway,
         },
     });
-    if args.light.is_some() || args.light_dir.is_some() {
-        if !args.shadows {
-            bail!("--light and --light-dir place the light of --shadows: add --shadows");
-        }
+    if (args.light.is_some() || args.light_dir.is_some()) && !args.shadows {
+        bail!("--light and --light-dir place the light of --shadows: add --shadows");
     }
     if args.shadows {
         view.light = Some(match (args.light, args.light_dir) {

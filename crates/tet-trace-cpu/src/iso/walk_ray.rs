@@ -31,7 +31,12 @@ pub(super) struct Ctx<'a> {
 }
 
 impl<'a> Ctx<'a> {
-    pub(super) fn new(mesh: &'a TetMesh, values: &'a [f32], ray: &'a Ray, query: &'a IsoQuery<'a>) -> Self {
+    pub(super) fn new(
+        mesh: &'a TetMesh,
+        values: &'a [f32],
+        ray: &'a Ray,
+        query: &'a IsoQuery<'a>,
+    ) -> Self {
         Ctx {
             mesh,
             values,
