@@ -552,6 +552,76 @@ pub fn parse_box(s: &str) -> Result<(glam::Vec3, glam::Vec3), String> {
     Ok((a.min(b), a.max(b)))
 }
 
+#[cfg(test)]
+mod iso_args_tests {
+    use clap::Parser;
+    use glam::Vec3;
+
+    use super::*;
+
+    #[test]
+    fn boxes_parse_as_six_numbers_in_either_corner_order() {
+        assert_eq!(
+            parse_box("1,-2,3,0,4,-5"),
+            Ok((Vec3::new(0.0, -2.0, -5.0), Vec3::new(1.0, 4.0, 3.0)))
+        );
+        for bad in [
+            "",
+            "1,2,3",
+            "1,2,3,4,5",
+            "1,2,3,4,5,6,7",
+            "1,2,3,4,x,6",
+            "1,2,3,inf,5,6",
+        ] {
+            assert!(parse_box(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn iso_flags_parse() {
+        let cli = Cli::try_parse_from([
+            "tet-bench",
+            "iso",
+            "ell32p",
+            "--clip",
+            "0,0,0,1,2,3",
+            "--clip-mode",
+            "cut",
+            "--shadows",
+            "--light-dir",
+            "0,-1,0",
+            "--eye",
+            "5,5,5",
+            "--fov",
+            "30",
+        ])
+        .unwrap();
+        let Command::Iso(a) = cli.command else {
+            panic!("not iso")
+        };
+        assert_eq!(a.clip, Some((Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0))));
+        assert_eq!(a.clip_mode, IsoClipMode::Cut);
+        assert!(a.shadows);
+        assert_eq!(a.light_dir, Some(Vec3::new(0.0, -1.0, 0.0)));
+        assert_eq!(a.view.eye, Some(Vec3::splat(5.0)));
+        assert_eq!(a.view.fov, Some(30.0));
+        // A point light and a directional one exclude each other.
+        assert!(
+            Cli::try_parse_from([
+                "tet-bench",
+                "iso",
+                "ell32p",
+                "--shadows",
+                "--light",
+                "1,2,3",
+                "--light-dir",
+                "0,1,0",
+            ])
+            .is_err()
+        );
+    }
+}
+
 /// `convert` arguments.
 #[derive(Debug, Args)]
 pub struct ConvertArgs {
