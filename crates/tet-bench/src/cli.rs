@@ -662,6 +662,122 @@ pub struct IsoArgs {
     /// Write the image (PNG).
     #[arg(short = 'o', long)]
     pub output: Option<PathBuf>,
+    /// Trace a shadow ray from every hit to the light (`--light` or
+    /// `--light-dir`; default: a point light at the eye); clipped-away
+    /// surface casts no shadow.
+    #[arg(long)]
+    pub shadows: bool,
+    /// Point light `X,Y,Z` of the shadow rays.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, conflicts_with = "light_dir")]
+    pub light: Option<glam::Vec3>,
+    /// Directional light: the direction `X,Y,Z` its light travels in.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub light_dir: Option<glam::Vec3>,
+    /// Clip box `X0,Y0,Z0,X1,Y1,Z1` (two opposite corners): only crossings
+    /// inside it count, or, with `--clip-mode cut`, crossings strictly
+    /// inside it are cut away.
+    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_box, allow_hyphen_values = true)]
+    pub clip: Option<(glam::Vec3, glam::Vec3)>,
+    /// What the clip box keeps.
+    #[arg(long, value_enum, default_value_t = IsoClipMode::Keep)]
+    pub clip_mode: IsoClipMode,
+    /// View (replaces parts of the default camera, which frames the
+    /// volume's bounds from an oblique direction).
+    #[command(flatten)]
+    pub view: ViewArgs,
+}
+
+/// What an `iso` clip box keeps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum IsoClipMode {
+    /// Crossings inside the box.
+    Keep,
+    /// Crossings outside the box (the box is cut away).
+    Cut,
+}
+
+/// Parses `X0,Y0,Z0,X1,Y1,Z1` (six finite numbers) into the box's lower and
+/// upper corners.
+pub fn parse_box(s: &str) -> Result<(glam::Vec3, glam::Vec3), String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 6 {
+        return Err(format!(
+            "`{s}` is not a box: give six numbers X0,Y0,Z0,X1,Y1,Z1 separated by commas"
+        ));
+    }
+    let a = parse_vec3(&parts[..3].join(","))?;
+    let b = parse_vec3(&parts[3..].join(","))?;
+    Ok((a.min(b), a.max(b)))
+}
+
+#[cfg(test)]
+mod iso_args_tests {
+    use clap::Parser;
+    use glam::Vec3;
+
+    use super::*;
+
+    #[test]
+    fn boxes_parse_as_six_numbers_in_either_corner_order() {
+        assert_eq!(
+            parse_box("1,-2,3,0,4,-5"),
+            Ok((Vec3::new(0.0, -2.0, -5.0), Vec3::new(1.0, 4.0, 3.0)))
+        );
+        for bad in [
+            "",
+            "1,2,3",
+            "1,2,3,4,5",
+            "1,2,3,4,5,6,7",
+            "1,2,3,4,x,6",
+            "1,2,3,inf,5,6",
+        ] {
+            assert!(parse_box(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn iso_flags_parse() {
+        let cli = Cli::try_parse_from([
+            "tet-bench",
+            "iso",
+            "ell32p",
+            "--clip",
+            "0,0,0,1,2,3",
+            "--clip-mode",
+            "cut",
+            "--shadows",
+            "--light-dir",
+            "0,-1,0",
+            "--eye",
+            "5,5,5",
+            "--fov",
+            "30",
+        ])
+        .unwrap();
+        let Command::Iso(a) = cli.command else {
+            panic!("not iso")
+        };
+        assert_eq!(a.clip, Some((Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0))));
+        assert_eq!(a.clip_mode, IsoClipMode::Cut);
+        assert!(a.shadows);
+        assert_eq!(a.light_dir, Some(Vec3::new(0.0, -1.0, 0.0)));
+        assert_eq!(a.view.eye, Some(Vec3::splat(5.0)));
+        assert_eq!(a.view.fov, Some(30.0));
+        // A point light and a directional one exclude each other.
+        assert!(
+            Cli::try_parse_from([
+                "tet-bench",
+                "iso",
+                "ell32p",
+                "--shadows",
+                "--light",
+                "1,2,3",
+                "--light-dir",
+                "0,1,0",
+            ])
+            .is_err()
+        );
+    }
 }
 
 /// `convert` arguments.

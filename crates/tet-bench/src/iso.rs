@@ -7,7 +7,9 @@
 //! Methods: the paper's implicit min-max BVH built BIH-style (`ibvh`) or by
 //! SAH (`ibvh-sah`), traced one ray at a time, or the BIH one by 16×16
 //! packets (`ibvh-packets`); and the iso walk over our compact layouts
-//! (`walk-tet20`, `walk-tet16`, `walk-tet32`), which needs no BVH at all.
+//! (`walk-tet20`, `walk-tet16`, `walk-tet32`), which needs no BVH at all
+//! (each 16×16 tile's walks interleaved on one thread,
+//! [`IsoWalk::trace_tile`]).
 //! Every method sees the same rays of the same camera, which frames the
 //! volume's bounds the same way for all of them.
 
@@ -21,9 +23,10 @@ use tet_build::volume::{VolumeOptions, load_volume, synthetic_volume_info};
 use tet_core::TetMesh;
 use tet_core::scene::Camera;
 use tet_trace_cpu::Ray;
-use tet_trace_cpu::iso::{Ibvh, IsoHit, IsoOutcome, IsoQuery, IsoStats, IsoWalk, WalkLayout};
+use tet_trace_cpu::iso::{
+    ClipBox, Ibvh, IsoHit, IsoOutcome, IsoQuery, IsoStats, IsoWalk, WalkLayout,
+};
 use tet_trace_cpu::render::PinholeCamera;
-use tet_trace_cpu::walk::EntryHint;
 
 pub use crate::cli::IsoMethod;
 
@@ -137,6 +140,10 @@ pub struct IsoDoc {
     pub rays: u64,
     /// Rays that hit an isosurface.
     pub hits: u64,
+    /// Shadow rays traced (one per hit with `--shadows`, else 0).
+    pub shadow_rays: u64,
+    /// Hits whose shadow ray was blocked.
+    pub shadowed: u64,
     /// Walks that failed (step cap, lost); always 0 for the IBVH.
     pub failures: u64,
     /// Building the method's structure (IBVH, or the walk's layout and
@@ -179,17 +186,88 @@ pub struct IsoFrames {
     pub frames: u32,
     /// Time step.
     pub time_step: usize,
+    /// Camera, clip box and light.
+    pub view: IsoView,
+}
+
+/// What a frame looks at and how: the camera, an optional clip box (every
+/// method applies it to primary and shadow rays alike) and an optional
+/// light for shadow rays.
+#[derive(Clone, Copy, Debug)]
+pub struct IsoView {
+    /// The camera.
+    pub camera: Camera,
+    /// Clip box.
+    pub clip: Option<ClipBox>,
+    /// Light of the shadow rays (none: no shadow rays).
+    pub light: Option<IsoLight>,
+}
+
+impl IsoView {
+    /// The default view of `mesh` ([`iso_camera`]), no clip box, no shadows.
+    pub fn of(mesh: &TetMesh) -> IsoView {
+        IsoView {
+            camera: iso_camera(mesh),
+            clip: None,
+            light: None,
+        }
+    }
+}
+
+/// The light of the shadow rays.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum IsoLight {
+    /// A point light.
+    Point(Vec3),
+    /// A directional light: the direction its light travels in.
+    Directional(Vec3),
+}
+
+/// Start of a shadow ray's accepted range: a thousandth of the way to a
+/// point light, or of the volume's diagonal for a directional one, so that
+/// the surface a shadow ray leaves does not shadow itself.
+const SHADOW_OFFSET: f32 = 1e-3;
+
+impl IsoLight {
+    /// The shadow ray from the hit point `p` to the light (`diagonal`: the
+    /// volume's bounding-box diagonal).
+    pub fn shadow_ray(&self, p: Vec3, diagonal: f32) -> Ray {
+        match *self {
+            IsoLight::Point(l) => Ray {
+                origin: p,
+                direction: l - p,
+                t_min: SHADOW_OFFSET,
+                t_max: 1.0,
+            },
+            IsoLight::Directional(d) => Ray {
+                origin: p,
+                direction: -d.normalize_or_zero(),
+                t_min: SHADOW_OFFSET * diagonal,
+                t_max: f32::INFINITY,
+            },
+        }
+    }
+}
+
+/// One pixel of a frame: the primary hit and whether a shadow ray from it
+/// found the light blocked.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IsoPixel {
+    /// The first crossing (`None`: background).
+    pub hit: Option<IsoHit>,
+    /// The hit's shadow ray met an isosurface before the light.
+    pub shadowed: bool,
 }
 
 /// Traces `method` on `volume` and returns the document and the last
-/// frame's hits (row-major, `None` = background).
+/// frame's pixels (row-major).
 pub fn measure(
     volume: &IsoVolume,
     isovalues: &[f32],
     method: IsoMethod,
     f: IsoFrames,
     pool: &rayon::ThreadPool,
-) -> Result<(IsoDoc, Vec<Option<IsoHit>>)> {
+) -> Result<(IsoDoc, Vec<IsoPixel>)> {
     let mesh = &volume.mesh;
     let field = mesh
         .attributes
@@ -203,8 +281,15 @@ pub fn measure(
             field.step_count()
         )
     })?;
-    let query = IsoQuery::new(isovalues);
+    let query = IsoQuery {
+        isovalues,
+        clip: f.view.clip,
+    };
     query.check()?;
+    let diagonal = {
+        let (lo, hi) = mesh.point_bounds();
+        (hi - lo).length()
+    };
     let t = Instant::now();
     let traced = match method {
         IsoMethod::Ibvh => Traced::Ibvh(Ibvh::build_bih(mesh, values)?, false),
@@ -221,14 +306,14 @@ pub fn measure(
         }
     };
     let build_ms = t.elapsed().as_secs_f64() * 1e3;
-    let camera = PinholeCamera::new(&iso_camera(mesh), f.width, f.height, true);
+    let camera = PinholeCamera::new(&f.view.camera, f.width, f.height, true);
     let tiles = tiles(f.width, f.height);
     let vp = match &traced {
         Traced::Walk(w) => Some(w.viewpoint(camera.position).context("camera not located")?),
         Traced::Ibvh(..) => None,
     };
-    // One frame: per tile, its rays' outcomes and counters.
-    let frame = || -> Vec<(Vec<Option<IsoHit>>, IsoStats, u64)> {
+    // One frame: per tile, its pixels and counters.
+    let frame = || -> Vec<(Vec<IsoPixel>, IsoStats, u64)> {
         pool.install(|| {
             tiles
                 .par_iter()
@@ -251,21 +336,26 @@ pub fn measure(
                         }
                         Traced::Walk(w) => {
                             let vp = vp.as_ref().expect("located above");
-                            let mut hint = EntryHint::default();
-                            rays.iter()
-                                .map(
-                                    |r| match w.trace_from(vp, r, &query, &mut hint, &mut stats) {
-                                        IsoOutcome::Hit { hit, .. } => Some(hit),
-                                        o => {
-                                            failures += o.is_failure() as u64;
-                                            None
-                                        }
-                                    },
-                                )
+                            let mut out = vec![IsoOutcome::Miss { tets_visited: 0 }; rays.len()];
+                            w.trace_tile(vp, &rays, &query, &mut out, &mut stats);
+                            out.iter()
+                                .map(|o| {
+                                    failures += o.is_failure() as u64;
+                                    o.hit().copied()
+                                })
                                 .collect()
                         }
                     };
-                    (hits, stats, failures)
+                    let shadowed = match f.view.light {
+                        Some(light) => shadows(&traced, &light, &rays, &hits, &query, diagonal),
+                        None => vec![false; hits.len()],
+                    };
+                    let pixels = hits
+                        .iter()
+                        .zip(shadowed)
+                        .map(|(&hit, shadowed)| IsoPixel { hit, shadowed })
+                        .collect();
+                    (pixels, stats, failures)
                 })
                 .collect()
         })
@@ -289,7 +379,9 @@ pub fn measure(
         failures += fl;
     }
     let image = assemble(&tiles, last, f.width, f.height);
-    let hits = image.iter().filter(|h| h.is_some()).count() as u64;
+    let hits = image.iter().filter(|p| p.hit.is_some()).count() as u64;
+    let shadowed = image.iter().filter(|p| p.shadowed).count() as u64;
+    let shadow_rays = if f.view.light.is_some() { hits } else { 0 };
     let bytes = match &traced {
         Traced::Ibvh(b, _) => b.bytes(),
         Traced::Walk(w) => w.bytes(),
@@ -308,6 +400,8 @@ pub fn measure(
         frames: f.frames.max(1),
         rays,
         hits,
+        shadow_rays,
+        shadowed,
         failures,
         build_ms,
         best_ms,
@@ -318,6 +412,51 @@ pub fn measure(
         per_ray: IsoCounts::per_ray(&stats, rays),
     };
     Ok((doc, image))
+}
+
+/// Per ray of a tile, whether the shadow ray from its hit to `light` is
+/// blocked, by the tile's own method: single IBVH shadow rays, IBVH packets
+/// of the tile's shadow rays, or walks from the hit tet.
+fn shadows(
+    traced: &Traced,
+    light: &IsoLight,
+    rays: &[Ray],
+    hits: &[Option<IsoHit>],
+    query: &IsoQuery,
+    diagonal: f32,
+) -> Vec<bool> {
+    let shadow =
+        |(r, h): (&Ray, &Option<IsoHit>)| h.map(|h| (light.shadow_ray(r.at(h.t), diagonal), h.tet));
+    let todo: Vec<(usize, Ray, u32)> = rays
+        .iter()
+        .zip(hits)
+        .enumerate()
+        .filter_map(|(i, x)| shadow(x).map(|(s, t)| (i, s, t)))
+        .collect();
+    let mut out = vec![false; rays.len()];
+    match traced {
+        Traced::Ibvh(b, false) => {
+            for &(i, s, _) in &todo {
+                out[i] = b.occluded(&s, query);
+            }
+        }
+        Traced::Ibvh(b, true) => {
+            let srays: Vec<Ray> = todo.iter().map(|x| x.1).collect();
+            let mut blocked = vec![false; srays.len()];
+            b.occluded_packet(&srays, query, &mut blocked);
+            for (&(i, _, _), b) in todo.iter().zip(blocked) {
+                out[i] = b;
+            }
+        }
+        Traced::Walk(w) => {
+            for &(i, s, tet) in &todo {
+                // A failed walk counts as lit (reported by the primary
+                // rays' failure count when it recurs).
+                out[i] = w.occluded_near(&s, tet, query).unwrap_or(false);
+            }
+        }
+    }
+    out
 }
 
 /// The image split into `TILE`×`TILE` tiles `(x0, y0, x1, y1)`, row-major.
@@ -334,11 +473,11 @@ fn tiles(width: u32, height: u32) -> Vec<(u32, u32, u32, u32)> {
 /// The tiles' hits back in row-major pixel order.
 fn assemble(
     tiles: &[(u32, u32, u32, u32)],
-    traced: Vec<(Vec<Option<IsoHit>>, IsoStats, u64)>,
+    traced: Vec<(Vec<IsoPixel>, IsoStats, u64)>,
     width: u32,
     height: u32,
-) -> Vec<Option<IsoHit>> {
-    let mut image = vec![None; width as usize * height as usize];
+) -> Vec<IsoPixel> {
+    let mut image = vec![IsoPixel::default(); width as usize * height as usize];
     for (&(x0, y0, x1, y1), (hits, _, _)) in tiles.iter().zip(traced) {
         let mut k = 0;
         for j in y0..y1 {
@@ -351,26 +490,153 @@ fn assemble(
     image
 }
 
-/// Linear RGB of a frame's hits: one colour per isovalue, shaded by the
-/// field gradient against the view direction; background dark grey.
-pub fn shade(image: &[Option<IsoHit>], mesh: &TetMesh, width: u32, height: u32) -> Vec<Vec3> {
+/// Linear RGB of a frame's pixels: one colour per isovalue, shaded by the
+/// field gradient against the view direction, darker in shadow; background
+/// dark grey.
+pub fn shade(image: &[IsoPixel], camera: &Camera, width: u32, height: u32) -> Vec<Vec3> {
     const PALETTE: [Vec3; 4] = [
         Vec3::new(0.9, 0.55, 0.2),
         Vec3::new(0.25, 0.6, 0.9),
         Vec3::new(0.4, 0.85, 0.35),
         Vec3::new(0.85, 0.3, 0.6),
     ];
-    let camera = PinholeCamera::new(&iso_camera(mesh), width, height, true);
+    let camera = PinholeCamera::new(camera, width, height, true);
     image
         .iter()
         .enumerate()
-        .map(|(k, h)| match h {
+        .map(|(k, p)| match p.hit {
             Some(h) => {
                 let d = camera.ray(k as u32 % width, k as u32 / width).direction;
-                let lambert = h.normal.dot(d).abs();
-                PALETTE[h.isovalue_index as usize % 4] * (0.2 + 0.8 * lambert)
+                let lambert = h.normal.dot(d.normalize_or_zero()).abs();
+                let light = if p.shadowed { 0.35 } else { 1.0 };
+                PALETTE[h.isovalue_index as usize % 4] * (0.2 + 0.8 * lambert * light)
             }
             None => Vec3::splat(0.05),
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use tet_trace_cpu::iso::ClipMode;
+    use tet_trace_cpu::iso::reference::closest;
+
+    use super::*;
+
+    /// The pixels of every method on the `linear` volume (parallel planes)
+    /// under `view`, at 40², two isovalues.
+    fn frames_of(view: impl Fn(&TetMesh) -> IsoView) -> (IsoVolume, Vec<f32>, Vec<Vec<IsoPixel>>) {
+        let volume = load_iso_volume("linear").unwrap();
+        let (lo, hi) = volume
+            .mesh
+            .attributes
+            .scalars
+            .as_ref()
+            .unwrap()
+            .range()
+            .unwrap();
+        let isos = vec![lo + 0.35 * (hi - lo), lo + 0.6 * (hi - lo)];
+        let pool = crate::timing::pool(Some(1)).unwrap();
+        let f = IsoFrames {
+            width: 40,
+            height: 40,
+            frames: 1,
+            time_step: 0,
+            view: view(&volume.mesh),
+        };
+        let images = IsoMethod::ALL
+            .iter()
+            .map(|&m| measure(&volume, &isos, m, f, &pool).unwrap().1)
+            .collect();
+        (volume, isos, images)
+    }
+
+    /// Pixels on which two methods differ (hit or not, shadowed or not).
+    fn differing(a: &[IsoPixel], b: &[IsoPixel]) -> usize {
+        a.iter()
+            .zip(b)
+            .filter(|(x, y)| x.hit.is_some() != y.hit.is_some() || x.shadowed != y.shadowed)
+            .count()
+    }
+
+    /// With a point light beyond both planes, every method shadows the same
+    /// pixels (the near plane's hits lie in the far plane's shadow), up to
+    /// a few pixels whose rays graze an edge of the planes.
+    #[test]
+    fn methods_agree_on_shadows() {
+        let (volume, _, images) = frames_of(|mesh| {
+            let mut v = IsoView::of(mesh);
+            let (lo, hi) = mesh.point_bounds();
+            // Opposite the camera across the volume.
+            let c = 0.5 * (lo + hi);
+            v.light = Some(IsoLight::Point(c + (c - v.camera.position)));
+            v
+        });
+        let hits = images[0].iter().filter(|p| p.hit.is_some()).count();
+        let shadowed = images[0].iter().filter(|p| p.shadowed).count();
+        assert!(
+            hits > 200 && shadowed > 50 && shadowed < hits,
+            "{hits} {shadowed}"
+        );
+        for (m, im) in IsoMethod::ALL.iter().zip(&images) {
+            let d = differing(&images[0], im);
+            assert!(d <= 4, "{}: {d} pixels differ", m.name());
+            // A shadowed pixel has a hit.
+            assert!(im.iter().all(|p| !p.shadowed || p.hit.is_some()));
+        }
+        let _ = volume;
+    }
+
+    /// A clip box keeping one half of the volume: every method keeps the
+    /// same pixels, each hit lies in the box, and the hits match the f64
+    /// reference under the same clip box.
+    #[test]
+    fn methods_agree_on_a_clip_box() {
+        let clip_of = |mesh: &TetMesh| {
+            let (lo, hi) = mesh.point_bounds();
+            ClipBox {
+                lo,
+                hi: Vec3::new(0.5 * (lo.x + hi.x), hi.y, hi.z),
+                mode: ClipMode::KeepInside,
+            }
+        };
+        let (_, _, unclipped) = frames_of(IsoView::of);
+        let (volume, isos, images) = frames_of(|mesh| {
+            let mut v = IsoView::of(mesh);
+            v.clip = Some(clip_of(mesh));
+            v
+        });
+        let clip = clip_of(&volume.mesh);
+        let count = |im: &[IsoPixel]| im.iter().filter(|p| p.hit.is_some()).count();
+        assert!(count(&images[0]) > 100 && count(&images[0]) < count(&unclipped[0]));
+        for (m, im) in IsoMethod::ALL.iter().zip(&images) {
+            assert!(differing(&images[0], im) <= 4, "{}", m.name());
+        }
+        // The reference, f64 brute force, on every pixel.
+        let camera = PinholeCamera::new(&iso_camera(&volume.mesh), 40, 40, true);
+        let values = volume
+            .mesh
+            .attributes
+            .scalars
+            .as_ref()
+            .unwrap()
+            .step(0)
+            .unwrap();
+        let q = IsoQuery {
+            isovalues: &isos,
+            clip: Some(clip),
+        };
+        let mut wrong = 0;
+        for (k, p) in images[0].iter().enumerate() {
+            let ray = camera.ray(k as u32 % 40, k as u32 / 40);
+            let want = closest(&volume.mesh, values, &ray, &q);
+            if let Some(h) = p.hit {
+                let at = ray.at(h.t);
+                let slack = Vec3::splat(1e-3 * (clip.hi - clip.lo).length());
+                assert!(at.cmpge(clip.lo - slack).all() && at.cmple(clip.hi + slack).all());
+            }
+            wrong += (want.is_some() != p.hit.is_some()) as usize;
+        }
+        assert!(wrong <= 4, "{wrong} pixels differ from the reference");
+    }
 }

@@ -495,3 +495,61 @@ fn rays_leaving_the_volume_miss() {
         }
     }
 }
+
+/// The entry face found from a hint carried between rays (the surface walk
+/// over the boundary faces) is the one found from scratch (the BVH over
+/// them): every walk outcome is the same, whichever path found the face,
+/// on rays from one eye in scanline order (coherent) and shuffled.
+#[test]
+fn entry_from_a_carried_hint_is_entry_from_scratch() {
+    let mesh = grid(0.12);
+    let values = gaussians(&mesh);
+    let isos = [0.4];
+    let q = IsoQuery::new(&isos);
+    let c = centre();
+    let eye = c + Vec3::new(9.0, 7.0, -11.0);
+    let fwd = (c - eye).normalize();
+    let right = fwd.cross(Vec3::Y).normalize();
+    let up = right.cross(fwd);
+    let res = 40;
+    let mut rays: Vec<Ray> = (0..res * res)
+        .map(|i| {
+            let (x, y) = ((i % res) as f32, (i / res) as f32);
+            let u = (x + 0.5) / res as f32 * 1.0 - 0.5;
+            let v = (y + 0.5) / res as f32 * 1.0 - 0.5;
+            Ray::new(eye, fwd + right * u + up * v)
+        })
+        .collect();
+    let mut r = SplitMix64(5);
+    let shuffled: Vec<Ray> = {
+        let mut s = rays.clone();
+        for i in (1..s.len()).rev() {
+            s.swap(i, r.range_f32(0.0, i as f32 + 0.999) as usize);
+        }
+        s
+    };
+    rays.extend(shuffled);
+    let w = IsoWalk::new(&mesh, &values, WalkLayout::Tet20).unwrap();
+    let vp = w.viewpoint(eye).unwrap();
+    let mut hint = Default::default();
+    let (mut entered, mut hits) = (0, 0);
+    for ray in &rays {
+        let carried = w.trace_from(&vp, ray, &q, &mut hint, &mut Default::default());
+        let fresh = w.trace_from(
+            &vp,
+            ray,
+            &q,
+            &mut Default::default(),
+            &mut Default::default(),
+        );
+        assert_eq!(carried, fresh, "{ray:?}");
+        entered += (carried.tets_visited() > 0) as usize;
+        hits += carried.hit().is_some() as usize;
+    }
+    // Both the surface walk and the BVH were exercised: a quarter of the
+    // rays enter the volume, some of them hit, the rest miss it.
+    assert!(
+        entered > rays.len() / 5 && entered < rays.len() && hits > 100,
+        "{entered} {hits}"
+    );
+}

@@ -4,8 +4,11 @@
 use anyhow::{Result, bail};
 use tet_trace_cpu::render::{Frame, FrameStats};
 
-use crate::cli::IsoArgs;
-use crate::iso::{IsoFrames, load_iso_volume, measure, shade};
+use tet_trace_cpu::iso::{ClipBox, ClipMode};
+
+use crate::camera::apply_view;
+use crate::cli::{IsoArgs, IsoClipMode};
+use crate::iso::{IsoFrames, IsoLight, IsoView, load_iso_volume, measure, shade};
 use crate::output::{outln, print_json};
 use crate::timing::pool;
 
@@ -21,18 +24,42 @@ pub fn run(args: &IsoArgs, json: bool) -> Result<()> {
         bail!("the image needs a width and a height of at least 1");
     }
     let pool = pool(args.threads)?;
+    let mut view = IsoView::of(&volume.mesh);
+    view.camera = apply_view(view.camera, &args.view)?;
+    view.clip = args.clip.map(|(lo, hi)| ClipBox {
+        lo,
+        hi,
+        mode: match args.clip_mode {
+            IsoClipMode::Keep => ClipMode::KeepInside,
+            IsoClipMode::Cut => ClipMode::CutAway,
+        },
+    });
+    if (args.light.is_some() || args.light_dir.is_some()) && !args.shadows {
+        bail!("--light and --light-dir place the light of --shadows: add --shadows");
+    }
+    if args.shadows {
+        view.light = Some(match (args.light, args.light_dir) {
+            (_, Some(d)) if d.length_squared() == 0.0 || !d.is_finite() => {
+                bail!("--light-dir needs a non-zero direction")
+            }
+            (_, Some(d)) => IsoLight::Directional(d),
+            (Some(p), None) => IsoLight::Point(p),
+            (None, None) => IsoLight::Point(view.camera.position),
+        });
+    }
     let frames = IsoFrames {
         width: args.width,
         height: args.height,
         frames: args.frames,
         time_step: args.time_step,
+        view,
     };
     let (doc, image) = measure(&volume, &isovalues, args.method, frames, &pool)?;
     if let Some(path) = &args.output {
         let frame = Frame {
             width: args.width,
             height: args.height,
-            color: shade(&image, &volume.mesh, args.width, args.height),
+            color: shade(&image, &view.camera, args.width, args.height),
             tets: vec![0; image.len()],
             triangle: vec![u32::MAX; image.len()],
             stats: FrameStats::default(),
@@ -43,7 +70,7 @@ pub fn run(args: &IsoArgs, json: bool) -> Result<()> {
         print_json(&doc)?;
     } else {
         outln!(
-            "{} {} (step {} of {}, isovalues {:?}) {} tets, {}x{} {} threads: build {:.1} ms, best {:.1} ms ({:.1} fps), median {:.1} ms, {:.2} Mrays/s, {} hits, {} failures, {:.2} MB",
+            "{} {} (step {} of {}, isovalues {:?}) {} tets, {}x{} {} threads: build {:.1} ms, best {:.1} ms ({:.1} fps), median {:.1} ms, {:.2} Mrays/s, {} hits, {} of {} shadow rays blocked, {} failures, {:.2} MB",
             doc.volume,
             doc.method.name(),
             doc.time_step,
@@ -59,6 +86,8 @@ pub fn run(args: &IsoArgs, json: bool) -> Result<()> {
             doc.median_ms,
             doc.mrays_per_s,
             doc.hits,
+            doc.shadowed,
+            doc.shadow_rays,
             doc.failures,
             doc.bytes as f64 / 1e6
         )?;

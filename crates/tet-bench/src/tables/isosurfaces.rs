@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 use anyhow::Result;
 
 use super::doc::{IsoRow, TablesDoc};
-use crate::iso::{IsoFrames, IsoMethod, load_iso_volume, measure};
+use crate::iso::{IsoFrames, IsoMethod, IsoView, load_iso_volume, measure};
 
 /// The paper's figures per data set: tets (Table 1), BIH and SAH build
 /// ms (Table 1, dual Core 2 Duo), laptop fps at 1024² (Table 2, 2 cores),
@@ -91,6 +91,7 @@ pub fn measure_all(quick: bool, pool: &rayon::ThreadPool) -> Vec<IsoRow> {
                 height: side,
                 frames,
                 time_step: 0,
+                view: IsoView::of(&volume.mesh),
             };
             let docs = IsoMethod::ALL
                 .iter()

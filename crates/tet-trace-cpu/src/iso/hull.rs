@@ -8,7 +8,12 @@
 //! rule) finds its inward-ordered projection counter-clockwise around the
 //! ray and the origin lies on or outside its plane (exact `orient3d`), the
 //! same decision as `BoundaryEntry`, so entry and walk agree on every
-//! boundary edge. The face the previous ray entered is tested first.
+//! boundary edge. The face the previous ray entered is tested first; when
+//! the ray misses it, a short walk over the boundary surface follows (to
+//! the neighbour across the first edge the ray lies right of, a few steps
+//! at most, front faces only) before the BVH is searched. Exactly one face
+//! passes the test for a ray that enters (the tie rule gives every edge one
+//! side), so the walk and the BVH find the same face.
 
 use glam::Vec3;
 use tet_core::predicates::orient3d_f32;
@@ -19,6 +24,9 @@ use crate::walk::{DuffF32, EntryHint, Projection, Start};
 
 /// Faces per leaf.
 const LEAF: usize = 4;
+
+/// Steps of the surface walk from the hint face before the BVH search.
+const SURFACE_STEPS: usize = 8;
 
 #[derive(Clone, Copy, Debug)]
 struct Face {
@@ -43,6 +51,10 @@ struct Node {
 pub(crate) struct Hull {
     faces: Vec<Face>,
     nodes: Vec<Node>,
+    /// Per face (in `faces` order), the face across its edge `k`
+    /// (`ids[k] → ids[k + 1]`), or `u32::MAX` when the edge is not shared
+    /// by exactly two boundary faces.
+    across: Vec<[u32; 3]>,
 }
 
 impl Hull {
@@ -64,6 +76,7 @@ impl Hull {
         let mut hull = Hull {
             faces,
             nodes: Vec::new(),
+            across: Vec::new(),
         };
         if !hull.faces.is_empty() {
             let n = hull.faces.len();
@@ -72,12 +85,15 @@ impl Hull {
             debug_assert_eq!(faces.len(), n);
             hull.faces = faces;
         }
+        hull.across = adjacency(&hull.faces);
         hull
     }
 
     /// Bytes of the structure.
     pub(crate) fn bytes(&self) -> usize {
-        std::mem::size_of_val(&self.faces[..]) + std::mem::size_of_val(&self.nodes[..])
+        std::mem::size_of_val(&self.faces[..])
+            + std::mem::size_of_val(&self.nodes[..])
+            + std::mem::size_of_val(&self.across[..])
     }
 
     /// The walk start of `ray` (origin outside the mesh) where its line
@@ -88,29 +104,45 @@ impl Hull {
         pre: &RayPre,
         hint: &mut EntryHint,
     ) -> Option<Start> {
-        let enters = |f: &Face| {
+        // The edge tests of face `f`: bit `k` set when the ray lies left of
+        // edge `k` (all three: inside the projected face).
+        let edges = |f: &Face| {
             let p = f.ids.map(|i| pre.proj.project(mesh.points[i as usize]));
             let proj: &DuffF32 = &pre.proj;
-            proj.left(p[0], f.ids[0], p[1], f.ids[1])
-                && proj.left(p[1], f.ids[1], p[2], f.ids[2])
-                && proj.left(p[2], f.ids[2], p[0], f.ids[0])
-                && {
-                    let [a, b, c] = mesh.face_vertices(f.tet, f.face as usize);
-                    let q = |i: u32| mesh.points[i as usize];
-                    orient3d_f32(q(a), q(b), q(c), pre.ray.origin) >= 0.0
-                }
+            proj.left(p[0], f.ids[0], p[1], f.ids[1]) as u32
+                | (proj.left(p[1], f.ids[1], p[2], f.ids[2]) as u32) << 1
+                | (proj.left(p[2], f.ids[2], p[0], f.ids[0]) as u32) << 2
         };
+        let front = |f: &Face| {
+            let [a, b, c] = mesh.face_vertices(f.tet, f.face as usize);
+            let q = |i: u32| mesh.points[i as usize];
+            orient3d_f32(q(a), q(b), q(c), pre.ray.origin) >= 0.0
+        };
+        let enters = |f: &Face| edges(f) == 7 && front(f);
         let start = |f: &Face| Start::Entry {
             tet: f.tet,
             face: f.face,
         };
-        if let Some(f) = self.faces.get(hint.0)
-            && enters(f)
-        {
-            return Some(start(f));
-        }
-        if self.nodes.is_empty() {
+        // A ray that misses the root box enters nowhere.
+        let root = self.nodes.first()?;
+        let (t0, t1) = pre.slab(root.lo, root.hi);
+        if !(t0 <= t1 && t1 >= 0.0) {
             return None;
+        }
+        // The surface walk from the hint face.
+        let mut at = hint.0;
+        for _ in 0..SURFACE_STEPS {
+            let Some(f) = self.faces.get(at) else { break };
+            if !front(f) {
+                break;
+            }
+            let m = edges(f);
+            if m == 7 {
+                hint.0 = at;
+                return Some(start(f));
+            }
+            let k = (!m).trailing_zeros() as usize;
+            at = self.across[at][k.min(2)] as usize;
         }
         let mut stack = [0u32; 64];
         let mut sp = 1;
@@ -141,6 +173,37 @@ impl Hull {
         }
         None
     }
+}
+
+/// The face across each edge of each face (see [`Hull::across`]).
+fn adjacency(faces: &[Face]) -> Vec<[u32; 3]> {
+    use std::collections::HashMap;
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    let mut by_edge: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    for (j, f) in faces.iter().enumerate() {
+        for k in 0..3 {
+            by_edge
+                .entry(key(f.ids[k], f.ids[(k + 1) % 3]))
+                .or_default()
+                .push(j as u32);
+        }
+    }
+    faces
+        .iter()
+        .enumerate()
+        .map(|(j, f)| {
+            std::array::from_fn(|k| match by_edge[&key(f.ids[k], f.ids[(k + 1) % 3])][..] {
+                [x, y] => {
+                    if x == j as u32 {
+                        y
+                    } else {
+                        x
+                    }
+                }
+                _ => u32::MAX,
+            })
+        })
+        .collect()
 }
 
 /// Median-split build over `faces` (global offset `first`); bounds padded by

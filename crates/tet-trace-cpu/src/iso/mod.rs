@@ -52,6 +52,7 @@ pub mod marching;
 pub mod packet;
 pub mod reference;
 pub mod walk;
+mod walk_ray;
 
 use glam::{Mat3, Vec3};
 use thiserror::Error;

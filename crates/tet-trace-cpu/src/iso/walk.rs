@@ -36,13 +36,14 @@
 
 use std::borrow::Cow;
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::Vec3;
 use tet_core::layout::{LayoutMesh, Tet16Mesh, Tet20Mesh, Tet32Mesh};
 use tet_core::{Link, TetMesh};
 
 use super::hull::Hull;
 use super::marching::RayPre;
-use super::{IsoError, IsoHit, IsoQuery, IsoStats, check_values, gradient};
+use super::walk_ray::{Ctx, Found};
+use super::{IsoError, IsoHit, IsoQuery, IsoStats, check_values};
 use crate::entry::Viewpoint;
 use crate::kernel::LANES;
 use crate::locate::{LocateError, locate};
@@ -51,7 +52,7 @@ use crate::walk::start::{Lane, begin};
 use crate::walk::step::advance;
 use crate::walk::stop::Advance;
 use crate::walk::{
-    BoundaryEntry, DuffF32, EntryHint, Face2, Projection, Start, Topology, step_cap,
+    BoundaryEntry, DuffF32, EntryHint, Face2, Projection, Start, Topology, prefetch_index, step_cap,
 };
 
 /// The compact layout an [`IsoWalk`] steps over.
@@ -138,9 +139,27 @@ pub struct IsoWalk<'m> {
     mesh: Cow<'m, TetMesh>,
     values: &'m [f32],
     topo: Topo,
+    /// Each tet's vertex value range `[min, max]` (the range test reads
+    /// one record per step, indexed by the tet, instead of the new vertex's
+    /// value behind the step's dependent loads).
+    ranges: Vec<[f32; 2]>,
     /// Boundary faces, when the boundary is convex (rays from outside).
     hull: Option<Hull>,
     cap: u32,
+}
+
+/// The value range `[min, max]` of every tet's four vertices.
+fn tet_ranges(mesh: &TetMesh, values: &[f32]) -> Vec<[f32; 2]> {
+    mesh.tets
+        .iter()
+        .map(|ids| {
+            let v = ids.map(|i| values[i as usize]);
+            [
+                v[0].min(v[1]).min(v[2].min(v[3])),
+                v[0].max(v[1]).max(v[2].max(v[3])),
+            ]
+        })
+        .collect()
 }
 
 /// The mesh with every constrained face replaced by a plain link (a volume
@@ -183,20 +202,23 @@ impl<'m> IsoWalk<'m> {
         };
         let hull = BoundaryEntry::new(&mesh).ok().map(|_| Hull::new(&mesh));
         let cap = step_cap(&mesh);
+        let ranges = tet_ranges(&mesh, values);
         Ok(IsoWalk {
             mesh,
             values,
             topo,
+            ranges,
             hull,
             cap,
         })
     }
 
     /// The same walk over other values of the same points (a new time step:
-    /// nothing to rebuild).
+    /// only the per-tet value ranges are recomputed, one pass over the tets).
     pub fn with_values(mut self, values: &'m [f32]) -> Result<Self, IsoError> {
         check_values(values, self.mesh.points.len())?;
         self.values = values;
+        self.ranges = tet_ranges(&self.mesh, values);
         Ok(self)
     }
 
@@ -205,16 +227,18 @@ impl<'m> IsoWalk<'m> {
         &self.mesh
     }
 
-    /// Bytes of the walk's data: layout records, points and the boundary
-    /// faces' BVH (the values are the caller's, 4 bytes per point, not
-    /// counted).
+    /// Bytes of the walk's data: layout records, points, the per-tet value
+    /// ranges (8 bytes per tet) and the boundary faces' BVH (the values are
+    /// the caller's, 4 bytes per point, not counted).
     pub fn bytes(&self) -> usize {
         let (recs, pts) = match &self.topo {
             Topo::Tet32(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
             Topo::Tet20(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
             Topo::Tet16(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
         };
-        recs + pts * 12 + self.hull.as_ref().map_or(0, Hull::bytes)
+        recs + pts * 12
+            + std::mem::size_of_val(&self.ranges[..])
+            + self.hull.as_ref().map_or(0, Hull::bytes)
     }
 
     /// Locates the viewpoint of many rays once ([`Viewpoint::locate`]).
@@ -234,6 +258,43 @@ impl<'m> IsoWalk<'m> {
             }),
         };
         self.trace_start(ray, start, query, &mut IsoStats::default())
+    }
+
+    /// Traces `ray` whose origin lies in or near tet `near` (a secondary
+    /// ray from an earlier hit in that tet): locates the origin walking from
+    /// `near`, else enters from outside as [`IsoWalk::trace`] does.
+    pub fn trace_near(
+        &self,
+        ray: &Ray,
+        near: u32,
+        query: &IsoQuery,
+        stats: &mut IsoStats,
+    ) -> IsoOutcome {
+        let from = if (near as usize) < self.mesh.tets.len() {
+            near
+        } else {
+            0
+        };
+        let start = match locate(&self.mesh, ray.origin, from) {
+            Ok(t) => Ok(Start::Tet(t)),
+            Err(LocateError::OutsideMesh { .. }) => self.enter(ray, &mut EntryHint::default()),
+            Err(_) => Err(TraceOutcome::Failed {
+                failure: Failure::InvalidRay,
+                tets_visited: 0,
+            }),
+        };
+        self.trace_start(ray, start, query, stats)
+    }
+
+    /// Shadow ray from a point in or near tet `near` ([`IsoWalk::trace_near`]):
+    /// true when some crossing lies in `[t_min, t_max]`. `Err` when the walk
+    /// failed.
+    pub fn occluded_near(&self, ray: &Ray, near: u32, query: &IsoQuery) -> Result<bool, Failure> {
+        match self.trace_near(ray, near, query, &mut IsoStats::default()) {
+            IsoOutcome::Hit { .. } => Ok(true),
+            IsoOutcome::Miss { .. } => Ok(false),
+            IsoOutcome::Failed { failure, .. } => Err(failure),
+        }
     }
 
     /// Traces `ray`, whose origin is the viewpoint `vp` (see
@@ -426,11 +487,9 @@ impl<'m> IsoWalk<'m> {
             }
             Err(out) => return Err(converted(out)),
         };
-        let fv = lane.st.ids.map(|i| self.values[i as usize]);
         let opened = lane.st.visited;
         let mut w = WalkState {
             lane,
-            fv,
             cached: None,
             ctx,
             opened,
@@ -438,10 +497,8 @@ impl<'m> IsoWalk<'m> {
         if let Start::Tet(_) = start {
             // The start tet: from the origin to its exit face.
             let tet = w.lane.st.tet;
-            let ids = mesh.tets[tet as usize];
-            let v = ids.map(|i| self.values[i as usize]);
             stats.range_tests += 1;
-            if w.ctx.active4(v) {
+            if w.ctx.active(self.ranges[tet as usize]) {
                 let f_in = w.ctx.value_at_origin(tet);
                 let out = w.ctx.face(w.lane.st.ids, &w.lane.st.p);
                 w.cached = Some(out);
@@ -476,9 +533,11 @@ impl<'m> IsoWalk<'m> {
         stats: &mut IsoStats,
     ) -> Option<IsoOutcome> {
         let points = &self.mesh.points[..];
-        let vals = self.values;
         let lane = &mut w.lane;
         let tet = lane.next;
+        // The range is read before the step's own loads: it depends only on
+        // the tet, known (and prefetched) one step ahead.
+        let range = self.ranges.get(tet as usize).copied();
         let entry_ids = lane.st.ids;
         let adv = advance(points, topo, lane, self.cap);
         let failed = |failure| {
@@ -488,25 +547,18 @@ impl<'m> IsoWalk<'m> {
             })
         };
         match adv {
-            Advance::Go | Advance::Face => {}
+            Advance::Go => prefetch_index(&self.ranges, lane.next),
+            Advance::Face => {}
             Advance::Cap => return failed(Failure::StepCap),
             Advance::Lost => return failed(Failure::Lost),
         }
+        let Some(range) = range else {
+            return failed(Failure::Lost);
+        };
         let exit_ids = lane.st.ids;
-        // The slot the new vertex replaced, branch-free (which slot it is
-        // varies unpredictably from step to step).
-        let changed = (exit_ids[0] != entry_ids[0]) as u32
-            | ((exit_ids[1] != entry_ids[1]) as u32) << 1
-            | ((exit_ids[2] != entry_ids[2]) as u32) << 2
-            | 8;
-        let slot = (changed.trailing_zeros() as usize).min(2);
-        let d = exit_ids[slot];
-        let vd = vals[d as usize];
-        let v = [w.fv[0], w.fv[1], w.fv[2], vd];
-        w.fv[slot] = vd;
         let entry_cache = w.cached.take();
         let visited = lane.st.visited;
-        if w.ctx.active4(v) {
+        if w.ctx.active(range) {
             // The entry face's projections are recomputed when the previous
             // tet did not compute its value: a pure function of the vertex,
             // so the same bits.
@@ -543,7 +595,6 @@ impl<'m> IsoWalk<'m> {
 /// cached face value and the ray's constants.
 pub(super) struct WalkState<'a> {
     lane: Lane<DuffF32>,
-    fv: [f32; 3],
     cached: Option<(f32, f32)>,
     ctx: Ctx<'a>,
     /// Tets visited when the walk loop began.
@@ -564,218 +615,4 @@ fn converted(out: TraceOutcome) -> IsoOutcome {
             tets_visited: other.tets_visited(),
         },
     }
-}
-
-/// What one tet holds.
-enum Found {
-    Hit(IsoHit),
-    /// A crossing beyond `t_max`: every later one is too.
-    Beyond,
-    None,
-}
-
-/// Per-ray constants of a walk.
-struct Ctx<'a> {
-    mesh: &'a TetMesh,
-    values: &'a [f32],
-    ray: &'a Ray,
-    query: &'a IsoQuery<'a>,
-    inv_dd: f32,
-    /// Smallest and largest isovalue.
-    iso_lo: f32,
-    iso_hi: f32,
-}
-
-impl<'a> Ctx<'a> {
-    fn new(mesh: &'a TetMesh, values: &'a [f32], ray: &'a Ray, query: &'a IsoQuery<'a>) -> Self {
-        Ctx {
-            mesh,
-            values,
-            ray,
-            query,
-            inv_dd: 1.0 / ray.direction.length_squared(),
-            iso_lo: query
-                .isovalues
-                .iter()
-                .copied()
-                .fold(f32::INFINITY, f32::min),
-            iso_hi: query
-                .isovalues
-                .iter()
-                .copied()
-                .fold(f32::NEG_INFINITY, f32::max),
-        }
-    }
-
-    #[inline(always)]
-    fn active4(&self, v: [f32; 4]) -> bool {
-        let lo = v[0].min(v[1]).min(v[2].min(v[3]));
-        let hi = v[0].max(v[1]).max(v[2].max(v[3]));
-        // Most tets lie on one side of every isovalue: two comparisons.
-        if hi < self.iso_lo || lo >= self.iso_hi {
-            return false;
-        }
-        self.query.active(lo, hi)
-    }
-
-    /// Depth of point `i` along the ray (a pure function of the point).
-    #[inline(always)]
-    fn depth(&self, i: u32) -> f32 {
-        (self.mesh.points[i as usize] - self.ray.origin).dot(self.ray.direction) * self.inv_dd
-    }
-
-    /// Field value and ray parameter where the ray crosses the face `ids`
-    /// (projected points `p`), computed in id order (see the module docs).
-    #[inline(always)]
-    fn face(&self, ids: [u32; 3], p: &Face2) -> (f32, f32) {
-        let mut k = [
-            (ids[0], p.point(0)),
-            (ids[1], p.point(1)),
-            (ids[2], p.point(2)),
-        ];
-        if k[0].0 > k[1].0 {
-            k.swap(0, 1);
-        }
-        if k[1].0 > k[2].0 {
-            k.swap(1, 2);
-        }
-        if k[0].0 > k[1].0 {
-            k.swap(0, 1);
-        }
-        let det = |a: Vec2, b: Vec2| a.x * b.y - a.y * b.x;
-        let w = [
-            det(k[1].1, k[2].1),
-            det(k[2].1, k[0].1),
-            det(k[0].1, k[1].1),
-        ];
-        let v = k.map(|(i, _)| self.values[i as usize]);
-        let z = k.map(|(i, _)| self.depth(i));
-        let s = w[0] + w[1] + w[2];
-        if s == 0.0 || !s.is_finite() {
-            return (v[0], z[0]);
-        }
-        let f = (w[0] * v[0] + w[1] * v[1] + w[2] * v[2]) / s;
-        let t = (w[0] * z[0] + w[1] * z[1] + w[2] * z[2]) / s;
-        let (vlo, vhi) = (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
-        let (zlo, zhi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
-        (f.clamp(vlo, vhi), t.clamp(zlo, zhi))
-    }
-
-    /// Field value at the ray origin inside `tet`, clamped to its range.
-    fn value_at_origin(&self, tet: u32) -> f32 {
-        let ids = self.mesh.tets[tet as usize];
-        let v = ids.map(|i| self.values[i as usize]);
-        let (lo, hi) = (
-            v[0].min(v[1]).min(v[2].min(v[3])),
-            v[0].max(v[1]).max(v[2].max(v[3])),
-        );
-        let (f0, _) = linear_along(self.mesh, self.values, tet, self.ray);
-        (f0 as f32).clamp(lo, hi)
-    }
-
-    /// The start tet when the ray leaves the volume through its exit face:
-    /// the crossing of the linear field (f64) ahead of the origin.
-    fn start_tet_alone(&self, tet: u32) -> Option<IsoHit> {
-        let (f0, f1, exit) = linear_and_exit(self.mesh, self.values, tet, self.ray);
-        let ids = self.mesh.tets[tet as usize];
-        let v = ids.map(|i| self.values[i as usize]);
-        if !self.active4(v) || f1 == 0.0 {
-            return None;
-        }
-        let mut best: Option<IsoHit> = None;
-        for (k, &iso) in self.query.isovalues.iter().enumerate() {
-            let t64 = (iso as f64 - f0) / f1;
-            let t = t64 as f32;
-            // Beyond the exit the ray is outside the volume.
-            let inside = t64 <= exit * (1.0 + 1e-9);
-            if inside && t >= self.ray.t_min.max(0.0) && t <= self.ray.t_max && self.keeps(t) {
-                let hit = self.hit(tet, k, t);
-                if best.is_none_or(|b| hit.before(&b)) {
-                    best = Some(hit);
-                }
-            }
-        }
-        best
-    }
-
-    #[inline]
-    fn keeps(&self, t: f32) -> bool {
-        self.query.keeps(self.ray.at(t))
-    }
-
-    fn hit(&self, tet: u32, k: usize, t: f32) -> IsoHit {
-        let ids = self.mesh.tets[tet as usize];
-        IsoHit {
-            t,
-            tet,
-            isovalue_index: k as u8,
-            normal: gradient(
-                ids.map(|i| self.mesh.points[i as usize]),
-                ids.map(|i| self.values[i as usize]),
-            ),
-        }
-    }
-
-    /// The nearest accepted crossing between the entry `(F_in, t_in)` and
-    /// the exit `(F_out, t_out)` of `tet`.
-    #[inline]
-    fn crossing(&self, tet: u32, (fa, ta): (f32, f32), (fb, tb): (f32, f32)) -> Found {
-        let mut best: Option<IsoHit> = None;
-        let mut beyond = false;
-        for (k, &iso) in self.query.isovalues.iter().enumerate() {
-            if (fa >= iso) == (fb >= iso) {
-                continue;
-            }
-            let s = (iso - fa) / (fb - fa);
-            let t = (ta + s * (tb - ta)).clamp(ta.min(tb), ta.max(tb));
-            if t > self.ray.t_max {
-                beyond = true;
-                continue;
-            }
-            if t < self.ray.t_min || !self.keeps(t) {
-                continue;
-            }
-            let hit = self.hit(tet, k, t);
-            if best.is_none_or(|b| hit.before(&b)) {
-                best = Some(hit);
-            }
-        }
-        match best {
-            Some(h) => Found::Hit(h),
-            None if beyond => Found::Beyond,
-            None => Found::None,
-        }
-    }
-}
-
-/// The linear field of `tet` along `ray` in f64: `f(t) = f0 + f1·t`.
-fn linear_along(mesh: &TetMesh, values: &[f32], tet: u32, ray: &Ray) -> (f64, f64) {
-    let (f0, f1, _) = linear_and_exit(mesh, values, tet, ray);
-    (f0, f1)
-}
-
-/// [`linear_along`] and the ray parameter where the ray leaves the tet
-/// (f64; infinite for a flat tet).
-fn linear_and_exit(mesh: &TetMesh, values: &[f32], tet: u32, ray: &Ray) -> (f64, f64, f64) {
-    let ids = mesh.tets[tet as usize];
-    let p = ids.map(|i| mesh.points[i as usize].as_dvec3());
-    let v = ids.map(|i| values[i as usize] as f64);
-    let m = glam::DMat3::from_cols(p[1] - p[0], p[2] - p[0], p[3] - p[0]);
-    if m.determinant() == 0.0 {
-        return (v[0], 0.0, f64::INFINITY);
-    }
-    let inv = m.inverse();
-    let g = inv.transpose() * DVec3::new(v[1] - v[0], v[2] - v[0], v[3] - v[0]);
-    let o = ray.origin.as_dvec3();
-    let d = ray.direction.as_dvec3();
-    // Barycentrics along the ray: λ(t) = a + b·t; the exit is the first
-    // t > 0 where a decreasing one reaches 0.
-    let (la, lb) = (inv * (o - p[0]), inv * d);
-    let a = [1.0 - la.x - la.y - la.z, la.x, la.y, la.z];
-    let b = [-lb.x - lb.y - lb.z, lb.x, lb.y, lb.z];
-    let exit = (0..4)
-        .filter(|&i| b[i] < 0.0)
-        .map(|i| -a[i] / b[i])
-        .fold(f64::INFINITY, f64::min);
-    (v[0] + g.dot(o - p[0]), g.dot(d), exit)
 }
