@@ -12,18 +12,16 @@
 use glam::Vec3;
 use proptest::prelude::*;
 use tet_core::TetMesh;
+use tet_core::scene::Camera;
 use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::kernel::{Interleaved, WalkTracer};
-use tet_core::scene::Camera;
 use tet_trace_cpu::lockstep::{
     Width, trace_lockstep_at, trace_lockstep_avx2, trace_lockstep_portable, trace_lockstep_sctp,
 };
-use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::reference::{Aim, random_direction, random_point_inside, ray_from_feature};
+use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Topology;
-use tet_trace_cpu::{
-    DuffF32, Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint, locate,
-};
+use tet_trace_cpu::{DuffF32, Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint, locate};
 
 mod common;
 use common::{bits, grid};

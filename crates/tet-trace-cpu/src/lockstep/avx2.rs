@@ -217,8 +217,7 @@ impl Lanes for Avx2 {
     fn get_i(self, x: __m256i, l: usize) -> u32 {
         // SAFETY: as `lane_mask`.
         unsafe {
-            _mm256_cvtsi256_si32(_mm256_permutevar8x32_epi32(x, _mm256_set1_epi32(l as i32)))
-                as u32
+            _mm256_cvtsi256_si32(_mm256_permutevar8x32_epi32(x, _mm256_set1_epi32(l as i32))) as u32
         }
     }
 

@@ -68,13 +68,20 @@ impl<L: Lanes, T: Topology> Records<L> for PerLane<'_, T> {
         e: L::I,
         entry: L::I,
     ) -> L::I {
-        let (next, d, e, entry) = (L::i_lanes(next), L::i_lanes(d), L::i_lanes(e), L::i_lanes(entry));
+        let (next, d, e, entry) = (
+            L::i_lanes(next),
+            L::i_lanes(d),
+            L::i_lanes(e),
+            L::i_lanes(entry),
+        );
         let ids = ids.map(L::i_lanes);
         let mut raw = L::arr(0u32);
         for (k, r) in raw.as_mut().iter_mut().enumerate() {
             let face = [ids[0].as_ref()[k], ids[1].as_ref()[k], ids[2].as_ref()[k]];
             let at = |x: &L::Arr<u32>| x.as_ref()[k];
-            *r = self.0.exit_link(at(&next), face, at(&d), at(&e), at(&entry));
+            *r = self
+                .0
+                .exit_link(at(&next), face, at(&d), at(&e), at(&entry));
         }
         from_lanes(l, raw)
     }
@@ -140,6 +147,15 @@ impl<'a> Geo<'a> {
         unsafe { l.gather_words(self.words, l.add_i(base, k)) }
     }
 
+    /// Tet16's `NX_r` (word `links + r`), 0 for rank 3: those lanes read
+    /// word 0 of the record (in range) and drop it.
+    #[inline(always)]
+    fn nx<L: Lanes>(&self, l: L, base: L::I, r: L::I) -> L::I {
+        let m = l.gt_i(l.splat_i(3), r);
+        let k = l.select_i(m, l.add_i(l.splat_i(self.links), r), l.splat_i(0));
+        l.zero_unless(m, self.word(l, base, k))
+    }
+
     /// The first word of the records of tets `next` (clamped to the last).
     #[inline(always)]
     fn base<L: Lanes>(&self, l: L, next: L::I) -> L::I {
@@ -196,8 +212,12 @@ impl<L: Lanes, const RULE: u8> Records<L> for Gathered<'_, RULE> {
         let base = g.base(l, next);
         let face = l.xor_i(ids[0], ids[1]);
         if RULE == IDS {
-            let vid = |k: u32| g.word(l, base, l.splat_i(g.ids + k));
-            let v = [vid(0), vid(1), vid(2), vid(3)];
+            let v = [
+                g.word(l, base, l.splat_i(g.ids)),
+                g.word(l, base, l.splat_i(g.ids + 1)),
+                g.word(l, base, l.splat_i(g.ids + 2)),
+                g.word(l, base, l.splat_i(g.ids + 3)),
+            ];
             let d = l.xor_i(
                 l.xor_i(l.xor_i(v[0], v[1]), l.xor_i(v[2], v[3])),
                 l.xor_i(face, ids[2]),
@@ -222,6 +242,7 @@ impl<L: Lanes, const RULE: u8> Records<L> for Gathered<'_, RULE> {
     ) -> L::I {
         let g = &self.0;
         let links = l.splat_i(g.links);
+        // (No closures over lane operations: see `walk`.)
         match RULE {
             RANK => {
                 let r = rank(l, e, [ids[0], ids[1], ids[2], d]);
@@ -231,18 +252,16 @@ impl<L: Lanes, const RULE: u8> Records<L> for Gathered<'_, RULE> {
                 // `rank(d)` among the entry face (d itself never counts).
                 let rd = rank(l, d, [ids[0], ids[1], ids[2], d]);
                 let re = rank(l, e, [ids[0], ids[1], ids[2], d]);
-                // `NX_r`, 0 for rank 3: those lanes read word 0 of the
-                // record (in range) and drop it.
-                let nx = |r: L::I| {
-                    let m = l.gt_i(l.splat_i(3), r);
-                    let k = l.select_i(m, l.add_i(links, r), l.splat_i(0));
-                    l.zero_unless(m, g.word(l, base, k))
-                };
-                l.xor_i(l.xor_i(entry, nx(rd)), nx(re))
+                let (nd, ne) = (g.nx(l, base, rd), g.nx(l, base, re));
+                l.xor_i(l.xor_i(entry, nd), ne)
             }
             SLOT => {
-                let vid = |k: u32| g.word(l, base, l.splat_i(g.ids + k));
-                slot_link(l, g, base, [vid(0), vid(1), vid(2)], e)
+                let vid = [
+                    g.word(l, base, l.splat_i(g.ids)),
+                    g.word(l, base, l.splat_i(g.ids + 1)),
+                    g.word(l, base, l.splat_i(g.ids + 2)),
+                ];
+                slot_link(l, g, base, vid, e)
             }
             _ => slot_link(l, g, base, vid, e),
         }

@@ -80,13 +80,7 @@ impl<L: Lanes> Geometry<L> for Planar {
         (ray, [z; 2])
     }
     #[inline(always)]
-    fn put(
-        l: L,
-        k: usize,
-        ray: &mut Self::Ray,
-        face: &mut [Self::Vert; 3],
-        lane: &Lane<DuffF32>,
-    ) {
+    fn put(l: L, k: usize, ray: &mut Self::Ray, face: &mut [Self::Vert; 3], lane: &Lane<DuffF32>) {
         let p = lane.proj;
         for (a, o) in ray.o.iter_mut().enumerate() {
             *o = l.set_f(*o, k, p.o[a]);
@@ -107,8 +101,7 @@ impl<L: Lanes> Geometry<L> for Planar {
             l.sub_f(p[1], ray.o[1]),
             l.sub_f(p[2], ray.o[2]),
         );
-        // `(c₀·qₓ + c₁·q_y) + c₂·q_z`, as `DuffF32::project` (no closure:
-        // closures would not inherit the entry point's target features).
+        // `(c₀·qₓ + c₁·q_y) + c₂·q_z`, as `DuffF32::project`.
         let c = &ray.c;
         let x = l.add_f(
             l.add_f(l.mul_f(c[0][0], qx), l.mul_f(c[1][0], qy)),
@@ -122,8 +115,11 @@ impl<L: Lanes> Geometry<L> for Planar {
     }
     #[inline(always)]
     fn edges(l: L, _: &Self::Ray, v: &Self::Vert, face: &[Self::Vert; 3]) -> [L::F; 3] {
-        let det = |f: &Self::Vert| l.sub_f(l.mul_f(v[0], f[1]), l.mul_f(v[1], f[0]));
-        [det(&face[0]), det(&face[1]), det(&face[2])]
+        [
+            det(l, v, &face[0]),
+            det(l, v, &face[1]),
+            det(l, v, &face[2]),
+        ]
     }
     #[inline(always)]
     fn select(l: L, m: L::M, t: Self::Vert, f: Self::Vert) -> Self::Vert {
@@ -142,6 +138,28 @@ impl<L: Lanes> Geometry<L> for Planar {
         let f = Face2::new(face.map(|p| Vec2::new(at(p[0]), at(p[1]))));
         f.left_mask_ties(Vec2::new(at(v[0]), at(v[1])), d, &ids)
     }
+}
+
+/// `det(p₃, pᵢ) = p₃.x·yᵢ − p₃.y·xᵢ`. (No closures over lane operations
+/// in the walk: a closure not inlined would lose the entry point's
+/// instruction set.)
+#[inline(always)]
+fn det<L: Lanes>(l: L, v: &[L::F; 2], f: &[L::F; 2]) -> L::F {
+    l.sub_f(l.mul_f(v[0], f[1]), l.mul_f(v[1], f[0]))
+}
+
+/// `d · (q₃ × qₖ)` with glam's `cross` and `dot`: `cross(q₃, qₖ)` is
+/// `(q₃.y·qₖ.z − qₖ.y·q₃.z, q₃.z·qₖ.x − qₖ.z·q₃.x, q₃.x·qₖ.y − qₖ.x·q₃.y)`,
+/// then `(d.x·c.x + d.y·c.y) + d.z·c.z`.
+#[inline(always)]
+fn triple<L: Lanes>(l: L, d: &[L::F; 3], q3: &[L::F; 3], qk: &[L::F; 3]) -> L::F {
+    let cx = l.sub_f(l.mul_f(q3[1], qk[2]), l.mul_f(qk[1], q3[2]));
+    let cy = l.sub_f(l.mul_f(q3[2], qk[0]), l.mul_f(qk[2], q3[0]));
+    let cz = l.sub_f(l.mul_f(q3[0], qk[1]), l.mul_f(qk[0], q3[1]));
+    l.add_f(
+        l.add_f(l.mul_f(d[0], cx), l.mul_f(d[1], cy)),
+        l.mul_f(d[2], cz),
+    )
 }
 
 /// [`TripleF32`] in lanes: `q = P − o`, edge values `d · (q₃ × qᵢ)` as
@@ -166,7 +184,13 @@ impl<L: Lanes> Geometry<L> for Triple {
     #[inline(always)]
     fn zero(l: L) -> (Self::Ray, Self::Vert) {
         let z = l.splat_f(0.0);
-        (TripleRay { o: [z; 3], dir: [z; 3] }, [z; 3])
+        (
+            TripleRay {
+                o: [z; 3],
+                dir: [z; 3],
+            },
+            [z; 3],
+        )
     }
     #[inline(always)]
     fn put(
@@ -198,16 +222,11 @@ impl<L: Lanes> Geometry<L> for Triple {
     }
     #[inline(always)]
     fn edges(l: L, ray: &Self::Ray, q3: &Self::Vert, face: &[Self::Vert; 3]) -> [L::F; 3] {
-        // `cross(q₃, qₖ)` is `(q₃.y·qₖ.z − qₖ.y·q₃.z, q₃.z·qₖ.x − qₖ.z·q₃.x,
-        // q₃.x·qₖ.y − qₖ.x·q₃.y)`, then `(d.x·c.x + d.y·c.y) + d.z·c.z`.
-        let d = &ray.dir;
-        let product = |qk: &Self::Vert| {
-            let cx = l.sub_f(l.mul_f(q3[1], qk[2]), l.mul_f(qk[1], q3[2]));
-            let cy = l.sub_f(l.mul_f(q3[2], qk[0]), l.mul_f(qk[2], q3[0]));
-            let cz = l.sub_f(l.mul_f(q3[0], qk[1]), l.mul_f(qk[0], q3[1]));
-            l.add_f(l.add_f(l.mul_f(d[0], cx), l.mul_f(d[1], cy)), l.mul_f(d[2], cz))
-        };
-        [product(&face[0]), product(&face[1]), product(&face[2])]
+        [
+            triple(l, &ray.dir, q3, &face[0]),
+            triple(l, &ray.dir, q3, &face[1]),
+            triple(l, &ray.dir, q3, &face[2]),
+        ]
     }
     #[inline(always)]
     fn select(l: L, m: L::M, t: Self::Vert, f: Self::Vert) -> Self::Vert {

@@ -149,7 +149,12 @@ pub enum Width {
 
 impl Width {
     /// Every width, narrowest first.
-    pub const ALL: [Width; 4] = [Width::Portable4, Width::Portable8, Width::Avx2, Width::Avx512];
+    pub const ALL: [Width; 4] = [
+        Width::Portable4,
+        Width::Portable8,
+        Width::Avx2,
+        Width::Avx512,
+    ];
 
     /// True when this CPU runs the width (the portable ones always).
     pub fn available(self) -> bool {
@@ -244,7 +249,9 @@ pub fn trace_lockstep_at<T: Topology>(
                 return false;
             };
             match (width, Avx2::detect(), Avx512::detect()) {
-                (Width::Avx512, _, Some(t)) => gathered_avx512(t, rule, g, mesh, rays, start, cap, out),
+                (Width::Avx512, _, Some(t)) => {
+                    gathered_avx512(t, rule, g, mesh, rays, start, cap, out)
+                }
                 (Width::Avx2, Some(t), _) => gathered_avx2(t, rule, g, mesh, rays, start, cap, out),
                 _ => return false,
             }
@@ -454,5 +461,13 @@ fn portable_avx2<T: Topology>(
     cap: u32,
     out: &mut [TraceOutcome],
 ) {
-    walk::run::<Portable<WIDE>, Planar, _, 1>(Portable, &PerLane(topo), mesh, rays, start, cap, out);
+    walk::run::<Portable<WIDE>, Planar, _, 1>(
+        Portable,
+        &PerLane(topo),
+        mesh,
+        rays,
+        start,
+        cap,
+        out,
+    );
 }

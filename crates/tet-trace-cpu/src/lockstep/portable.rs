@@ -177,6 +177,10 @@ impl<const W: usize> Lanes for Portable<W> {
     #[inline(always)]
     unsafe fn gather_point(self, points: &[Vec3], i: [u32; W]) -> [[f32; W]; 3] {
         let p: [Vec3; W] = from_fn(|l| points[i[l] as usize]);
-        [from_fn(|l| p[l].x), from_fn(|l| p[l].y), from_fn(|l| p[l].z)]
+        [
+            from_fn(|l| p[l].x),
+            from_fn(|l| p[l].y),
+            from_fn(|l| p[l].z),
+        ]
     }
 }

@@ -184,8 +184,10 @@ fn ties<L: Lanes, G: Geometry<L>>(
     tie: L::M,
     left: [L::M; 3],
 ) -> [L::M; 3] {
+    // No closures over lane operations here: a closure not inlined would
+    // lose the instruction set of the entry point.
     let tie = l.bits(tie);
-    let mut bits = left.map(|m| l.bits(m));
+    let mut bits = [l.bits(left[0]), l.bits(left[1]), l.bits(left[2])];
     let (d, ids) = (L::i_lanes(d), pk.ids.map(L::i_lanes));
     for k in (0..L::WIDTH).filter(|k| tie >> k & 1 != 0) {
         let id = [ids[0].as_ref()[k], ids[1].as_ref()[k], ids[2].as_ref()[k]];
@@ -194,7 +196,11 @@ fn ties<L: Lanes, G: Geometry<L>>(
             *b = *b & !(1 << k) | ((m >> s & 1) as u32) << k;
         }
     }
-    bits.map(|b| l.from_bits(b))
+    [
+        l.from_bits(bits[0]),
+        l.from_bits(bits[1]),
+        l.from_bits(bits[2]),
+    ]
 }
 
 /// The rare part of a round: each lane of `r.events` stopped; finish its
@@ -214,7 +220,11 @@ fn events<L: Lanes, G: Geometry<L>>(
         let link = r.raw.as_ref()[k];
         let stopped = Stopped {
             adv: Advance::stopped(bit(r.capped), bit(r.lost)),
-            ids: pk.ids.map(|x| l.get_i(x, k)),
+            ids: [
+                l.get_i(pk.ids[0], k),
+                l.get_i(pk.ids[1], k),
+                l.get_i(pk.ids[2], k),
+            ],
             tet: l.get_i(pk.next, k),
             visited: l.get_i(pk.visited, k),
             link,
@@ -255,8 +265,7 @@ pub(crate) fn run<L: Lanes, G: Geometry<L>, X: Records<L>, const PACKS: usize>(
         "too many points for the lockstep walk"
     );
     let mut feed = Feed::new(mesh, rays, start, out);
-    let mut packs: [(Pack<L, G>, usize); PACKS] =
-        std::array::from_fn(|_| Pack::fill(l, &mut feed));
+    let mut packs: [(Pack<L, G>, usize); PACKS] = std::array::from_fn(|_| Pack::fill(l, &mut feed));
     // A walk started only if the mesh has points and tets (its start tet
     // and vertices exist), so the loads of `step` have something to clamp to.
     if mesh.points.is_empty() {
