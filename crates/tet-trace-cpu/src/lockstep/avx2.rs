@@ -194,7 +194,7 @@ impl Lanes for Avx2 {
         unsafe { _mm256_movemask_ps(m) as u32 }
     }
     #[inline(always)]
-    fn from_bits(self, b: u32) -> __m256 {
+    fn mask_of_bits(self, b: u32) -> __m256 {
         // SAFETY: as `lane_mask`.
         let bit = unsafe { _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128) };
         // SAFETY: as `lane_mask`.

@@ -179,7 +179,7 @@ impl Lanes for Avx512 {
         m as u32
     }
     #[inline(always)]
-    fn from_bits(self, b: u32) -> __mmask16 {
+    fn mask_of_bits(self, b: u32) -> __mmask16 {
         b as __mmask16
     }
     #[inline(always)]

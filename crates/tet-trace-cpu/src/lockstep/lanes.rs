@@ -91,7 +91,7 @@ pub(crate) trait Lanes: Copy {
     /// Bit `l` set when lane `l` of `m` is.
     fn bits(self, m: Self::M) -> u32;
     /// The mask whose lane `l` is bit `l` of `b`.
-    fn from_bits(self, b: u32) -> Self::M;
+    fn mask_of_bits(self, b: u32) -> Self::M;
     /// `x` with lane `l` replaced by `v`.
     fn set_f(self, x: Self::F, l: usize, v: f32) -> Self::F;
     /// `x` with lane `l` replaced by `v`.

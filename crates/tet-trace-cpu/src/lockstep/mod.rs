@@ -124,8 +124,12 @@ pub use crate::walk::topology::{ExitRule, RecordWords};
 use avx2::Avx2;
 #[cfg(target_arch = "x86_64")]
 use avx512::Avx512;
-use exit::{Gathered, Geo, IDS, PerLane, RANK, RANK_XOR, Records, SLOT};
-use geometry::{Geometry, Planar, Triple};
+use exit::{Gathered, Geo, IDS, PerLane};
+#[cfg(target_arch = "x86_64")]
+use exit::{RANK, RANK_XOR, Records, SLOT};
+#[cfg(target_arch = "x86_64")]
+use geometry::Geometry;
+use geometry::{Planar, Triple};
 use portable::Portable;
 
 /// Lanes of the AVX2 lockstep walk (256-bit vectors of f32 / u32).
@@ -308,6 +312,7 @@ pub fn trace_lockstep_sctp<T: Topology>(
 
 /// The gatherable records of a projected layout (Tet20, Tet16, Tet32; the
 /// baseline's `Ids` rule is ScTP's) and their exit rule.
+#[cfg(target_arch = "x86_64")]
 fn projected_records<'a, T: Topology>(mesh: &TetMesh, topo: &'a T) -> Option<(ExitRule, Geo<'a>)> {
     let rw = topo.record_words()?;
     if matches!(rw.rule, ExitRule::Ids { .. }) {

@@ -152,7 +152,7 @@ impl<const W: usize> Lanes for Portable<W> {
             .fold(0, |b, (l, &x)| b | (x as u32) << l)
     }
     #[inline(always)]
-    fn from_bits(self, b: u32) -> [bool; W] {
+    fn mask_of_bits(self, b: u32) -> [bool; W] {
         from_fn(|l| b >> l & 1 != 0)
     }
     #[inline(always)]

@@ -51,7 +51,7 @@ impl<L: Lanes, G: Geometry<L>> Pack<L, G> {
             next: z,
             entry: z,
             visited: z,
-            live: l.from_bits(0),
+            live: l.mask_of_bits(0),
             ray_index: L::arr(0),
             cold: L::arr(G::Cold::default()),
         }
@@ -67,14 +67,14 @@ impl<L: Lanes, G: Geometry<L>> Pack<L, G> {
         self.next = l.set_i(self.next, k, lane.next);
         self.entry = l.set_i(self.entry, k, lane.entry_raw);
         self.visited = l.set_i(self.visited, k, lane.st.visited);
-        self.live = l.or_m(self.live, l.from_bits(1 << k));
+        self.live = l.or_m(self.live, l.mask_of_bits(1 << k));
         self.ray_index.as_mut()[k] = ray;
     }
 
     /// Parks lane `k` (on tet 0).
     #[inline(always)]
     fn park(&mut self, l: L, k: usize) {
-        self.live = l.andnot_m(l.from_bits(1 << k), self.live);
+        self.live = l.andnot_m(l.mask_of_bits(1 << k), self.live);
         self.next = l.set_i(self.next, k, 0);
     }
 
@@ -197,9 +197,9 @@ fn ties<L: Lanes, G: Geometry<L>>(
         }
     }
     [
-        l.from_bits(bits[0]),
-        l.from_bits(bits[1]),
-        l.from_bits(bits[2]),
+        l.mask_of_bits(bits[0]),
+        l.mask_of_bits(bits[1]),
+        l.mask_of_bits(bits[2]),
     ]
 }
 
