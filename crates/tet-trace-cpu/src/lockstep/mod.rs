@@ -66,11 +66,11 @@
 //! clamped in-register to the arrays (`next ≤ tets − 1`, `idx₃ ≤ points −
 //! 1`, ranks and slots ≤ 3, offsets checked once per batch by
 //! `RecordWords::gatherable`), so no layout, valid or not, can make them
-//! read out of bounds. A corrupt layout
-//! whose links point past the tet array makes the scalar walk panic on the
-//! index; the gather path then reads a clamped record instead (a wrong walk,
-//! never an out-of-bounds read); [`tet_core::layout::LayoutMesh::from_mesh`]
-//! validates the mesh, so neither happens for a tracer built by `new`.
+//! read out of bounds. A corrupt layout whose links point past the tet
+//! array makes the scalar walk panic on the index; the gather path then
+//! reads a clamped record instead (a wrong walk, never an out-of-bounds
+//! read); [`tet_core::layout::LayoutMesh::from_mesh`] validates the mesh,
+//! so neither happens for a tracer built by `new`.
 //!
 //! # Identical to the scalar walk
 //!
