@@ -156,8 +156,18 @@ impl Lanes for Avx2 {
     }
     #[inline(always)]
     fn select_f(self, m: __m256, t: __m256, f: __m256) -> __m256 {
+        // A byte blend, not `vblendvps`: LLVM turns a float blend whose
+        // result is stored where its old operand was loaded into a masked
+        // store (`vmaskmovps`), slow on AMD and a store-forwarding stall
+        // when the next round loads the field; no byte-masked store exists.
         // SAFETY: as `lane_mask`.
-        unsafe { _mm256_blendv_ps(f, t, m) }
+        unsafe {
+            _mm256_castsi256_ps(_mm256_blendv_epi8(
+                _mm256_castps_si256(f),
+                _mm256_castps_si256(t),
+                _mm256_castps_si256(m),
+            ))
+        }
     }
     #[inline(always)]
     fn select_i(self, m: __m256, t: __m256i, f: __m256i) -> __m256i {
