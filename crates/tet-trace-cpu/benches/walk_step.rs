@@ -2,8 +2,10 @@
 //! mesh (not a criterion bench): the scalar interleaved walk
 //! ([`tet_trace_cpu::walk::trace_interleaved`]) against the SIMD lockstep walk
 //! ([`tet_trace_cpu::lockstep`]), frame by frame in turn, so that the load of
-//! a shared machine hits both alike. Prints Mrays/s of the best frame, tets
-//! per ray, and checks that both paths give identical outcomes per pixel.
+//! a shared machine hits both alike; likewise ScTP's batch path against its
+//! lockstep walk at 8 (AVX2) and 16 (AVX-512) lanes where the CPU runs
+//! them. Prints Mrays/s of the best frame, tets per ray, and checks that
+//! both paths give identical outcomes per pixel.
 //!
 //! Run (mesh from `tet-bench build torus-knots -o /tmp/tk.tmesh`):
 //! `TT_MESH=/tmp/tk.tmesh RAYON_NUM_THREADS=2 cargo bench -p tet-trace-cpu
@@ -19,12 +21,13 @@ use glam::Vec3;
 use tet_core::TetMesh;
 use tet_core::scene::{Camera, PointLight};
 use tet_trace_cpu::kernel::Interleaved;
+use tet_trace_cpu::lockstep::{Width, trace_lockstep_sctp};
 use tet_trace_cpu::render::{Frame, RenderOptions, render};
 use tet_trace_cpu::sctp::SctpTracer;
 use tet_trace_cpu::tet16::Tet16Tracer;
 use tet_trace_cpu::tet20::Tet20Tracer;
 use tet_trace_cpu::tet32::Tet32Tracer;
-use tet_trace_cpu::{DuffF32, Tracer, TripleF32};
+use tet_trace_cpu::{DuffF32, Ray, Start, Starts, TraceOutcome, Tracer, TripleF32};
 
 /// Process CPU time (user + system, all threads) in ms from /proc/self/stat
 /// (10 ms ticks); `None` off Linux. On a shared machine, CPU time is less
@@ -61,6 +64,38 @@ fn framing_camera(mesh: &TetMesh) -> Camera {
     }
 }
 
+/// ScTP's lockstep walk at one width (the batch path of `SctpTracer` is
+/// 16-lane AVX-512 where the CPU has it, else the interleaved walk).
+struct SctpAt<'a, 'm>(&'a SctpTracer<'m>, Width);
+
+impl Tracer for SctpAt<'_, '_> {
+    fn name(&self) -> String {
+        format!("sctp/{:?}", self.1)
+    }
+    fn mesh(&self) -> &TetMesh {
+        self.0.mesh()
+    }
+    fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
+        self.0.trace(ray, start)
+    }
+    fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
+        self.trace_batch_from(rays, Starts::Same(start), out);
+    }
+    fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
+        let t = self.0;
+        let ran = trace_lockstep_sctp(
+            self.1,
+            t.mesh(),
+            t.layout(),
+            rays,
+            starts,
+            t.step_cap(),
+            out,
+        );
+        assert!(ran, "{:?} lockstep not available", self.1);
+    }
+}
+
 fn main() {
     if std::env::args().any(|a| a == "--list") {
         return;
@@ -88,15 +123,23 @@ fn main() {
     let t32 = Tet32Tracer::<DuffF32>::new(&mesh).unwrap();
     let sctp = SctpTracer::<TripleF32>::new(&mesh).unwrap();
     let (i20, i16, i32) = (Interleaved(&t20), Interleaved(&t16), Interleaved(&t32));
-    let all: Vec<(&str, &dyn Tracer)> = vec![
+    let (s8, s16) = (SctpAt(&sctp, Width::Avx2), SctpAt(&sctp, Width::Avx512));
+    let mut all: Vec<(&str, &dyn Tracer)> = vec![
         ("tet20-interleaved", &i20),
         ("tet20-lockstep", &t20),
         ("tet16-interleaved", &i16),
         ("tet16-lockstep", &t16),
         ("tet32-interleaved", &i32),
         ("tet32-lockstep", &t32),
-        ("sctp-interleaved", &sctp),
+        ("sctp-batch", &sctp),
     ];
+    // ScTP's lockstep walk at the SIMD widths this CPU runs.
+    if Width::Avx2.available() {
+        all.push(("sctp-lockstep8", &s8));
+    }
+    if Width::Avx512.available() {
+        all.push(("sctp-lockstep16", &s16));
+    }
     let only = std::env::var("TT_ONLY").ok();
     let run: Vec<(&str, &dyn Tracer)> = all
         .into_iter()

@@ -4,17 +4,24 @@
 //! grids with random constrained faces and closed shells, for random rays and
 //! rays aimed exactly at vertices, edge midpoints, face centroids and along
 //! the grid axes, with `t_min`/`t_max` windows (walks through constrained
-//! faces), invalid rays, restarts on constrained faces, and step caps.
+//! faces), invalid rays, restarts on constrained faces, and step caps; and
+//! every lane width the CPU runs (portable 4 and 8, AVX2, AVX-512), one by
+//! one, for the projected walks and ScTP's, on camera images and on those
+//! adversarial rays.
 
 use glam::Vec3;
 use proptest::prelude::*;
 use tet_core::TetMesh;
+use tet_core::scene::Camera;
 use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::kernel::{Interleaved, WalkTracer};
-use tet_trace_cpu::lockstep::{trace_lockstep_avx2, trace_lockstep_portable};
+use tet_trace_cpu::lockstep::{
+    Width, trace_lockstep_at, trace_lockstep_avx2, trace_lockstep_portable, trace_lockstep_sctp,
+};
 use tet_trace_cpu::reference::{Aim, random_direction, random_point_inside, ray_from_feature};
+use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Topology;
-use tet_trace_cpu::{DuffF32, Ray, Start, Starts, TraceOutcome, Tracer, locate};
+use tet_trace_cpu::{DuffF32, Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint, locate};
 
 mod common;
 use common::{bits, grid};
@@ -232,5 +239,185 @@ proptest! {
     ) {
         let mesh = grid(cells.max(if shell { 3 } else { 2 }), jitter, fraction, shell, seed);
         check_mesh(&mesh, seed ^ 0xA5A5, 4, 23, None);
+    }
+}
+
+/// The walks of one kernel at every width: `trace(width, starts, out)`
+/// runs the lockstep walk at `width` (false: not run); every width the CPU
+/// has must run, and give the scalar outcome `scalar[i]` on ray `i`.
+/// Returns the widths that ran.
+fn check_widths(
+    name: &str,
+    rays: &[Ray],
+    scalar: &[TraceOutcome],
+    trace: impl Fn(Width, &mut [TraceOutcome]) -> bool,
+) -> Vec<Width> {
+    let mut ran = Vec::new();
+    for width in Width::ALL {
+        let mut got = vec![
+            TraceOutcome::Miss {
+                tets_visited: u32::MAX
+            };
+            rays.len()
+        ];
+        let did = trace(width, &mut got);
+        assert_eq!(
+            did,
+            width.available(),
+            "{name}: {width:?} ran {did}, available {}",
+            width.available()
+        );
+        if !did {
+            continue;
+        }
+        ran.push(width);
+        for (i, r) in rays.iter().enumerate() {
+            assert_eq!(
+                bits(&got[i]),
+                bits(&scalar[i]),
+                "{name} {width:?} differs on ray {i} {r:?}: {:?} vs scalar {:?}",
+                got[i],
+                scalar[i]
+            );
+        }
+    }
+    ran
+}
+
+/// Tet20, Tet16, Tet32 and ScTP at every width on `rays` from `view`
+/// against their scalar walks (`cap`: the step cap, default when `None`).
+/// Returns the widths that ran, per kernel.
+fn check_all_widths(
+    mesh: &TetMesh,
+    view: &Viewpoint,
+    rays: &[Ray],
+    cap: Option<u32>,
+) -> Vec<(String, Vec<Width>)> {
+    fn scalar<T: Tracer>(t: &T, view: &Viewpoint, rays: &[Ray]) -> Vec<TraceOutcome> {
+        rays.iter()
+            .map(|r| match view.start(t, r) {
+                Ok(s) => t.trace(r, s),
+                Err(done) => done,
+            })
+            .collect()
+    }
+    fn projected<L: Topology>(
+        t: &WalkTracer<'_, L, DuffF32>,
+        view: &Viewpoint,
+        rays: &[Ray],
+    ) -> (String, Vec<Width>) {
+        let want = scalar(t, view, rays);
+        let (mesh, topo, cap) = (t.mesh(), t.layout(), t.step_cap());
+        let ran = check_widths(&t.name(), rays, &want, |w, out| {
+            trace_lockstep_at(w, mesh, topo, rays, starts(view), cap, out)
+        });
+        (t.name(), ran)
+    }
+    let t20 = tet_trace_cpu::tet20::Tet20Tracer::<DuffF32>::new(mesh).unwrap();
+    let t16 = tet_trace_cpu::tet16::Tet16Tracer::<DuffF32>::new(mesh).unwrap();
+    let t32 = tet_trace_cpu::tet32::Tet32Tracer::<DuffF32>::new(mesh).unwrap();
+    let sctp: tet_trace_cpu::sctp::SctpTracer<'_> =
+        tet_trace_cpu::sctp::SctpTracer::new(mesh).unwrap();
+    let (t20, t16, t32, sctp) = match cap {
+        Some(c) => (
+            t20.with_step_cap(c),
+            t16.with_step_cap(c),
+            t32.with_step_cap(c),
+            sctp.with_step_cap(c),
+        ),
+        None => (t20, t16, t32, sctp),
+    };
+    let mut ran = vec![
+        projected(&t20, view, rays),
+        projected(&t16, view, rays),
+        projected(&t32, view, rays),
+    ];
+    let want = scalar(&sctp, view, rays);
+    let (m, topo, c) = (sctp.mesh(), sctp.layout(), sctp.step_cap());
+    let widths = check_widths("ScTP", rays, &want, |w, out| {
+        trace_lockstep_sctp(w, m, topo, rays, starts(view), c, out)
+    });
+    ran.push(("ScTP".to_string(), widths));
+    ran
+}
+
+/// The batch starts of `view`.
+fn starts(view: &Viewpoint) -> Starts<'_> {
+    match view {
+        Viewpoint::Inside(tet) => Starts::Same(Start::Tet(*tet)),
+        Viewpoint::Outside(entry) => Starts::Outside(entry),
+    }
+}
+
+/// The primary rays of a `w × h` image.
+fn image_rays(camera: &Camera, w: u32, h: u32) -> Vec<Ray> {
+    let cam = PinholeCamera::new(camera, w, h, true);
+    (0..h)
+        .flat_map(|j| (0..w).map(move |i| (i, j)))
+        .map(|(i, j)| cam.ray(i, j))
+        .collect()
+}
+
+#[test]
+fn every_width_equals_scalar_on_camera_images_and_adversarial_rays() {
+    let mut report = Vec::new();
+    // 8³ jittered cells, 3 % of the faces constrained, a closed shell; a
+    // camera inside the mesh and one outside (rays entering through the
+    // boundary).
+    let mesh = grid(8, 0.1, 0.03, true, 11);
+    let centre = Vec3::splat(4.0);
+    for (position, up) in [
+        (Vec3::new(0.45, 0.6, 0.5), Vec3::Z),
+        (Vec3::new(-7.0, 2.5, 13.0), Vec3::Y),
+    ] {
+        let camera = Camera {
+            position,
+            target: centre,
+            up,
+            vfov_deg: 55.0,
+        };
+        let view = Viewpoint::locate(&mesh, position).unwrap();
+        let rays = image_rays(&camera, 48, 36);
+        report.extend(check_all_widths(&mesh, &view, &rays, None));
+    }
+    // Adversarial rays (at vertices, edge midpoints, face centroids, along
+    // the axes, windows, invalid) from inside, on an unjittered grid (many
+    // exact ties), with and without a small step cap.
+    let mut rng = SplitMix64(77);
+    for (mesh, cap) in [
+        (grid(4, 0.0, 0.1, false, 9), None),
+        (grid(5, 0.1, 0.05, true, 4), None),
+        (grid(5, 0.1, 0.05, true, 4), Some(4)),
+    ] {
+        for k in 0..6 {
+            let origin = match k % 3 {
+                0 => random_point_inside(&mesh, &mut rng).0,
+                _ => {
+                    let aim = [Aim::Vertex, Aim::EdgeMidpoint][k % 2];
+                    ray_from_feature(&mesh, &mut rng, aim).origin
+                }
+            };
+            let view = Viewpoint::Inside(locate(&mesh, origin, 0).unwrap());
+            let rays = batch(&mesh, &mut rng, origin, 61);
+            report.extend(check_all_widths(&mesh, &view, &rays, cap));
+        }
+    }
+    // Say which widths ran (the AVX-512 ones only where the CPU has it).
+    let mut kernels: Vec<(String, Vec<Width>)> = Vec::new();
+    for (name, widths) in report {
+        match kernels.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, w)) => assert_eq!(*w, widths, "{name}: widths differ between cases"),
+            None => kernels.push((name, widths)),
+        }
+    }
+    for (name, widths) in &kernels {
+        eprintln!("lockstep widths run for {name}: {widths:?}");
+        assert!(widths.contains(&Width::Portable4) && widths.contains(&Width::Portable8));
+    }
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx512f") {
+        assert!(kernels.iter().all(|(_, w)| w.contains(&Width::Avx512)));
+    } else {
+        eprintln!("lockstep: this CPU has no AVX-512F; the 16-lane walks did not run");
     }
 }

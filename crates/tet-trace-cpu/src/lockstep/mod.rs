@@ -31,26 +31,46 @@
 //!   intrinsics, all five loads of a step (`VX`, the point's x, y, z, the
 //!   link) as `vpgatherdd`/`vgatherdps`, two packs of 8 lanes in flight per
 //!   thread so that the core overlaps their gather chains;
-//! * x86-64 with AVX2, other layouts: the portable lane loops compiled
+//! * x86-64 with AVX2, other layouts: the portable lanes (`portable`) compiled
 //!   for AVX2 (8 lanes, scalar loads through [`Topology`]);
-//! * otherwise: the portable lane loops with 4 lanes on the baseline target
+//! * otherwise: the portable lanes with 4 lanes on the baseline target
 //!   (SSE2 on x86-64), [`trace_lockstep_portable`].
 //!
+//! # One walk, generic over lanes
+//!
+//! The walk (`walk`) is written once, like Embree's kernels over
+//! `vfloat<K>`, over three small traits: the lanes (`lanes::Lanes`: f32
+//! and u32 vectors, masks, splat, add/sub/mul, compares, selects, gathers;
+//! implemented by `avx512::Avx512`, 16 lanes with mask registers,
+//! `avx2::Avx2`, 8 lanes with masks as vectors, and
+//! `portable::Portable<W>`, arrays of `W` lanes), the projection
+//! (`geometry::Geometry`: `Planar` for [`DuffF32`](crate::DuffF32),
+//! `Triple` for ScTP's [`TripleF32`](crate::TripleF32)) and the record
+//! reads (`exit::Records`: `Gathered` with the exit rule as a const
+//! parameter, `PerLane` through [`Topology`]). Every function on the way
+//! is `#[inline(always)]` and the walk is instantiated inside a
+//! `#[target_feature]` entry point per instruction set, so it compiles to
+//! the same straight-line intrinsics as a hand-written kernel; its rare
+//! paths run out of line, compiled for the same instruction set
+//! (`Lanes::cold`).
+//!
 //! Why intrinsics and `unsafe`: the same lane loops left to the
-//! auto-vectoriser (the portable path compiled for AVX2, 8 lanes) run more
+//! auto-vectoriser (the portable lanes compiled for AVX2, 8 lanes) run more
 //! instructions per step than the scalar interleaved walk and are no faster
 //! — the scalar loads and the transposition of 8 points into SoA vectors
 //! cost more than the SIMD arithmetic saves —, while the intrinsics with
-//! gathers run well under half its instructions per step. The only
-//! `unsafe` is the call into the `avx2` functions after the run-time
-//! check and the gathers, whose indices are clamped in-register to the
-//! arrays (`next ≤ tets − 1`, `idx₃ ≤ points − 1`, ranks and slots ≤ 3,
-//! offsets checked once per batch by `RecordWords::gatherable`), so no
-//! layout, valid or not, can make them read out of bounds. A corrupt layout
-//! whose links point past the tet array makes the scalar walk panic on the
-//! index; the gather path then reads a clamped record instead (a wrong walk,
-//! never an out-of-bounds read); [`tet_core::layout::LayoutMesh::from_mesh`]
-//! validates the mesh, so neither happens for a tracer built by `new`.
+//! gathers run well under half its instructions per step. The `unsafe` is
+//! the intrinsics inside the `Avx2` and `Avx512` lanes, whose values
+//! (tokens) exist only after the run-time check, the calls into the
+//! `#[target_feature]` entry points, and the gathers, whose indices are
+//! clamped in-register to the arrays (`next ≤ tets − 1`, `idx₃ ≤ points −
+//! 1`, ranks and slots ≤ 3, offsets checked once per batch by
+//! `RecordWords::gatherable`), so no layout, valid or not, can make them
+//! read out of bounds. A corrupt layout whose links point past the tet
+//! array makes the scalar walk panic on the index; the gather path then
+//! reads a clamped record instead (a wrong walk, never an out-of-bounds
+//! read); [`tet_core::layout::LayoutMesh::from_mesh`] validates the mesh,
+//! so neither happens for a tracer built by `new`.
 //!
 //! # Identical to the scalar walk
 //!
@@ -67,26 +87,32 @@
 //! # Tuning
 //!
 //! Two packs in flight per thread beat one and are not beaten by three or
-//! four (AVX2 and AVX-512 alike); prefetching the next records, as the
-//! scalar walk does, gains nothing here and is off (`avx2::PREFETCH`).
-//! Rerun the instruction counts with `benches/walk_step.rs`.
+//! four (AVX2 and AVX-512 alike; the `PACKS` of `walk::run`); prefetching
+//! the next records, as the scalar walk does, gains nothing with gathers
+//! and is off there (`exit::Records::prefetch`). Rerun the instruction
+//! counts with `benches/walk_step.rs`.
 //!
 //! # Modules
 //!
-//! * `pack`: the lanes in structure-of-arrays form, shared by every width,
-//!   and the gathers' view of a layout;
-//! * `portable`: the lane loops (4 lanes, or 8 compiled for AVX2);
-//! * `avx2`, `avx512`: the 8- and 16-lane walks in intrinsics;
-//! * `sctp`: ScTP's triple products in 16-lane AVX-512 lockstep.
+//! * `lanes`: the lane trait;
+//! * `avx512`, `avx2`, `portable`: its 16-, 8- and `W`-lane implementations;
+//! * `geometry`: the projections in lanes (Duff's 2-D basis, ScTP's triple
+//!   products);
+//! * `exit`: the record reads (gathers with the exit rules, or lane by lane);
+//! * `walk`: the walk itself, once;
+//! * `sctp`: ScTP's batch path (16-lane AVX-512 lockstep).
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
-mod pack;
+mod exit;
+mod geometry;
+mod lanes;
 mod portable;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod sctp;
+mod walk;
 
 use tet_core::TetMesh;
 
@@ -94,9 +120,68 @@ use crate::ray::{Ray, TraceOutcome};
 use crate::walk::lanes::Starts;
 use crate::walk::topology::Topology;
 pub use crate::walk::topology::{ExitRule, RecordWords};
-pub use pack::{NARROW, WIDE};
 #[cfg(target_arch = "x86_64")]
-use pack::{RANK, RANK_XOR, SLOT};
+use avx2::Avx2;
+#[cfg(target_arch = "x86_64")]
+use avx512::Avx512;
+use exit::{Gathered, Geo, IDS, PerLane};
+#[cfg(target_arch = "x86_64")]
+use exit::{RANK, RANK_XOR, Records, SLOT};
+#[cfg(target_arch = "x86_64")]
+use geometry::Geometry;
+use geometry::{Planar, Triple};
+use portable::Portable;
+
+/// Lanes of the AVX2 lockstep walk (256-bit vectors of f32 / u32).
+pub const WIDE: usize = 8;
+/// Lanes of the portable lockstep walk (128-bit vectors).
+pub const NARROW: usize = 4;
+
+/// A lockstep walk's lanes, for running one width on purpose (tests,
+/// comparisons); [`trace_lockstep`] picks the widest the CPU runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Width {
+    /// The portable lanes, 4 wide ([`NARROW`]), baseline target.
+    Portable4,
+    /// The portable lanes, 8 wide, baseline target.
+    Portable8,
+    /// AVX2 intrinsics, 8 lanes ([`WIDE`]).
+    Avx2,
+    /// AVX-512F intrinsics, 16 lanes.
+    Avx512,
+}
+
+impl Width {
+    /// Every width, narrowest first.
+    pub const ALL: [Width; 4] = [
+        Width::Portable4,
+        Width::Portable8,
+        Width::Avx2,
+        Width::Avx512,
+    ];
+
+    /// True when this CPU runs the width (the portable ones always).
+    pub fn available(self) -> bool {
+        match self {
+            Width::Portable4 | Width::Portable8 => true,
+            #[cfg(target_arch = "x86_64")]
+            Width::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+            #[cfg(target_arch = "x86_64")]
+            Width::Avx512 => std::arch::is_x86_feature_detected!("avx512f"),
+            #[cfg(not(target_arch = "x86_64"))]
+            Width::Avx2 | Width::Avx512 => false,
+        }
+    }
+
+    /// Lanes per pack.
+    pub fn lanes(self) -> usize {
+        match self {
+            Width::Portable4 => NARROW,
+            Width::Portable8 | Width::Avx2 => WIDE,
+            Width::Avx512 => 16,
+        }
+    }
+}
 
 /// Traces `rays` from `start` (at most `cap` tets each) with [`DuffF32`](crate::DuffF32)
 /// lanes in lockstep; `out[i]` is exactly
@@ -131,6 +216,118 @@ pub fn trace_lockstep_avx2<T: Topology>(
     dispatch(mesh, topo, rays, start, cap, out, false);
 }
 
+/// [`trace_lockstep`] with `W` lanes compiled for the baseline target (no
+/// run-time dispatch; `0 < W ≤ 32`): the portable fallback, public so that
+/// tests cover it on machines with AVX2 too.
+pub fn trace_lockstep_portable<T: Topology, const W: usize>(
+    mesh: &TetMesh,
+    topo: &T,
+    rays: &[Ray],
+    start: Starts<'_>,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    const { assert!(W > 0 && W <= 32, "1 to 32 portable lanes") };
+    walk::run::<Portable<W>, Planar, _, 1>(Portable, &PerLane(topo), mesh, rays, start, cap, out);
+}
+
+/// [`trace_lockstep`] at `width` exactly: the portable widths read the
+/// records through [`Topology`]; the AVX2 and AVX-512 ones gather them and
+/// need [`Topology::record_words`] (a Tet20, Tet16 or Tet32 layout). False
+/// (nothing traced) when the CPU lacks the width or the layout its records.
+pub fn trace_lockstep_at<T: Topology>(
+    width: Width,
+    mesh: &TetMesh,
+    topo: &T,
+    rays: &[Ray],
+    start: Starts<'_>,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) -> bool {
+    match width {
+        Width::Portable4 => trace_lockstep_portable::<T, NARROW>(mesh, topo, rays, start, cap, out),
+        Width::Portable8 => trace_lockstep_portable::<T, WIDE>(mesh, topo, rays, start, cap, out),
+        #[cfg(target_arch = "x86_64")]
+        Width::Avx2 | Width::Avx512 => {
+            let Some((rule, g)) = projected_records(mesh, topo) else {
+                return false;
+            };
+            match (width, Avx2::detect(), Avx512::detect()) {
+                (Width::Avx512, _, Some(t)) => {
+                    gathered_avx512(t, rule, g, mesh, rays, start, cap, out)
+                }
+                (Width::Avx2, Some(t), _) => gathered_avx2(t, rule, g, mesh, rays, start, cap, out),
+                _ => return false,
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        Width::Avx2 | Width::Avx512 => return false,
+    }
+    true
+}
+
+/// ScTP ([`TripleF32`](crate::TripleF32)) in lockstep at `width` over the
+/// 32-byte baseline layout ([`ExitRule::Ids`] records, gathered at every
+/// width): `out[i]` is exactly [`crate::walk::trace`]`::<TripleF32, T>` of
+/// `rays[i]`. False (nothing traced) when the CPU lacks the width or `topo`
+/// is not a baseline layout. The batch path of [`crate::sctp::SctpTracer`]
+/// is this walk at [`Width::Avx512`] where the CPU has it.
+pub fn trace_lockstep_sctp<T: Topology>(
+    width: Width,
+    mesh: &TetMesh,
+    topo: &T,
+    rays: &[Ray],
+    start: Starts<'_>,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) -> bool {
+    let Some(g) = baseline_records(mesh, topo) else {
+        return false;
+    };
+    let x = &Gathered::<IDS>(g);
+    match width {
+        Width::Portable4 => {
+            walk::run::<Portable<NARROW>, Triple, _, 1>(Portable, x, mesh, rays, start, cap, out)
+        }
+        Width::Portable8 => {
+            walk::run::<Portable<WIDE>, Triple, _, 1>(Portable, x, mesh, rays, start, cap, out)
+        }
+        #[cfg(target_arch = "x86_64")]
+        Width::Avx2 => match Avx2::detect() {
+            // SAFETY: the token proves the CPU has AVX2.
+            Some(t) => unsafe { walk_avx2::<Triple, _>(t, x, mesh, rays, start, cap, out) },
+            None => return false,
+        },
+        #[cfg(target_arch = "x86_64")]
+        Width::Avx512 => match Avx512::detect() {
+            // SAFETY: the token proves the CPU has AVX-512F.
+            Some(t) => unsafe { walk_avx512::<Triple, _>(t, x, mesh, rays, start, cap, out) },
+            None => return false,
+        },
+        #[cfg(not(target_arch = "x86_64"))]
+        Width::Avx2 | Width::Avx512 => return false,
+    }
+    true
+}
+
+/// The gatherable records of a projected layout (Tet20, Tet16, Tet32; the
+/// baseline's `Ids` rule is ScTP's) and their exit rule.
+#[cfg(target_arch = "x86_64")]
+fn projected_records<'a, T: Topology>(mesh: &TetMesh, topo: &'a T) -> Option<(ExitRule, Geo<'a>)> {
+    let rw = topo.record_words()?;
+    if matches!(rw.rule, ExitRule::Ids { .. }) {
+        return None;
+    }
+    Some((rw.rule, Geo::new(mesh, &rw)?))
+}
+
+/// The gatherable records of the 32-byte baseline layout.
+fn baseline_records<'a, T: Topology>(mesh: &TetMesh, topo: &'a T) -> Option<Geo<'a>> {
+    let rw = topo.record_words()?;
+    matches!(rw.rule, ExitRule::Ids { .. }).then_some(())?;
+    Geo::new(mesh, &rw)
+}
+
 /// The widest walk the CPU supports (AVX-512 only when `wide`).
 fn dispatch<T: Topology>(
     mesh: &TetMesh,
@@ -143,56 +340,26 @@ fn dispatch<T: Topology>(
 ) {
     #[cfg(not(target_arch = "x86_64"))]
     let _ = wide;
-    // Records the gathers of the projected walks can read (the baseline's
-    // `Ids` rule is ScTP's, `sctp`).
     #[cfg(target_arch = "x86_64")]
-    let words = topo
-        .record_words()
-        .filter(|rw| rw.gatherable(mesh.points.len()) && !matches!(rw.rule, ExitRule::Ids { .. }));
-    #[cfg(target_arch = "x86_64")]
-    if wide
-        && std::arch::is_x86_feature_detected!("avx512f")
-        && let Some(rw) = words
     {
-        // SAFETY (all three): the `avx512f` functions only require the
-        // CPU to support AVX-512F, which was detected just above.
-        match rw.rule {
-            ExitRule::Rank { .. } => unsafe {
-                avx512::run_gather::<RANK>(mesh, rw, rays, start, cap, out)
-            },
-            ExitRule::RankXor { .. } => unsafe {
-                avx512::run_gather::<RANK_XOR>(mesh, rw, rays, start, cap, out)
-            },
-            ExitRule::Slot { .. } | ExitRule::Ids { .. } => unsafe {
-                avx512::run_gather::<SLOT>(mesh, rw, rays, start, cap, out)
-            },
+        let records = projected_records(mesh, topo);
+        if wide
+            && let Some(t) = Avx512::detect()
+            && let Some((rule, g)) = records
+        {
+            gathered_avx512(t, rule, g, mesh, rays, start, cap, out);
+            return;
         }
-        return;
-    }
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        match words {
-            Some(rw) => {
-                // SAFETY (all three): the `avx2` functions only require the
-                // CPU to support AVX2, which was detected just above.
-                match rw.rule {
-                    ExitRule::Rank { .. } => unsafe {
-                        avx2::run_gather::<RANK>(mesh, rw, rays, start, cap, out)
-                    },
-                    ExitRule::RankXor { .. } => unsafe {
-                        avx2::run_gather::<RANK_XOR>(mesh, rw, rays, start, cap, out)
-                    },
-                    ExitRule::Slot { .. } | ExitRule::Ids { .. } => unsafe {
-                        avx2::run_gather::<SLOT>(mesh, rw, rays, start, cap, out)
-                    },
-                }
+        if let Some(t) = Avx2::detect() {
+            match records {
+                Some((rule, g)) => gathered_avx2(t, rule, g, mesh, rays, start, cap, out),
+                // SAFETY: the token proves the CPU has AVX2.
+                None => unsafe { portable_avx2(t, topo, mesh, rays, start, cap, out) },
             }
-            // SAFETY: as above.
-            _ => unsafe { portable::trace_avx2(mesh, topo, rays, start, cap, out) },
+            return;
         }
-        return;
     }
-    portable::run::<T, NARROW>(mesh, topo, rays, start, cap, out);
+    trace_lockstep_portable::<T, NARROW>(mesh, topo, rays, start, cap, out);
 }
 
 /// True when `TET_LOCKSTEP=avx2` asks the lockstep walk to keep to 8-lane
@@ -203,16 +370,109 @@ fn avx2_only() -> bool {
     *AVX2_ONLY.get_or_init(|| std::env::var("TET_LOCKSTEP").is_ok_and(|v| v == "avx2"))
 }
 
-/// [`trace_lockstep`] with `W` lanes compiled for the baseline target (no
-/// run-time dispatch): the portable fallback, public so that tests cover it
-/// on machines with AVX2 too.
-pub fn trace_lockstep_portable<T: Topology, const W: usize>(
+/// Runs `$walk::<Planar, _>` with the gathered records of exit rule `$rule`.
+#[cfg(target_arch = "x86_64")]
+macro_rules! by_rule {
+    ($walk:ident, $t:expr, $rule:expr, $g:expr, $($arg:expr),*) => {
+        // SAFETY (all three): the token `$t` proves the CPU has the
+        // entry point's instruction set.
+        match $rule {
+            ExitRule::Rank { .. } => unsafe {
+                $walk::<Planar, _>($t, &Gathered::<RANK>($g), $($arg),*)
+            },
+            ExitRule::RankXor { .. } => unsafe {
+                $walk::<Planar, _>($t, &Gathered::<RANK_XOR>($g), $($arg),*)
+            },
+            ExitRule::Slot { .. } | ExitRule::Ids { .. } => unsafe {
+                $walk::<Planar, _>($t, &Gathered::<SLOT>($g), $($arg),*)
+            },
+        }
+    };
+}
+
+/// The projected walk with AVX-512 lanes and gathered records of `rule`.
+#[cfg(target_arch = "x86_64")]
+#[allow(clippy::too_many_arguments)]
+fn gathered_avx512(
+    t: Avx512,
+    rule: ExitRule,
+    g: Geo<'_>,
     mesh: &TetMesh,
-    topo: &T,
     rays: &[Ray],
     start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
 ) {
-    portable::run::<T, W>(mesh, topo, rays, start, cap, out);
+    by_rule!(walk_avx512, t, rule, g, mesh, rays, start, cap, out)
+}
+
+/// The projected walk with AVX2 lanes and gathered records of `rule`.
+#[cfg(target_arch = "x86_64")]
+#[allow(clippy::too_many_arguments)]
+fn gathered_avx2(
+    t: Avx2,
+    rule: ExitRule,
+    g: Geo<'_>,
+    mesh: &TetMesh,
+    rays: &[Ray],
+    start: Starts<'_>,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    by_rule!(walk_avx2, t, rule, g, mesh, rays, start, cap, out)
+}
+
+/// The walk with 16 AVX-512 lanes, two packs in flight, compiled for
+/// AVX-512F (everything inlines into it).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn walk_avx512<G: Geometry<Avx512>, X: Records<Avx512>>(
+    t: Avx512,
+    x: &X,
+    mesh: &TetMesh,
+    rays: &[Ray],
+    start: Starts<'_>,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    walk::run::<Avx512, G, X, 2>(t, x, mesh, rays, start, cap, out);
+}
+
+/// The walk with 8 AVX2 lanes, two packs in flight, compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn walk_avx2<G: Geometry<Avx2>, X: Records<Avx2>>(
+    t: Avx2,
+    x: &X,
+    mesh: &TetMesh,
+    rays: &[Ray],
+    start: Starts<'_>,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    walk::run::<Avx2, G, X, 2>(t, x, mesh, rays, start, cap, out);
+}
+
+/// The portable lanes, 8 wide, compiled for AVX2, reading the records
+/// through [`Topology`] (layouts without gatherable records).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn portable_avx2<T: Topology>(
+    _: Avx2,
+    topo: &T,
+    mesh: &TetMesh,
+    rays: &[Ray],
+    start: Starts<'_>,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    walk::run::<Portable<WIDE>, Planar, _, 1>(
+        Portable,
+        &PerLane(topo),
+        mesh,
+        rays,
+        start,
+        cap,
+        out,
+    );
 }
