@@ -1,6 +1,6 @@
 //! ScTP (Lagae & Dutré's scalar triple products, [`TripleF32`](crate::TripleF32)) walked in
-//! 16-lane AVX-512 lockstep over the 32-byte baseline layout: the batch path
-//! of [`crate::sctp::SctpTracer`].
+//! 16-lane AVX-512 (else 8-lane AVX2) lockstep over the 32-byte baseline
+//! layout: the batch path of [`crate::sctp::SctpTracer`].
 //!
 //! It is the one lockstep walk of [`crate::lockstep`] with ScTP's geometry
 //! and records (`geometry::Triple`, `exit::Gathered` with the `IDS` rule):
@@ -21,9 +21,11 @@
 //! in [`crate::lockstep`].
 //!
 //! Why: the scalar interleaved walk spends about 146 instructions per ScTP
-//! step; in lockstep the arithmetic is shared by 16 rays. (The same walk
-//! runs at the other widths through [`super::trace_lockstep_sctp`], for
-//! tests; with 8 AVX2 lanes the batch path keeps the interleaved walk.)
+//! step; in lockstep the arithmetic is shared by 16 (or 8) rays: with 8
+//! AVX2 lanes it traced 2.5 times the rays per CPU-second of the
+//! interleaved walk on Torus Knots (`benches/walk_step.rs`). The same walk
+//! runs at the portable widths through [`super::trace_lockstep_sctp`], for
+//! tests.
 
 use tet_core::TetMesh;
 
@@ -32,9 +34,10 @@ use crate::ray::{Ray, TraceOutcome};
 use crate::walk::lanes::Starts;
 use crate::walk::topology::Topology;
 
-/// Traces the batch in lockstep when the CPU has AVX-512F and the
-/// layout exposes baseline records ([`ExitRule::Ids`](super::ExitRule::Ids)); false (nothing
-/// traced) otherwise.
+/// Traces the batch in lockstep when the CPU has AVX-512F (unless
+/// `TET_LOCKSTEP=avx2`) or AVX2 and the layout exposes baseline records
+/// ([`ExitRule::Ids`](super::ExitRule::Ids)); false (nothing traced)
+/// otherwise.
 pub(crate) fn trace<T: Topology>(
     mesh: &TetMesh,
     topo: &T,
@@ -43,5 +46,10 @@ pub(crate) fn trace<T: Topology>(
     cap: u32,
     out: &mut [TraceOutcome],
 ) -> bool {
-    trace_lockstep_sctp(Width::Avx512, mesh, topo, rays, start, cap, out)
+    #[cfg(target_arch = "x86_64")]
+    let wide = !super::avx2_only();
+    #[cfg(not(target_arch = "x86_64"))]
+    let wide = false;
+    (wide && trace_lockstep_sctp(Width::Avx512, mesh, topo, rays, start, cap, out))
+        || trace_lockstep_sctp(Width::Avx2, mesh, topo, rays, start, cap, out)
 }

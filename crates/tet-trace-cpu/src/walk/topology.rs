@@ -74,7 +74,7 @@ pub enum ExitRule {
     /// The 32-byte baseline (ScTP): no `VX` word; the new vertex is the one
     /// of the four ids at words `ids..ids + 4` not on the entry face, the
     /// link that of the exiting vertex's slot among the first three (3:
-    /// none), at `links + slot`. Walked by `crate::sctp_lockstep` only.
+    /// none), at `links + slot`. Walked by ScTP's lockstep walk (`crate::lockstep`, `IDS` rule) only.
     Ids {
         /// Word of the slot-0 vertex id.
         ids: usize,
