@@ -16,11 +16,20 @@ use anyhow::Result;
 use crate::accuracy::{CaseAccuracy, MethodAccuracy, Reference, ray_set, trace_all};
 use crate::cli::{Method, Precision};
 use crate::load::{Loaded, spinner};
-use crate::methods::{has_f64, tracer};
+use crate::methods::{has_f64, tracer_capped};
 
 /// Rays per batch: about 60 MB of rays, starts, reference hits and
 /// outcomes per method at a time.
 pub const BATCH_RAYS: usize = 1 << 20;
+
+/// Step cap of the walks here (or the default cap where that is lower): a
+/// walk longer than this counts as
+/// [`tet_trace_cpu::ray::Failure::StepCap`]. A ray crosses each tet at most
+/// once, and no ray of the scenes here crosses more than a few thousand;
+/// the default cap (twice the tets, up to 2²⁴) would let every cycling
+/// walk of the faithful Tet80 and ScTP on adversarial rays run hundreds of
+/// thousands of steps before it is counted.
+pub const STEP_CAP: u32 = 1 << 16;
 
 /// Side of the camera image of the first batch (Maria et al. count per
 /// 1024² image).
@@ -75,13 +84,14 @@ fn run_in_batches(
 ) -> Result<CaseAccuracy> {
     let mesh = &loaded.mesh;
     let reference = Reference::new(mesh);
+    let cap = Some(STEP_CAP.min(tet_trace_cpu::walk::step_cap(mesh)));
     let mut tracers = Vec::new();
     for &m in methods {
         if matches!(precision, Precision::F32 | Precision::Both) && m != Method::Brute {
-            tracers.push((tracer(m, false, mesh)?, "f32"));
+            tracers.push((tracer_capped(m, false, mesh, cap)?, "f32"));
         }
         if matches!(precision, Precision::F64 | Precision::Both) && has_f64(m) {
-            tracers.push((tracer(m, true, mesh)?, "f64"));
+            tracers.push((tracer_capped(m, true, mesh, cap)?, "f64"));
         }
     }
     let mut counts: Vec<(MethodAccuracy, f64)> = tracers

@@ -15,16 +15,36 @@ use crate::strips::StripsTracer;
 
 /// Builds the tracer of `method` over `mesh`, in f64 when `f64` is set.
 pub fn tracer<'m>(method: Method, f64: bool, mesh: &'m TetMesh) -> Result<Box<dyn Tracer + 'm>> {
+    tracer_capped(method, f64, mesh, None)
+}
+
+/// [`tracer`] with the tet walks' step cap replaced by `cap` (tets
+/// visited before a walk reports [`tet_trace_cpu::ray::Failure::StepCap`];
+/// the triangle structures have none).
+pub fn tracer_capped<'m>(
+    method: Method,
+    f64: bool,
+    mesh: &'m TetMesh,
+    cap: Option<u32>,
+) -> Result<Box<dyn Tracer + 'm>> {
+    macro_rules! walk {
+        ($t:expr) => {
+            match cap {
+                Some(c) => Box::new($t.with_step_cap(c)) as Box<dyn Tracer + 'm>,
+                None => Box::new($t),
+            }
+        };
+    }
     Ok(match (method, f64) {
-        (Method::Sctp, false) => Box::new(<SctpTracer<'_>>::new(mesh)?),
-        (Method::Tet80, false) => Box::new(Tet80Tracer::new(mesh)?),
-        (Method::Tet80Consistent, false) => Box::new(Tet80ConsistentTracer::consistent(mesh)?),
-        (Method::Tet32, false) => Box::new(<Tet32Tracer<'_>>::new(mesh)?),
-        (Method::Tet32, true) => Box::new(Tet32TracerF64::new(mesh)?),
-        (Method::Tet20, false) => Box::new(<Tet20Tracer<'_>>::new(mesh)?),
-        (Method::Tet20, true) => Box::new(Tet20TracerF64::new(mesh)?),
-        (Method::Tet16, false) => Box::new(<Tet16Tracer<'_>>::new(mesh)?),
-        (Method::Tet16, true) => Box::new(Tet16TracerF64::new(mesh)?),
+        (Method::Sctp, false) => walk!(<SctpTracer<'_>>::new(mesh)?),
+        (Method::Tet80, false) => walk!(Tet80Tracer::new(mesh)?),
+        (Method::Tet80Consistent, false) => walk!(Tet80ConsistentTracer::consistent(mesh)?),
+        (Method::Tet32, false) => walk!(<Tet32Tracer<'_>>::new(mesh)?),
+        (Method::Tet32, true) => walk!(Tet32TracerF64::new(mesh)?),
+        (Method::Tet20, false) => walk!(<Tet20Tracer<'_>>::new(mesh)?),
+        (Method::Tet20, true) => walk!(Tet20TracerF64::new(mesh)?),
+        (Method::Tet16, false) => walk!(<Tet16Tracer<'_>>::new(mesh)?),
+        (Method::Tet16, true) => walk!(Tet16TracerF64::new(mesh)?),
         (Method::Obvhs, false) => Box::new(BvhTracer::new(mesh)),
         (Method::Strips, false) => Box::new(StripsTracer::new(mesh, false)?),
         (Method::StripsPackets, false) => Box::new(StripsTracer::new(mesh, true)?),
@@ -39,7 +59,7 @@ pub fn tracer<'m>(method: Method, f64: bool, mesh: &'m TetMesh) -> Result<Box<dy
             method.name()
         ),
         (Method::Brute, _) => Box::new(crate::brute::BruteTracer { mesh }),
-        (Method::Exact, false) => Box::new(tet_trace_cpu::exact::ExactTracer::new(mesh)),
+        (Method::Exact, false) => walk!(tet_trace_cpu::exact::ExactTracer::new(mesh)),
         (m, true) => bail!("method {} has no f64 variant", m.name()),
         (m, false) => bail!("{} runs on the GPU: only `render` supports it", m.name()),
     })
