@@ -1,6 +1,6 @@
 //! The job commands: `build SCENE --plan JOB_DIR` ([`plan`]),
 //! `build-part` ([`build_part`]), `merge` ([`merge`]), `job status`
-//! ([`job`]) and `submit --engine slurm` ([`submit`]). They are thin:
+//! ([`job`]) and `submit --engine slurm` ([`submit()`]). They are thin:
 //! the job itself (plan, idempotent part runs, status, merge) is
 //! `tet_build::outofcore::job`; the Slurm scripts are [`slurm`].
 
