@@ -640,6 +640,20 @@ impl MethodAccuracy {
     }
 }
 
+/// The kernel precisions `precision` asks of `method`, as `(f64, label)`:
+/// f32 for every method but the brute force (the f64 reference itself),
+/// f64 where the method has it.
+pub(crate) fn variants(
+    method: Method,
+    precision: Precision,
+) -> impl Iterator<Item = (bool, &'static str)> {
+    let f32 = matches!(precision, Precision::F32 | Precision::Both) && method != Method::Brute;
+    let f64 = matches!(precision, Precision::F64 | Precision::Both) && has_f64(method);
+    [(f32, (false, "f32")), (f64, (true, "f64"))]
+        .into_iter()
+        .filter_map(|(on, v)| on.then_some(v))
+}
+
 /// Runs every method on one mesh.
 pub fn run_case(
     case: &str,
@@ -663,24 +677,18 @@ pub fn run_case(
     let mut left_out = Vec::new();
     for &m in methods {
         let unscaled_f32 = matches!(m, Method::Sctp | Method::Tet80);
-        if unscaled_f32 && extremes::beyond_f32_products(case) {
+        let beyond_f32 = unscaled_f32 && extremes::beyond_f32_products(case);
+        if beyond_f32 {
             left_out.push(format!("{}/f32", m.name()));
-        } else if matches!(precision, Precision::F32 | Precision::Both) && m != Method::Brute {
-            let t = tracer(m, false, mesh)?;
-            out.push(check(
-                t.as_ref(),
-                "f32",
-                &reference,
-                &expected,
-                &set,
-                plan.min_time_s,
-            ));
         }
-        if matches!(precision, Precision::F64 | Precision::Both) && has_f64(m) {
-            let t = tracer(m, true, mesh)?;
+        for (f64, label) in variants(m, precision) {
+            if beyond_f32 && !f64 {
+                continue;
+            }
+            let t = tracer(m, f64, mesh)?;
             out.push(check(
                 t.as_ref(),
-                "f64",
+                label,
                 &reference,
                 &expected,
                 &set,

@@ -13,10 +13,10 @@ use std::time::Instant;
 
 use anyhow::Result;
 
-use crate::accuracy::{CaseAccuracy, MethodAccuracy, Reference, ray_set, trace_all};
+use crate::accuracy::{CaseAccuracy, MethodAccuracy, Reference, ray_set, trace_all, variants};
 use crate::cli::{Method, Precision};
 use crate::load::{Loaded, spinner};
-use crate::methods::{has_f64, tracer_capped};
+use crate::methods::tracer_capped;
 
 /// Rays per batch: about 60 MB of rays, starts, reference hits and
 /// outcomes per method at a time.
@@ -87,11 +87,8 @@ fn run_in_batches(
     let cap = Some(STEP_CAP.min(tet_trace_cpu::walk::step_cap(mesh)));
     let mut tracers = Vec::new();
     for &m in methods {
-        if matches!(precision, Precision::F32 | Precision::Both) && m != Method::Brute {
-            tracers.push((tracer_capped(m, false, mesh, cap)?, "f32"));
-        }
-        if matches!(precision, Precision::F64 | Precision::Both) && has_f64(m) {
-            tracers.push((tracer_capped(m, true, mesh, cap)?, "f64"));
+        for (f64, label) in variants(m, precision) {
+            tracers.push((tracer_capped(m, f64, mesh, cap)?, label));
         }
     }
     let mut counts: Vec<(MethodAccuracy, f64)> = tracers
