@@ -46,10 +46,7 @@ pub(crate) fn trace<T: Topology>(
     cap: u32,
     out: &mut [TraceOutcome],
 ) -> bool {
-    #[cfg(target_arch = "x86_64")]
-    let wide = !super::avx2_only();
-    #[cfg(not(target_arch = "x86_64"))]
-    let wide = false;
-    (wide && trace_lockstep_sctp(Width::Avx512, mesh, topo, rays, start, cap, out))
+    // This module exists on x86-64 only.
+    (!super::avx2_only() && trace_lockstep_sctp(Width::Avx512, mesh, topo, rays, start, cap, out))
         || trace_lockstep_sctp(Width::Avx2, mesh, topo, rays, start, cap, out)
 }
