@@ -12,11 +12,9 @@
 //! rows need no tetrahedralization; Tet20's build time is the whole
 //! pipeline's (clean, resolve, TetGen, assemble, reorder).
 
-use std::fmt::Write as _;
-use std::time::Instant;
-
 use anyhow::{Result, bail};
 use glam::{DVec3, Vec3};
+use std::fmt::Write as _;
 use tet_build::procedural::dense_torus_knots;
 use tet_build::scene::Scene;
 use tet_core::link::Link;
@@ -28,9 +26,8 @@ use tet_trace_cpu::render::RenderOptions;
 use super::doc::{LargeModelRow, LargeStructure, TABLE_FLAGS, TablesDoc};
 use crate::bvh::BvhTracer;
 use crate::cli::Method;
-use crate::layouts::layout_bytes;
+use crate::layouts::{layout_bytes, strips_bytes};
 use crate::load::{Loaded, from_scene};
-use crate::strips::StripsTracer;
 use crate::timing::time_method;
 
 /// Bytes each structure needs per triangle while it is built and timed
@@ -103,8 +100,9 @@ fn surface_mesh(scene: &Scene, camera: Vec3) -> TetMesh {
     }
 }
 
-/// One structure's row: built once to count its bytes and build time,
-/// then rendered by [`time_method`].
+/// One structure's row: built once to count its bytes, then rendered by
+/// [`time_method`], whose set-up time (the second build) is the build
+/// time.
 fn structure(
     loaded: &Loaded,
     method: Method,
@@ -113,23 +111,18 @@ fn structure(
     pool: &rayon::ThreadPool,
 ) -> Result<LargeStructure> {
     let triangles = loaded.mesh.constrained.len().max(1) as f64;
-    let t = Instant::now();
     let bytes = match method {
-        Method::Strips => {
-            StripsTracer::new(&loaded.mesh, false)?
-                .strips()
-                .bytes()
-                .total
-        }
+        Method::Strips => strips_bytes(&loaded.mesh)?.total_bytes,
         Method::Obvhs => {
             let (hierarchy, geometry) = BvhTracer::new(&loaded.mesh).bytes();
             hierarchy + geometry
         }
         _ => bail!("not a structure over triangles: {}", method.name()),
     };
-    let build_s = t.elapsed().as_secs_f64();
     eprintln!("  {}: rendering with {}", loaded.name, method.name());
     let render = time_method(loaded, method, opts, frames, pool)?.0;
+    // The render's set-up is the structure's build.
+    let build_s = render.setup_s;
     Ok(LargeStructure {
         structure: method.name().to_string(),
         bytes,
