@@ -12,12 +12,16 @@
 //! it lies that close to has only such edges around it), the ray crosses
 //! the surface there rather than touching its outline (moved sideways by
 //! `2·tol` in each of eight directions it still passes through a face
-//! around the hit triangle's vertices), and the method misses or hits
+//! around the hit triangle's vertices and meets it within 64·`tol` of the
+//! hit, so that a ray skimming a fold is not taken for one crossing it),
+//! and the method misses or hits
 //! something more than `2·tol` farther along than the reference hit. Leaks are failures, the worst a renderer can make: light
 //! passes through a watertight surface.
 //!
 //! Otherwise a ray counts as **ambiguous** (grazing), not wrong, when the
-//! reference hit point lies within `tol` of an edge of its triangle, a
+//! reference hit point lies within `tol` of an edge of its triangle (or
+//! the ray's line passes within `tol` of one: a ray nearly in the
+//! triangle's plane), a
 //! second triangle is hit within `tol` along the ray, the hit lies within
 //! `tol` of the ray origin, or the method's own hit point lies within
 //! `tol` of an edge of the triangle it reports; `tol = max(1e-5 · diagonal, 4e-7 · max |coordinate|)`
@@ -44,7 +48,8 @@ use tet_trace_cpu::Viewpoint;
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Failure, Hit, Ray, TraceOutcome};
 use tet_trace_cpu::reference::{
-    Aim, edge_distance, line_triangle, random_ray, ray_triangle, segment_distance,
+    Aim, edge_distance, line_edge_distance, line_triangle, random_ray, ray_triangle,
+    segment_distance,
 };
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Start;
@@ -170,6 +175,14 @@ impl EdgeSharing {
     }
 }
 
+/// How far from the reference hit (in units of the tolerance) the shifted
+/// rays of [`Reference::crosses`] may meet the surface and still count as
+/// crossing it there. A shift of `2·tol` moves the hit on a face met at
+/// angle θ by `2·tol·cot θ` along the ray: rays meeting the surface at
+/// more than about 2° are judged, shallower ones near an edge stay
+/// grazing.
+const CROSSING_WINDOW: f64 = 64.0;
+
 /// f64 reference over a padded-box BVH.
 pub struct Reference<'m> {
     /// The mesh whose constrained faces are tested.
@@ -274,7 +287,7 @@ impl<'m> Reference<'m> {
         let cf = &mesh.constrained[face as usize];
         let v = cf.vertices.map(|k| mesh.points[k as usize].as_dvec3());
         let p = ray.origin.as_dvec3() + ray.direction.as_dvec3() * t;
-        let near_edge = edge_distance(p, v) < self.tol;
+        let near_edge = self.near_edge(face, ray, p);
         Some(RefHit {
             face,
             triangle: cf.triangle,
@@ -283,18 +296,22 @@ impl<'m> Reference<'m> {
             near_edge,
             closed: near_edge
                 && self.sharing.grazed_closed(cf.vertices, v, p, self.tol)
-                && self.crosses(ray, cf.vertices),
+                && self.crosses(ray, cf.vertices, p),
             second_close: second - t < tol_t,
             near_origin: t < tol_t,
         })
     }
 
-    /// True when the ray crosses the surface around face `vertices` rather
-    /// than touching it: the ray moved sideways by `2·tol` in each of eight
-    /// directions still passes through a face around one of those vertices.
-    /// A ray that grazes the outline of a closed surface (both faces of the
-    /// edge on one side of it) fails this, and stays grazing.
-    fn crosses(&self, ray: &Ray, vertices: [u32; 3]) -> bool {
+    /// True when the ray crosses the surface around face `vertices` at the
+    /// hit point `x` rather than touching it: the ray moved sideways by
+    /// `2·tol` in each of eight directions still passes through a face
+    /// around one of those vertices, within [`CROSSING_WINDOW`]`·tol` of
+    /// `x`. A ray that grazes the outline of a closed surface (both faces
+    /// of the edge on one side of it) fails this, and stays grazing; so
+    /// does one that touches an edge and meets a face of the same ring
+    /// farther along (a ray skimming a fold), which a test of the whole
+    /// line would take for a crossing.
+    fn crosses(&self, ray: &Ray, vertices: [u32; 3], x: DVec3) -> bool {
         let o = ray.origin.as_dvec3();
         let d = ray.direction.as_dvec3();
         let (u, w) = d.normalize().any_orthonormal_pair();
@@ -310,15 +327,24 @@ impl<'m> Reference<'m> {
         (0..8).all(|k| {
             let a = k as f64 * std::f64::consts::FRAC_PI_4;
             let shifted = o + (u * a.cos() + w * a.sin()) * (2.0 * self.tol);
-            ring.iter().any(|&v| line_triangle(shifted, d, v).is_some())
+            ring.iter().any(|&v| {
+                line_triangle(shifted, d, v).is_some_and(|b| {
+                    let hit = v[0] * b[0] + v[1] * b[1] + v[2] * b[2];
+                    (hit - x).length() <= CROSSING_WINDOW * self.tol
+                })
+            })
         })
     }
 
-    /// True when point `p` lies within `tol` of an edge of constrained face `face`.
-    fn near_edge(&self, face: u32, p: DVec3) -> bool {
+    /// True when the hit point `p` of `ray` on constrained face `face`
+    /// lies within `tol` of an edge of the face, or the ray's line passes
+    /// within `tol` of one elsewhere (a ray nearly in the face's plane
+    /// grazes the face along its whole width).
+    fn near_edge(&self, face: u32, ray: &Ray, p: DVec3) -> bool {
         let cf = &self.mesh.constrained[face as usize];
         let v = cf.vertices.map(|k| self.mesh.points[k as usize].as_dvec3());
         edge_distance(p, v) < self.tol
+            || line_edge_distance(ray.origin.as_dvec3(), ray.direction.as_dvec3(), v) < self.tol
     }
 }
 
@@ -544,7 +570,7 @@ impl MethodAccuracy {
             let own_hit_grazes = |h: &Hit| {
                 let d = ray.direction.as_dvec3();
                 (h.t as f64).abs() * d.length() < reference.tol
-                    || reference.near_edge(h.face, ray.origin.as_dvec3() + d * h.t as f64)
+                    || reference.near_edge(h.face, ray, ray.origin.as_dvec3() + d * h.t as f64)
             };
             self.count(classify(o, e.as_ref(), own_hit_grazes));
         }
@@ -921,6 +947,101 @@ mod tests {
                 assert_eq!((m.leaks, m.ambiguous, m.failures), (0, n, 0), "{m:?}");
             }
         }
+    }
+
+    /// A closed step: the block [1, 3]×[1, 2]×[1, 2] with the block
+    /// [1, 2]×[1, 2]×[2, 3] on top of its left half, in a 5×3×5 grid. Its
+    /// top face at z = 2 meets the wall x = 2 of the upper block in a
+    /// concave edge.
+    fn closed_step() -> TetMesh {
+        let grid = kuhn_grid(&GridSpec {
+            cells: [5, 3, 5],
+            jitter: 0.0,
+            ..Default::default()
+        });
+        let solid = |c: Vec3| {
+            let lower = c.x > 1.0 && c.x < 3.0 && c.z > 1.0 && c.z < 2.0;
+            let upper = c.x > 1.0 && c.x < 2.0 && c.z > 2.0 && c.z < 3.0;
+            c.y > 1.0 && c.y < 2.0 && (lower || upper)
+        };
+        constrain_faces(
+            grid,
+            |v| {
+                // An axis-aligned face separates a cell of the solid from
+                // one outside it.
+                (0..3).any(|a| {
+                    let m = (v[0] + v[1] + v[2]) / 3.0;
+                    let e = Vec3::AXES[a] * 0.5;
+                    let cell = |p: Vec3| p.floor() + Vec3::splat(0.5);
+                    v.iter().all(|p| p[a] == v[0][a]) && solid(cell(m - e)) != solid(cell(m + e))
+                })
+            },
+            None,
+        )
+    }
+
+    #[test]
+    fn a_ray_clipping_a_convex_edge_before_a_wall_is_grazing() {
+        // The ray meets the top face of the step's lower block within
+        // tol/4 of its convex edge x = 3 and leaves through the side face
+        // at once: it clips the corner. The line behind it meets the wall
+        // x = 2, a face around a vertex of the hit triangle, which a test
+        // of the whole line took for a crossing (a leak).
+        let mesh = closed_step();
+        let reference = Reference::new(&mesh);
+        let delta = (reference.tol / 4.0) as f32;
+        let p = Vec3::new(3.0 - delta, 1.37, 2.0);
+        let clip = Vec3::new(1.0, 0.0, -0.5);
+        // Control: entering the block steeply at the same point crosses
+        // the surface there.
+        let enter = Vec3::new(-0.2, 0.0, -1.0);
+        let set = RaySet {
+            rays: [clip, enter]
+                .iter()
+                .map(|&d| (Ray::new(p - d * 0.5, d), Some(Start::Tet(0))))
+                .collect(),
+            view: None,
+        };
+        let exp = expected(&reference, &set);
+        let [Some(c), Some(e)] = [exp[0], exp[1]] else {
+            panic!("both rays hit the step: {exp:?}");
+        };
+        assert!(c.near_edge && !c.closed, "{c:?}");
+        assert!(e.near_edge && e.closed, "{e:?}");
+        let m = check(&AlwaysMiss(&mesh), "f32", &reference, &exp, &set, 0.0);
+        assert_eq!((m.leaks, m.ambiguous, m.failures), (1, 1, 1), "{m:?}");
+    }
+
+    #[test]
+    fn a_ray_nearly_in_a_face_plane_is_grazing() {
+        // The ray runs 1.3e-6 rad below the plane of the box's top face
+        // and crosses it 0.3 from every edge: its hit point is far from
+        // the edges, but its line passes within `tol` of them.
+        let mesh = closed_box();
+        let reference = Reference::new(&mesh);
+        let rise = 2f32.powi(-19);
+        let origin = Vec3::new(0.5, 1.37, 3.0 + rise);
+        let ray = Ray::new(origin, Vec3::new(1.0, 0.0, -rise / 1.8));
+        let hit = reference.closest(&ray).expect("the ray hits the top face");
+        let cf = &mesh.constrained[hit.face as usize];
+        let v = cf.vertices.map(|k| mesh.points[k as usize].as_dvec3());
+        let x = ray.origin.as_dvec3() + ray.direction.as_dvec3() * hit.t;
+        assert!((x.z - 3.0).abs() < 1e-9 && (x.x - 2.3).abs() < 1e-6, "{x}");
+        assert!(edge_distance(x, v) > 100.0 * reference.tol);
+        assert!(hit.near_edge && hit.ambiguous(), "{hit:?}");
+        let set = RaySet {
+            rays: vec![(ray, Some(Start::Tet(0)))],
+            view: None,
+        };
+        let m = check(
+            &AlwaysMiss(&mesh),
+            "f32",
+            &reference,
+            &[Some(hit)],
+            &set,
+            0.0,
+        );
+        assert_eq!((m.ambiguous, m.failures), (1, 0), "{m:?}");
     }
 
     #[test]

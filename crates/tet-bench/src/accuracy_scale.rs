@@ -24,12 +24,25 @@ pub const BATCH_RAYS: usize = 1 << 20;
 
 /// Step cap of the walks here (or the default cap where that is lower): a
 /// walk longer than this counts as
-/// [`tet_trace_cpu::ray::Failure::StepCap`]. A ray crosses each tet at most
-/// once, and no ray of the scenes here crosses more than a few thousand;
-/// the default cap (twice the tets, up to 2²⁴) would let every cycling
-/// walk of the faithful Tet80 and ScTP on adversarial rays run hundreds of
-/// thousands of steps before it is counted.
-pub const STEP_CAP: u32 = 1 << 16;
+/// [`tet_trace_cpu::ray::Failure::StepCap`]. A straight walk crosses each
+/// tet at most once, and a ray through `n` tets of about even size crosses
+/// on the order of `n^(1/3)` of them: the cap is 64 times that, at least
+/// [`MIN_STEP_CAP`] and at most [`MAX_STEP_CAP`]. The default cap (twice
+/// the tets, up to 2²⁴) would let every cycling walk of the faithful Tet80
+/// and ScTP on adversarial rays run hundreds of thousands of steps before
+/// it is counted, and those walks would take most of a 10⁸-ray run. A
+/// walk that never cycles (Tet20, the exact walk) reaching the cap would
+/// show in the table as a step cap.
+pub fn step_cap(tets: usize) -> u32 {
+    let cube_root = (tets as f64).cbrt();
+    ((64.0 * cube_root) as u32).clamp(MIN_STEP_CAP, MAX_STEP_CAP)
+}
+
+/// Lower bound of [`step_cap`].
+pub const MIN_STEP_CAP: u32 = 1 << 12;
+
+/// Upper bound of [`step_cap`].
+pub const MAX_STEP_CAP: u32 = 1 << 16;
 
 /// Side of the camera image of the first batch (Maria et al. count per
 /// 1024² image).
@@ -84,7 +97,7 @@ fn run_in_batches(
 ) -> Result<CaseAccuracy> {
     let mesh = &loaded.mesh;
     let reference = Reference::new(mesh);
-    let cap = Some(STEP_CAP.min(tet_trace_cpu::walk::step_cap(mesh)));
+    let cap = Some(step_cap(mesh.tets.len()).min(tet_trace_cpu::walk::step_cap(mesh)));
     let mut tracers = Vec::new();
     for &m in methods {
         for (f64, label) in variants(m, precision) {
@@ -252,5 +265,15 @@ mod tests {
         }
         // The first batch opened with the camera image.
         assert_eq!(batch_plan(true, 3_000).0, 54);
+    }
+
+    /// The cap grows with the cube root of the tets, within its bounds.
+    #[test]
+    fn the_step_cap_follows_the_mesh_size() {
+        assert_eq!(step_cap(0), MIN_STEP_CAP);
+        assert_eq!(step_cap(1000), MIN_STEP_CAP);
+        // 64 · 512 for 512³ tets (within the bounds).
+        assert_eq!(step_cap(512 * 512 * 512), 64 * 512);
+        assert_eq!(step_cap(usize::MAX), MAX_STEP_CAP);
     }
 }

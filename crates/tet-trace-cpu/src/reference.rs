@@ -55,6 +55,33 @@ pub fn edge_distance(p: DVec3, v: [DVec3; 3]) -> f64 {
         .min(segment_distance(p, v[2], v[0]))
 }
 
+/// Distance from the line `o + s·d` to segment `ab`: small when the line
+/// passes close to the segment anywhere, which for a ray nearly parallel to
+/// a triangle happens far from where it meets the triangle.
+pub fn line_segment_distance(o: DVec3, d: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let dd = d.length_squared();
+    // Components across the line: the distance of `a + u·(b − a)` to the
+    // line is `|pa + u·pe|`, a convex function of `u`.
+    let across = |v: DVec3| {
+        if dd > 0.0 { v - d * (v.dot(d) / dd) } else { v }
+    };
+    let (pa, pe) = (across(a - o), across(b - a));
+    let ee = pe.length_squared();
+    let u = if ee > 0.0 {
+        (-pa.dot(pe) / ee).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (pa + pe * u).length()
+}
+
+/// Distance from the line `o + s·d` to the nearest edge of triangle `v`.
+pub fn line_edge_distance(o: DVec3, d: DVec3, v: [DVec3; 3]) -> f64 {
+    line_segment_distance(o, d, v[0], v[1])
+        .min(line_segment_distance(o, d, v[1], v[2]))
+        .min(line_segment_distance(o, d, v[2], v[0]))
+}
+
 /// Where the line `o + s·d` passes through triangle `v` (closed), in f64:
 /// its barycentrics w.r.t. `v`, or `None` when the line misses the
 /// triangle or is parallel to it.
@@ -281,4 +308,45 @@ pub fn trace_from(
 ) -> Result<crate::TraceOutcome, crate::LocateError> {
     let start = crate::locate(tracer.mesh(), origin, 0)?;
     Ok(tracer.trace(&Ray::new(origin, direction), crate::Start::Tet(start)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The closed form against a dense sampling of the segment (each
+    /// sample's distance to the line by the cross product).
+    #[test]
+    fn line_segment_distance_matches_sampling() {
+        let mut rng = SplitMix64(7);
+        let mut coord = || rng.next_f64() * 4.0 - 2.0;
+        for _ in 0..200 {
+            let o = DVec3::new(coord(), coord(), coord());
+            let d = DVec3::new(coord(), coord(), coord());
+            let a = DVec3::new(coord(), coord(), coord());
+            // Every tenth segment parallel to the line.
+            let b = if coord() > 1.6 {
+                a + d * 0.7
+            } else {
+                DVec3::new(coord(), coord(), coord())
+            };
+            let sampled = (0..=4000)
+                .map(|k| {
+                    let p = a + (b - a) * (k as f64 / 4000.0);
+                    (p - o).cross(d).length() / d.length()
+                })
+                .fold(f64::INFINITY, f64::min);
+            let exact = line_segment_distance(o, d, a, b);
+            assert!(exact <= sampled + 1e-12, "{exact} > {sampled}");
+            assert!(
+                sampled - exact < 2e-3 * (b - a).length(),
+                "{exact} vs {sampled}"
+            );
+        }
+        // A line through a vertex of a triangle, in the triangle's plane.
+        let v = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let o = DVec3::new(-1.0, -1.0, 0.0);
+        assert!(line_edge_distance(o, DVec3::ONE.with_z(0.0), v) < 1e-15);
+        assert!((line_edge_distance(o, DVec3::Z, v) - 2f64.sqrt()).abs() < 1e-12);
+    }
 }
