@@ -61,9 +61,23 @@ pub struct BuildFlags {
     /// TetGen quality bound (radius-edge ratio, `-q`); off by default (`-pY` only).
     #[arg(long)]
     pub quality: Option<f64>,
+    /// Refine tets whose smallest dihedral angle is below this many
+    /// degrees (slivers; TetGen `-q<ratio>/<degrees>`), with or without
+    /// `--quality`.
+    #[arg(long, value_name = "DEGREES")]
+    pub min_dihedral: Option<f64>,
     /// Cap on Steiner points (`-S`).
     #[arg(long)]
     pub max_steiner: Option<u64>,
+    /// TetGen's mesh optimisation `LEVEL/SCHEME` (`-O`): up to 2^LEVEL − 1
+    /// passes (LEVEL 0 to 9) of flips (SCHEME bit 1), smoothing (2) and
+    /// vertex insertion/deletion (4). Default: TetGen's 2/7.
+    #[arg(long, value_name = "LEVEL/SCHEME", value_parser = parse_optimization)]
+    pub optimize: Option<tet_build::tetgen::Optimization>,
+    /// Dihedral angle in degrees above which TetGen's optimisation works on
+    /// a tet (`-o/`; TetGen's default 165).
+    #[arg(long, value_name = "DEGREES")]
+    pub max_dihedral: Option<f64>,
     /// Time limit for TetGen in seconds (the build runs in a worker process).
     #[arg(long, default_value_t = 600.0)]
     pub time_limit: f64,
@@ -831,4 +845,19 @@ impl IsoMethod {
             IsoMethod::WalkTet32 => "walk-tet32",
         }
     }
+}
+
+/// Parses `--optimize LEVEL/SCHEME` (`7/7`; a bare `LEVEL` keeps scheme 7).
+fn parse_optimization(s: &str) -> Result<tet_build::tetgen::Optimization, String> {
+    let (level, scheme) = s.split_once('/').unwrap_or((s, "7"));
+    let digit = |x: &str, max: u8, what: &str| {
+        x.parse::<u8>()
+            .ok()
+            .filter(|v| *v <= max)
+            .ok_or_else(|| format!("{what} `{x}` is not a number from 0 to {max}"))
+    };
+    Ok(tet_build::tetgen::Optimization {
+        level: digit(level, 9, "level")?,
+        scheme: digit(scheme, 7, "scheme")?,
+    })
 }

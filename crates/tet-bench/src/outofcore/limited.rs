@@ -311,6 +311,9 @@ impl Limited<'_> {
             tetgen: TetgenOptions {
                 quality: flags.quality,
                 max_steiner: flags.max_steiner,
+                min_dihedral: flags.min_dihedral.or(TetgenOptions::default().min_dihedral),
+                optimization: flags.optimize.or(TetgenOptions::default().optimization),
+                max_dihedral: flags.max_dihedral.or(TetgenOptions::default().max_dihedral),
                 ..TetgenOptions::default()
             },
             isolation: crate::load::worker_isolation(flags.time_limit)?,

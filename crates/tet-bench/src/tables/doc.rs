@@ -69,6 +69,9 @@ pub struct SceneResult {
     /// The build trade (full mode only): the same scene built with the
     /// quality bound `-q5`, and tet20 on it.
     pub quality5: Option<QualityTrade>,
+    /// Full mode: the scene built with slivers bounded
+    /// (`--min-dihedral 2`) and tet20 on it.
+    pub min_dihedral2: Option<QualityTrade>,
     /// Out-of-core builds under ½ and ⅓ of the in-core peak (full mode,
     /// first scene of each geometry only).
     pub out_of_core: Vec<OutOfCoreRow>,
@@ -168,7 +171,10 @@ pub struct TablesDoc {
 /// TetGen `-pY` in a box, Hilbert order, the default time limit.
 pub const TABLE_FLAGS: BuildFlags = BuildFlags {
     quality: None,
+    min_dihedral: None,
     max_steiner: None,
+    optimize: None,
+    max_dihedral: None,
     time_limit: 600.0,
     no_box: false,
     wide_box: false,

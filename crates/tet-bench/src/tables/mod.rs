@@ -107,10 +107,18 @@ fn measure_scene(
     let unsorted_tet20 = Some(sorting::measure(planned, cache, opts, frames, pool)?);
     let wide_box_tet20 = Some(entry::measure(planned, cache, opts, frames, pool)?);
     let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames);
-    let quality5 = if args.quick {
-        None
+    let (quality5, min_dihedral2) = if args.quick {
+        (None, None)
     } else {
-        Some(quality::measure(planned, cache, opts, frames, pool)?)
+        let mut trade =
+            |flags, label| quality::measure(planned, cache, opts, frames, pool, flags, label);
+        (
+            Some(trade(&quality::QUALITY5, "quality-refined (-q5)")?),
+            Some(trade(
+                &quality::MIN_DIHEDRAL2,
+                "slivers-bounded (--min-dihedral 2)",
+            )?),
+        )
     };
     let out_of_core = if args.quick || !planned.first {
         Vec::new()
@@ -120,6 +128,7 @@ fn measure_scene(
     Ok(SceneResult {
         ray_strips,
         quality5,
+        min_dihedral2,
         out_of_core,
         shares_mesh_with: planned.shares_with.clone(),
         mesh_reused,
@@ -192,6 +201,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
                     gpu_renders: Vec::new(),
                     gpu_note: None,
                     quality5: None,
+                    min_dihedral2: None,
                     out_of_core: Vec::new(),
                     shares_mesh_with: planned.shares_with.clone(),
                     mesh_reused: false,

@@ -40,7 +40,7 @@ pub mod worker;
 
 pub use check::check_input;
 pub use error::TetgenError;
-pub use types::{Isolation, TetgenInput, TetgenOptions, TetgenOutput, WorkerCommand};
+pub use types::{Isolation, Optimization, TetgenInput, TetgenOptions, TetgenOutput, WorkerCommand};
 
 /// Tetrahedralizes `input` where `isolation` says.
 pub fn tetrahedralize(

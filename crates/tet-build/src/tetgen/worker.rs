@@ -45,7 +45,7 @@ use std::time::{Duration, Instant};
 use super::check::check_input;
 use super::error::TetgenError;
 use super::in_process::run_in_process;
-use super::types::{TetgenInput, TetgenOptions, TetgenOutput, WorkerCommand};
+use super::types::{Optimization, TetgenInput, TetgenOptions, TetgenOutput, WorkerCommand};
 
 const REQUEST_MAGIC: &[u8; 8] = b"TETREQ01";
 const REPLY_MAGIC: &[u8; 8] = b"TETRES02";
@@ -238,9 +238,35 @@ fn parse_switches(s: &str) -> Option<TetgenOptions> {
             b'c' => o.keep_convex_hull = true,
             b'n' if o.neighbors => o.face_tets = true,
             b'n' => o.neighbors = true,
-            b'q' => o.quality = Some(number(&mut i).parse().ok()?),
+            b'q' => {
+                let q: f64 = number(&mut i).parse().ok()?;
+                if b.get(i) == Some(&b'/') {
+                    i += 1;
+                    o.min_dihedral = Some(number(&mut i).parse().ok()?);
+                    o.quality = (q != super::types::NO_RATIO).then_some(q);
+                } else {
+                    o.quality = Some(q);
+                }
+            }
             b'S' => o.max_steiner = Some(number(&mut i).parse().ok()?),
             b'T' => o.coplanar_tolerance = Some(number(&mut i).parse().ok()?),
+            b'O' => {
+                let digit = |i: &mut usize| {
+                    let d = b.get(*i).filter(|c| c.is_ascii_digit())?;
+                    *i += 1;
+                    Some(d - b'0')
+                };
+                let level = digit(&mut i)?;
+                (b.get(i) == Some(&b'/')).then_some(())?;
+                i += 1;
+                let scheme = digit(&mut i)?;
+                o.optimization = Some(Optimization { level, scheme });
+            }
+            b'o' => {
+                (b.get(i) == Some(&b'/')).then_some(())?;
+                i += 1;
+                o.max_dihedral = Some(number(&mut i).parse().ok()?);
+            }
             _ => return None,
         }
     }
@@ -537,6 +563,21 @@ mod tests {
                 face_tets: false,
                 keep_convex_hull: false,
                 preserve_surface: false,
+                optimization: Some(Optimization {
+                    level: 7,
+                    scheme: 3,
+                }),
+                max_dihedral: Some(140.5),
+                min_dihedral: None,
+            },
+            TetgenOptions {
+                quality: Some(4.0),
+                min_dihedral: Some(8.5),
+                ..TetgenOptions::default()
+            },
+            TetgenOptions {
+                min_dihedral: Some(10.0),
+                ..TetgenOptions::default()
             },
             TetgenOptions {
                 neighbors: true,
@@ -548,6 +589,7 @@ mod tests {
             assert_eq!(parse_switches(&o.switches()), Some(o));
         }
         assert_eq!(parse_switches("pYczQx"), None);
+        assert_eq!(parse_switches("pYczO7zQ"), None);
     }
 
     #[test]

@@ -55,6 +55,9 @@ pub fn plan(args: &BuildArgs, dir: &Path, json: bool) -> Result<()> {
             tetgen: TetgenOptions {
                 quality: flags.quality,
                 max_steiner: flags.max_steiner,
+                min_dihedral: flags.min_dihedral.or(TetgenOptions::default().min_dihedral),
+                optimization: flags.optimize.or(TetgenOptions::default().optimization),
+                max_dihedral: flags.max_dihedral.or(TetgenOptions::default().max_dihedral),
                 ..TetgenOptions::default()
             },
             resolve: (!flags.no_resolve).then(Default::default),

@@ -76,6 +76,14 @@ pub struct BuildRecord {
     pub quality: Option<f64>,
     /// TetGen `-S` cap, if any.
     pub max_steiner: Option<u64>,
+    /// TetGen `-O` optimisation, when not TetGen's default (absent in
+    /// files written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub optimization: Option<crate::tetgen::Optimization>,
+    /// TetGen `-o/` dihedral bound of the optimisation, when not its
+    /// default (absent in files written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_dihedral: Option<f64>,
     /// Seconds one part's TetGen worker may run.
     pub time_limit_s: f64,
     /// Hilbert-sort each part on its own before writing it.

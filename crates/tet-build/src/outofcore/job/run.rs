@@ -173,6 +173,14 @@ fn build(
         tetgen: TetgenOptions {
             quality: job.build.quality,
             max_steiner: job.build.max_steiner,
+            optimization: job
+                .build
+                .optimization
+                .or(TetgenOptions::default().optimization),
+            max_dihedral: job
+                .build
+                .max_dihedral
+                .or(TetgenOptions::default().max_dihedral),
             ..TetgenOptions::default()
         },
         isolation: isolation.clone(),
