@@ -70,7 +70,7 @@ pub(crate) fn strips(data: &StripData) -> Vec<StripView> {
             let mut nodes = Vec::new();
             collect(data, &layout, 0, 0, layout.n, &mut nodes);
             StripView {
-                bounds: (Vec3::from(leaf.min), Vec3::from(leaf.max)),
+                bounds: (Vec3::from(leaf.min()), Vec3::from(leaf.max())),
                 vertices,
                 triangles: words
                     .iter()

@@ -55,6 +55,8 @@
 //! the lower child's box is the parent's with `max[axis] = lo`, the upper
 //! child's the parent's with `min[axis] = hi`.
 
+use glam::{Vec3, Vec3A, Vec4};
+
 /// Node-flag bit: the second strip part is the lower child.
 pub(crate) const REVERSE: u8 = 4;
 
@@ -155,34 +157,66 @@ impl BlockLayout {
 /// Flag on [`BvhNode::b`] marking a leaf.
 pub(crate) const LEAF: u32 = 1 << 31;
 
-/// A high-level BVH node (32 bytes). Inner: first child at `self + 1`,
-/// second child at `a`, `b` = split axis (children are visited first-child
-/// first when the ray's direction along that axis is `≥ 0`). Leaf:
-/// `a` = word offset of its first strip block, `b = LEAF | count` for
-/// `count` consecutive blocks.
+/// A high-level BVH node (32 bytes): two 16-byte vectors, box minimum
+/// and maximum in `xyz`, and in the `w` lanes (as `f32` bits) two words
+/// `a` and `b`, so that a box test loads two aligned vectors. Inner: first
+/// child at `self + 1`, second child at `a`, `b` = split axis (children are
+/// visited first-child first when the ray's direction along that axis is
+/// `≥ 0`). Leaf: `a` = word offset of its first strip block,
+/// `b = LEAF | count` for `count` consecutive blocks.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct BvhNode {
-    /// Box minimum.
-    pub min: [f32; 3],
-    /// Box maximum.
-    pub max: [f32; 3],
+    /// Box minimum and `a`.
+    pub lo: Vec4,
+    /// Box maximum and `b`.
+    pub hi: Vec4,
+}
+
+impl BvhNode {
+    /// A node over the box `[min, max]` with words `a` and `b`.
+    pub fn new(min: Vec3, max: Vec3, a: u32, b: u32) -> Self {
+        Self {
+            lo: min.extend(f32::from_bits(a)),
+            hi: max.extend(f32::from_bits(b)),
+        }
+    }
+
     /// Second child (inner) or strip block offset (leaf).
-    pub a: u32,
-    /// Split axis (inner) or [`LEAF`].
-    pub b: u32,
+    #[inline(always)]
+    pub fn a(&self) -> u32 {
+        self.lo.w.to_bits()
+    }
+
+    /// Split axis (inner) or [`LEAF`]` | count`.
+    #[inline(always)]
+    pub fn b(&self) -> u32 {
+        self.hi.w.to_bits()
+    }
+
+    /// Box minimum.
+    #[inline(always)]
+    pub fn min(&self) -> Vec3A {
+        Vec3A::from_vec4(self.lo)
+    }
+
+    /// Box maximum.
+    #[inline(always)]
+    pub fn max(&self) -> Vec3A {
+        Vec3A::from_vec4(self.hi)
+    }
 }
 
 /// The strip blocks of a leaf node: `(offset, count)` (meaningful only
 /// for leaves).
 #[inline(always)]
 pub(crate) fn leaf_blocks(node: &BvhNode) -> (usize, u32) {
-    (node.a as usize, node.b & !LEAF)
+    (node.a() as usize, node.b() & !LEAF)
 }
 
 /// Whether a BVH node is a leaf.
 #[inline(always)]
 pub(crate) fn is_leaf(node: &BvhNode) -> bool {
-    node.b & LEAF != 0
+    node.b() & LEAF != 0
 }
 
 /// Everything traversal reads.

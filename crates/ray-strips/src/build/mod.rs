@@ -131,12 +131,7 @@ impl Builder<'_> {
     ) {
         let (lo, hi) = bounds(items);
         let at = self.data.nodes.len();
-        self.data.nodes.push(BvhNode {
-            min: lo.to_array(),
-            max: hi.to_array(),
-            a: 0,
-            b: 0,
-        });
+        self.data.nodes.push(BvhNode::new(lo, hi, 0, 0));
         let (mid, axis) = if depth < SAH_MAX_DEPTH {
             split(items)
         } else {
@@ -146,8 +141,7 @@ impl Builder<'_> {
         child(self, first, depth + 1);
         let second_at = self.data.nodes.len() as u32;
         child(self, second, depth + 1);
-        self.data.nodes[at].a = second_at;
-        self.data.nodes[at].b = axis as u32;
+        self.data.nodes[at] = BvhNode::new(lo, hi, second_at, axis as u32);
     }
 
     /// Stripifies one chunk and builds its strip leaves.
@@ -190,12 +184,9 @@ impl Builder<'_> {
                 lo = lo.min(a);
                 hi = hi.max(b);
             }
-            self.data.nodes.push(BvhNode {
-                min: lo.to_array(),
-                max: hi.to_array(),
-                a: offset,
-                b: LEAF | items.len() as u32,
-            });
+            self.data
+                .nodes
+                .push(BvhNode::new(lo, hi, offset, LEAF | items.len() as u32));
             return;
         }
         self.inner(items, depth, |b, part, d| {

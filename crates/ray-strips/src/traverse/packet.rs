@@ -87,7 +87,7 @@ pub(crate) fn trace_packet(
         let mut dmin = [0.0f32; LANES];
         let mut dmax = [0.0f32; LANES];
         for l in lanes(mask) {
-            if let Some((tn, tf)) = rays[l].box_interval(&node.min, &node.max, best[l].t) {
+            if let Some((tn, tf)) = rays[l].box_interval(node, best[l].t) {
                 active |= 1 << l;
                 dmin[l] = tn;
                 dmax[l] = tf;
@@ -118,8 +118,8 @@ pub(crate) fn trace_packet(
                 offset += strip_words(layout.n as usize);
             }
         } else {
-            let (first, second) = (i + 1, node.a);
-            let (near, far) = if forward(node.b as usize) {
+            let (first, second) = (i + 1, node.a());
+            let (near, far) = if forward(node.b() as usize) {
                 (first, second)
             } else {
                 (second, first)

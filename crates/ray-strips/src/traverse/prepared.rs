@@ -1,6 +1,9 @@
 //! A ray prepared once for traversal: reciprocal direction for the box and
 //! plane distances, and the shear of Woop et al.'s watertight test.
 
+use glam::Vec3A;
+
+use crate::layout::BvhNode;
 use crate::ray::Ray;
 
 /// Relative slack applied to every computed box or plane distance so that
@@ -49,6 +52,10 @@ pub(crate) struct Prepared {
     pub k: [usize; 3],
     /// Woop's shear constants `Sx, Sy, Sz`.
     pub shear: [f32; 3],
+    /// `org` as a vector (box tests).
+    pub org_a: Vec3A,
+    /// `inv` as a vector (box tests).
+    pub inv_a: Vec3A,
     /// Whether some direction component is zero (slab tests then need the
     /// careful path).
     pub parallel: bool,
@@ -79,6 +86,8 @@ impl Prepared {
             org: ray.origin.to_array(),
             dir,
             inv: dir.map(|d| 1.0 / d),
+            org_a: Vec3A::from(ray.origin),
+            inv_a: Vec3A::from(dir.map(|d| 1.0 / d)),
             t_min: ray.t_min,
             k: [kx, ky, kz],
             shear: [dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]],
@@ -96,24 +105,17 @@ impl Prepared {
     /// Conservative `[t_near, t_far]` of the box within `[t_min, t_max]`,
     /// `None` when empty.
     #[inline(always)]
-    pub fn box_interval(&self, min: &[f32; 3], max: &[f32; 3], t_max: f32) -> Option<(f32, f32)> {
+    pub fn box_interval(&self, node: &BvhNode, t_max: f32) -> Option<(f32, f32)> {
+        let (min, max) = (node.min(), node.max());
         if !self.parallel {
             // No direction component is zero: every slab distance is a
-            // number, and `down`/`up` are monotonic, so the slack is applied
-            // once to the combined ends.
-            let mut tn = f32::NEG_INFINITY;
-            let mut tf = f32::INFINITY;
-            for a in 0..3 {
-                let t0 = (min[a] - self.org[a]) * self.inv[a];
-                let t1 = (max[a] - self.org[a]) * self.inv[a];
-                let (near, far) = if self.inv[a] >= 0.0 {
-                    (t0, t1)
-                } else {
-                    (t1, t0)
-                };
-                tn = fmax(tn, near);
-                tf = fmin(tf, far);
-            }
+            // number (the same IEEE operations per lane as a scalar loop),
+            // and `down`/`up` are monotonic, so the slack is applied once
+            // to the combined ends.
+            let t0 = (min - self.org_a) * self.inv_a;
+            let t1 = (max - self.org_a) * self.inv_a;
+            let tn = t0.min(t1).max_element();
+            let tf = t0.max(t1).min_element();
             let tn = fmax(self.t_min, down(tn));
             let tf = fmin(t_max, up(tf));
             return (tn <= tf).then_some((tn, tf));

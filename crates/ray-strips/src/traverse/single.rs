@@ -139,7 +139,7 @@ pub(crate) fn trace_from(
         sp -= 1;
         let i = stack[sp] as usize;
         let node = &data.nodes[i];
-        let Some((tn, tf)) = ray.box_interval(&node.min, &node.max, best.t) else {
+        let Some((tn, tf)) = ray.box_interval(node, best.t) else {
             continue;
         };
         if is_leaf(node) {
@@ -157,8 +157,8 @@ pub(crate) fn trace_from(
                 offset += strip_words(layout.n as usize);
             }
         } else {
-            let (first, second) = (i as u32 + 1, node.a);
-            let (near, far) = if ray.forward(node.b as usize) {
+            let (first, second) = (i as u32 + 1, node.a());
+            let (near, far) = if ray.forward(node.b() as usize) {
                 (first, second)
             } else {
                 (second, first)
