@@ -40,20 +40,42 @@ pub(crate) fn intersect_leaf(
     ray: &Prepared,
     best: &mut Best,
 ) -> bool {
-    let m = m as usize;
-    debug_assert!(m <= MAX_LEAF);
+    debug_assert!(m as usize <= MAX_LEAF);
+    // One copy per leaf size, so that the loops unroll and the ray-space
+    // vertices stay in registers.
+    match m {
+        2 => leaf::<2>(data, layout, t0, ray, best),
+        3 => leaf::<3>(data, layout, t0, ray, best),
+        _ => leaf::<1>(data, layout, t0, ray, best),
+    }
+}
+
+/// [`intersect_leaf`] for `M` triangles.
+#[inline(always)]
+fn leaf<const M: usize>(
+    data: &StripData,
+    layout: &BlockLayout,
+    t0: u32,
+    ray: &Prepared,
+    best: &mut Best,
+) -> bool {
+    let m = M;
     let [kx, ky, kz] = ray.k;
     let [sx, sy, sz] = ray.shear;
+    let [ox, oy, oz] = [ray.org[kx], ray.org[ky], ray.org[kz]];
     let mut x = [0.0f32; MAX_LEAF + 2];
     let mut y = [0.0f32; MAX_LEAF + 2];
     let mut z = [0.0f32; MAX_LEAF + 2];
     let first = layout.indices + t0 as usize;
-    for j in 0..m + 2 {
-        let v = data.vertices[data.words[first + j] as usize];
-        let p = [v[0] - ray.org[0], v[1] - ray.org[1], v[2] - ray.org[2]];
-        x[j] = p[kx] - sx * p[kz];
-        y[j] = p[ky] - sy * p[kz];
-        z[j] = sz * p[kz];
+    let indices = &data.words[first..first + M + 2];
+    for j in 0..M + 2 {
+        // The same operations as translating all three coordinates and
+        // then permuting: `p[k] = v[k] − org[k]`.
+        let v = &data.vertices[indices[j] as usize];
+        let pz = v[kz] - oz;
+        x[j] = (v[kx] - ox) - sx * pz;
+        y[j] = (v[ky] - oy) - sy * pz;
+        z[j] = sz * pz;
     }
     let edge = |p: usize, q: usize| x[q] * y[p] - y[q] * x[p];
     let edge64 = |p: usize, q: usize| {
