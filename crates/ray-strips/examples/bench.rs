@@ -6,7 +6,7 @@
 //! command line. Prints bytes, strip statistics and single-ray
 //! throughput (this thread's CPU time, best of 5).
 //!
-//! `cargo run --release -p ray-strips --example bench [-- CHUNK STRIPS_PER_LEAF]`
+//! `cargo run --release -p ray-strips --example bench [-- CHUNK STRIPS_PER_LEAF [SWAPS: 0 or 1]]`
 
 use std::time::Instant;
 
@@ -189,6 +189,7 @@ fn main() {
         o.chunk_triangles = c;
         o.strips_per_leaf = s;
     }
+    o.strip_swaps = args.get(2) == Some(&1);
     let only = std::env::var("SCENE").unwrap_or_default();
     if only != "knots" {
         let (v, f) = load_obj(BUNNY).expect("the bunny");

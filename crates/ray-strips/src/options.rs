@@ -43,8 +43,8 @@ impl Default for BuildOptions {
     /// instructions per ray.
     fn default() -> Self {
         Self {
-            chunk_triangles: 128,
-            strips_per_leaf: 1,
+            chunk_triangles: 36,
+            strips_per_leaf: 16,
             strip_swaps: false,
         }
     }

@@ -24,7 +24,7 @@
 //! in which triangles are tested.
 
 use crate::layout::{BlockLayout, PERMUTATION_BITS, PERMUTATIONS, SWAP_WORD, StripData};
-use crate::traverse::prepared::{Best, Prepared};
+use crate::traverse::prepared::{Best, Prepared, fmax, fmin};
 
 /// Largest leaf (in triangles) of a strip hierarchy.
 const MAX_LEAF: usize = 3;
@@ -65,17 +65,16 @@ fn leaf<const M: usize>(
     let [ox, oy, oz] = [ray.org[kx], ray.org[ky], ray.org[kz]];
     let mut x = [0.0f32; MAX_LEAF + 2];
     let mut y = [0.0f32; MAX_LEAF + 2];
-    let mut z = [0.0f32; MAX_LEAF + 2];
+    let mut pz = [0.0f32; MAX_LEAF + 2];
     let first = layout.indices + t0 as usize;
     let indices = &data.words[first..first + M + 2];
     for j in 0..M + 2 {
         // The same operations as translating all three coordinates and
         // then permuting: `p[k] = v[k] − org[k]`.
         let v = &data.vertices[indices[j] as usize];
-        let pz = v[kz] - oz;
-        x[j] = (v[kx] - ox) - sx * pz;
-        y[j] = (v[ky] - oy) - sy * pz;
-        z[j] = sz * pz;
+        pz[j] = v[kz] - oz;
+        x[j] = (v[kx] - ox) - sx * pz[j];
+        y[j] = (v[ky] - oy) - sy * pz[j];
     }
     let edge = |p: usize, q: usize| x[q] * y[p] - y[q] * x[p];
     let edge64 = |p: usize, q: usize| {
@@ -94,14 +93,17 @@ fn leaf<const M: usize>(
             v = edge64(j + 2, j);
             w = edge64(j, j + 1);
         }
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        // Mixed signs (some < 0 and some > 0): outside.
+        if fmin(fmin(u, v), w) < 0.0 && fmax(fmax(u, v), w) > 0.0 {
             continue;
         }
         let det = u + v + w;
         if det == 0.0 {
             continue;
         }
-        let t = (u * z[j] + v * z[j + 1] + w * z[j + 2]) / det;
+        // Woop's scaled z, needed only here: `z = Sz · p[kz]`.
+        let z = |i: usize| sz * pz[i];
+        let t = (u * z(j) + v * z(j + 1) + w * z(j + 2)) / det;
         if !(t >= ray.t_min && t <= best.t) {
             continue;
         }
