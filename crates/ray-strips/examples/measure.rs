@@ -152,6 +152,7 @@ fn measure(name: &str, positions: &[Vec3], triangles: &[[u32; 3]]) {
         .map(|&c| (c, 1, false))
         .collect();
     configs.extend([
+        (36, 16, false),
         (64, 4, false),
         (128, 4, false),
         (256, 4, false),
