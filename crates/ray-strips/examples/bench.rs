@@ -13,34 +13,12 @@ use std::time::Instant;
 use glam::Vec3;
 use ray_strips::{BuildOptions, Ray, RayStrips};
 
+mod common;
+use common::load_obj;
 const BUNNY: &str = "/work/shared/scenes/stanford-bunny.obj";
 
-fn load_obj(path: &str) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let mut v = Vec::new();
-    let mut f = Vec::new();
-    for line in text.lines() {
-        let mut w = line.split_whitespace();
-        match w.next() {
-            Some("v") => {
-                let c: Vec<f32> = w.take(3).filter_map(|s| s.parse().ok()).collect();
-                v.push(Vec3::new(c[0], c[1], c[2]));
-            }
-            Some("f") => {
-                let idx: Vec<u32> = w
-                    .filter_map(|s| s.split('/').next()?.parse::<i64>().ok())
-                    .map(|i| if i < 0 { v.len() as i64 + i } else { i - 1 } as u32)
-                    .collect();
-                for k in 1..idx.len().saturating_sub(1) {
-                    f.push([idx[0], idx[k], idx[k + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    Some((v, f))
-}
-
+/// The Torus Knots scene: a copy of `tet_build::procedural::torus_knot` on
+/// its grid, kept here so that this crate does not depend on the tet crates.
 fn torus_knots() -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let (segments, sides) = (120u32, 12u32);
     let (p, q, c, k, r) = (2.0f64, 3.0f64, 0.91555f64, 5.0 / 11.0, 0.40711f64);

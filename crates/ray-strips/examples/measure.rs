@@ -13,6 +13,8 @@ use std::time::Instant;
 use glam::Vec3;
 use ray_strips::{BuildOptions, Hit, Ray, RayStrips};
 
+mod common;
+use common::load_obj;
 const RES: usize = 512;
 /// Timed runs per measurement (the best counts).
 const RUNS: usize = 5;
@@ -54,34 +56,6 @@ fn bumpy_sphere(rings: u32, segments: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
         }
     }
     (v, f)
-}
-
-/// Minimal OBJ reader: `v x y z` and `f a b c …` (fans; `a/b/c` and
-/// negative indices accepted).
-fn load_obj(path: &str) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let mut v = Vec::new();
-    let mut f = Vec::new();
-    for line in text.lines() {
-        let mut w = line.split_whitespace();
-        match w.next() {
-            Some("v") => {
-                let c: Vec<f32> = w.take(3).filter_map(|s| s.parse().ok()).collect();
-                v.push(Vec3::new(c[0], c[1], c[2]));
-            }
-            Some("f") => {
-                let idx: Vec<u32> = w
-                    .filter_map(|s| s.split('/').next()?.parse::<i64>().ok())
-                    .map(|i| if i < 0 { v.len() as i64 + i } else { i - 1 } as u32)
-                    .collect();
-                for k in 1..idx.len().saturating_sub(1) {
-                    f.push([idx[0], idx[k], idx[k + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    Some((v, f))
 }
 
 /// Primary rays of a camera framing the mesh's box, in 2×2 pixel blocks.
