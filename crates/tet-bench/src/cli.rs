@@ -847,6 +847,23 @@ impl IsoMethod {
     }
 }
 
+impl BuildFlags {
+    /// The TetGen options these flags ask for: every TetGen flag given
+    /// replaces its default, the rest keep [`TetgenOptions::default`]. The
+    /// one mapping for in-core, out-of-core and job builds.
+    pub fn tetgen_options(&self) -> tet_build::tetgen::TetgenOptions {
+        let d = tet_build::tetgen::TetgenOptions::default();
+        tet_build::tetgen::TetgenOptions {
+            quality: self.quality,
+            max_steiner: self.max_steiner,
+            min_dihedral: self.min_dihedral.or(d.min_dihedral),
+            optimization: self.optimize.or(d.optimization),
+            max_dihedral: self.max_dihedral.or(d.max_dihedral),
+            ..d
+        }
+    }
+}
+
 /// Parses `--optimize LEVEL/SCHEME` (`7/7`; a bare `LEVEL` keeps scheme 7).
 fn parse_optimization(s: &str) -> Result<tet_build::tetgen::Optimization, String> {
     let (level, scheme) = s.split_once('/').unwrap_or((s, "7"));

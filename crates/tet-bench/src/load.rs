@@ -236,11 +236,7 @@ pub fn build_scene_in(
     if flags.no_resolve {
         options.resolve = None;
     }
-    options.tetgen.quality = flags.quality;
-    options.tetgen.max_steiner = flags.max_steiner;
-    options.tetgen.min_dihedral = flags.min_dihedral.or(options.tetgen.min_dihedral);
-    options.tetgen.optimization = flags.optimize.or(options.tetgen.optimization);
-    options.tetgen.max_dihedral = flags.max_dihedral.or(options.tetgen.max_dihedral);
+    options.tetgen = flags.tetgen_options();
     if !flags.no_sort {
         // Hilbert order inside the pipeline: parallel, one gather per array.
         options.reorder = tet_build::pipeline::Reorder::Hilbert;

@@ -204,3 +204,49 @@ fn broken_parts_are_named_and_rebuilt_alone() {
     merge_job(&jobdir, &job, &out).unwrap();
     assert_eq!(std::fs::read(&out).unwrap(), reference);
 }
+
+/// Every TetGen option of the plan reaches the job file and comes back
+/// from it, so that parts built from the file are built as planned.
+#[test]
+fn the_plan_records_every_tetgen_option() {
+    use tet_build::tetgen::{Optimization, TetgenOptions};
+    let scene = knot_grid(1, 60, 8);
+    let dir = tempfile::tempdir().unwrap();
+    let tetgen = TetgenOptions {
+        quality: Some(4.0),
+        max_steiner: Some(5000),
+        min_dihedral: Some(2.0),
+        optimization: Some(Optimization {
+            level: 3,
+            scheme: 1,
+        }),
+        max_dihedral: Some(150.0),
+        ..TetgenOptions::default()
+    };
+    let options = PlanOptions {
+        parts: 2,
+        seam: SeamOptions {
+            tetgen: tetgen.clone(),
+            ..SeamOptions::default()
+        },
+        ..PlanOptions::default()
+    };
+    plan_job(&scene, &options, dir.path()).unwrap();
+    let b = JobManifest::load(dir.path()).unwrap().build;
+    assert_eq!(
+        (
+            b.quality,
+            b.max_steiner,
+            b.min_dihedral,
+            b.optimization,
+            b.max_dihedral
+        ),
+        (
+            tetgen.quality,
+            tetgen.max_steiner,
+            tetgen.min_dihedral,
+            tetgen.optimization,
+            tetgen.max_dihedral
+        )
+    );
+}

@@ -17,7 +17,6 @@ use tet_build::outofcore::stream::{StreamOptions, StreamSummary};
 use tet_build::outofcore::tree::{
     CutTree, TreePlan, build_tree_with_memory_limit, build_tree_with_memory_limit_to_file,
 };
-use tet_build::tetgen::TetgenOptions;
 use tet_core::TetMesh;
 use tet_core::scene::SceneInfo;
 
@@ -308,14 +307,7 @@ impl Limited<'_> {
         let (split, parallel) = chosen;
         let options = SeamOptions {
             enclosing_box: box_spec,
-            tetgen: TetgenOptions {
-                quality: flags.quality,
-                max_steiner: flags.max_steiner,
-                min_dihedral: flags.min_dihedral.or(TetgenOptions::default().min_dihedral),
-                optimization: flags.optimize.or(TetgenOptions::default().optimization),
-                max_dihedral: flags.max_dihedral.or(TetgenOptions::default().max_dihedral),
-                ..TetgenOptions::default()
-            },
+            tetgen: flags.tetgen_options(),
             isolation: crate::load::worker_isolation(flags.time_limit)?,
             parallel_parts: parallel,
             resolve: (!flags.no_resolve).then(Default::default),

@@ -7,7 +7,6 @@ use serde::Serialize;
 use tet_build::outofcore::job::manifest::Partition;
 use tet_build::outofcore::job::{PlanOptions, Planner, plan_job};
 use tet_build::outofcore::seam::SeamOptions;
-use tet_build::tetgen::TetgenOptions;
 use tet_core::scene::SceneInfo;
 
 use crate::cli::{BuildArgs, Planner as CliPlanner};
@@ -52,14 +51,7 @@ pub fn plan(args: &BuildArgs, dir: &Path, json: bool) -> Result<()> {
     let options = PlanOptions {
         seam: SeamOptions {
             enclosing_box: crate::load::enclosing_box(&scene, &[], flags.wide_box),
-            tetgen: TetgenOptions {
-                quality: flags.quality,
-                max_steiner: flags.max_steiner,
-                min_dihedral: flags.min_dihedral.or(TetgenOptions::default().min_dihedral),
-                optimization: flags.optimize.or(TetgenOptions::default().optimization),
-                max_dihedral: flags.max_dihedral.or(TetgenOptions::default().max_dihedral),
-                ..TetgenOptions::default()
-            },
+            tetgen: flags.tetgen_options(),
             resolve: (!flags.no_resolve).then(Default::default),
             ..SeamOptions::default()
         },

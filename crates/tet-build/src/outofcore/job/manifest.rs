@@ -76,6 +76,10 @@ pub struct BuildRecord {
     pub quality: Option<f64>,
     /// TetGen `-S` cap, if any.
     pub max_steiner: Option<u64>,
+    /// TetGen `-q<ratio>/<degrees>` sliver bound, if any (absent in files
+    /// written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_dihedral: Option<f64>,
     /// TetGen `-O` optimisation, when not TetGen's default (absent in
     /// files written before it existed).
     #[serde(default, skip_serializing_if = "Option::is_none")]

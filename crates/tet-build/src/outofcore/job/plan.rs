@@ -196,6 +196,7 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
         build: BuildRecord {
             quality: seam.tetgen.quality,
             max_steiner: seam.tetgen.max_steiner,
+            min_dihedral: seam.tetgen.min_dihedral,
             optimization: seam.tetgen.optimization,
             max_dihedral: seam.tetgen.max_dihedral,
             time_limit_s: options.time_limit_s,

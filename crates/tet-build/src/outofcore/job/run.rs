@@ -173,6 +173,10 @@ fn build(
         tetgen: TetgenOptions {
             quality: job.build.quality,
             max_steiner: job.build.max_steiner,
+            min_dihedral: job
+                .build
+                .min_dihedral
+                .or(TetgenOptions::default().min_dihedral),
             optimization: job
                 .build
                 .optimization
