@@ -14,7 +14,7 @@ use glam::Vec3;
 use ray_strips::{BuildOptions, Ray, RayStrips};
 
 mod common;
-use common::load_obj;
+use common::{cpu_seconds, framing, load_obj};
 const BUNNY: &str = "/work/shared/scenes/stanford-bunny.obj";
 
 /// The Torus Knots scene: a copy of `tet_build::procedural::torus_knot` on
@@ -86,13 +86,7 @@ fn rays_towards(eye: Vec3, centre: Vec3, half: f32) -> Vec<Ray> {
 }
 
 fn bunny_rays(positions: &[Vec3]) -> Vec<Ray> {
-    let (lo, hi) = positions.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    let centre = 0.5 * (lo + hi);
-    let radius = 0.5 * (hi - lo).length();
-    let eye = centre + Vec3::new(0.3, 0.25, 1.0).normalize() * radius * 2.4;
+    let (eye, centre) = framing(positions);
     rays_towards(eye, centre, 0.45)
 }
 
@@ -100,11 +94,6 @@ fn knots_rays() -> Vec<Ray> {
     let (ox, oy) = (0.5f32, 1.0f32);
     let dir = Vec3::new(oy.cos() * ox.cos(), ox.sin(), oy.sin() * ox.cos());
     rays_towards(20.0 * dir, Vec3::ZERO, (22.5f32).to_radians().tan())
-}
-
-fn cpu_seconds() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    Some(s.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
 }
 
 /// All rays once: hit count and a checksum of the hits.

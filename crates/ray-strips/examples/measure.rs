@@ -14,7 +14,7 @@ use glam::Vec3;
 use ray_strips::{BuildOptions, Hit, Ray, RayStrips};
 
 mod common;
-use common::load_obj;
+use common::{cpu_seconds, framing, load_obj};
 const RES: usize = 512;
 /// Timed runs per measurement (the best counts).
 const RUNS: usize = 5;
@@ -60,13 +60,7 @@ fn bumpy_sphere(rings: u32, segments: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
 
 /// Primary rays of a camera framing the mesh's box, in 2×2 pixel blocks.
 fn camera(positions: &[Vec3]) -> Vec<Ray> {
-    let (lo, hi) = positions.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    let centre = 0.5 * (lo + hi);
-    let radius = 0.5 * (hi - lo).length();
-    let eye = centre + Vec3::new(0.3, 0.25, 1.0).normalize() * radius * 2.4;
+    let (eye, centre) = framing(positions);
     let forward = (centre - eye).normalize();
     let right = forward.cross(Vec3::Y).normalize();
     let up = right.cross(forward);
@@ -82,14 +76,6 @@ fn camera(positions: &[Vec3]) -> Vec<Ray> {
         }
     }
     rays
-}
-
-/// Seconds this thread has run on a CPU (Linux `schedstat`), so that
-/// timings on a loaded machine count only our own time; wall-clock time
-/// elsewhere.
-fn cpu_seconds() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    Some(s.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
 }
 
 fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {

@@ -29,3 +29,25 @@ pub fn load_obj(path: &str) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
     }
     Some((v, f))
 }
+
+/// Seconds this thread has run on a CPU (Linux `schedstat`), so that
+/// timings on a loaded machine count only our own time.
+pub fn cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    Some(s.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
+}
+
+/// The examples' camera framing a mesh: `(eye, centre)`, the eye outside
+/// the mesh's box at 2.4 box radii, above and to the right.
+pub fn framing(positions: &[Vec3]) -> (Vec3, Vec3) {
+    let (lo, hi) = positions.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let centre = 0.5 * (lo + hi);
+    let radius = 0.5 * (hi - lo).length();
+    (
+        centre + Vec3::new(0.3, 0.25, 1.0).normalize() * radius * 2.4,
+        centre,
+    )
+}
