@@ -109,9 +109,11 @@ mod avx512;
 mod exit;
 mod geometry;
 mod lanes;
+pub(crate) mod plucker;
 mod portable;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod sctp;
+mod side;
 mod walk;
 
 use tet_core::TetMesh;
