@@ -83,6 +83,20 @@
 //! leaves by; from there each entry face contains the projected origin by
 //! construction. The faithful variant keeps Algorithm 2, as the paper.
 //!
+//! # Batches: the walk in SIMD lockstep
+//!
+//! [`Tracer::trace_batch`] and [`Tracer::trace_batch_from`] walk 16
+//! (AVX-512F) or 8 (AVX2) rays side by side, one per SIMD lane
+//! ([`crate::lockstep`]'s Plücker walk, `lockstep/plucker.rs`), for both
+//! side rules: the faithful product in the apex's frame is a formula per
+//! tet, not state that differs per tet, so it runs per lane as well as the
+//! consistent one. Each lane evaluates exactly this module's formulas and
+//! tables, takes this module's start ([`Tet80Tracer::trace_batch_lockstep`]
+//! calls the same `begin`), its crossing of occlusive and boundary faces and
+//! its tie rule, so every ray's outcome equals the scalar walk's bit for
+//! bit ([`Tet80Tracer::trace_batch_scalar`], kept as the reference and
+//! taken without AVX2 or with `TET_LOCKSTEP=scalar`).
+//!
 //! ScTP ([`crate::sctp`]) cannot be repaired the same way within its
 //! operation count: its triple products are taken in the frame of the
 //! entry face's projected vertices, which differ per tet by design; a
@@ -638,10 +652,10 @@ impl<const CONSISTENT: bool> Tracer for Tet80Tracer<'_, CONSISTENT> {
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
         ShadowTracer::trace_until(self, ray, start, stop)
     }
-    /// In SIMD lockstep where the CPU has AVX2 or AVX-512F
-    /// ([`Tet80Tracer::trace_batch_lockstep`], see [`lockstep_width`]),
-    /// else the scalar walk ([`Tet80Tracer::trace_batch_scalar`]); the
-    /// outcomes are the same.
+    /// In SIMD lockstep ([`Tet80Tracer::trace_batch_lockstep`]): 16 lanes
+    /// with AVX-512F (unless `TET_LOCKSTEP=avx2`), else 8 with AVX2; else,
+    /// or with `TET_LOCKSTEP=scalar`, the scalar walk
+    /// ([`Tet80Tracer::trace_batch_scalar`]). The outcomes are the same.
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
         let done = lockstep_width()
             .is_some_and(|w| self.trace_batch_lockstep(w, rays, Starts::Same(start), out));
