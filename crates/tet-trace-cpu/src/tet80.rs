@@ -83,22 +83,39 @@
 //! leaves by; from there each entry face contains the projected origin by
 //! construction. The faithful variant keeps Algorithm 2, as the paper.
 //!
+//! # Batches: the walk in SIMD lockstep
+//!
+//! [`Tracer::trace_batch`] and [`Tracer::trace_batch_from`] walk 16
+//! (AVX-512F) or 8 (AVX2) rays side by side, one per SIMD lane
+//! ([`crate::lockstep`]'s Plücker walk, `lockstep/plucker.rs`), for both
+//! side rules: the faithful product in the apex's frame is a formula per
+//! tet, not state that differs per tet, so it runs per lane as well as the
+//! consistent one. Each lane evaluates exactly this module's formulas and
+//! tables, takes this module's start ([`Tet80Tracer::trace_batch_lockstep`]
+//! calls the same `begin`), its crossing of occlusive and boundary faces and
+//! its tie rule, so every ray's outcome equals the scalar walk's bit for
+//! bit ([`Tet80Tracer::trace_batch_scalar`], kept as the reference and
+//! taken without AVX2 or with `TET_LOCKSTEP=scalar`).
+//!
 //! ScTP ([`crate::sctp`]) cannot be repaired the same way within its
 //! operation count: its triple products are taken in the frame of the
 //! entry face's projected vertices, which differ per tet by design; a
 //! consistent rule per edge is exactly the Plücker form above.
 
-use glam::Vec3;
-use tet_core::layout::{LayoutError, Tet80Face, Tet80Mesh};
+use glam::{Vec2, Vec3};
+use tet_core::layout::{LayoutError, Tet80, Tet80Face, Tet80Mesh};
 use tet_core::predicates::orient3d;
 use tet_core::{FACE_VERTICES, NO_TET, TetMesh};
 
 use crate::kernel::Tracer;
+use crate::lockstep::plucker::width as lockstep_width;
+use crate::lockstep::plucker::{Begun, PluckerWalk};
+use crate::lockstep::{self, Width};
 use crate::ray::{Failure, Hit, Ray, TraceOutcome};
 use crate::secondary::{ShadowTracer, stops_at};
 use crate::walk::{
-    DuffF32, Projection, Start, TripleF32, degenerate_crossing, face_hit, left_f32,
-    start_exit_face, start_scale, step_cap,
+    DuffF32, EntryHint, Projection, Start, Starts, TripleF32, degenerate_crossing, face_hit,
+    left_f32, start_exit_face, start_scale, step_cap,
 };
 
 /// `EXIT[e][2·s₁ + s₂]`: the exit face of a tet entered through face `e`,
@@ -308,11 +325,32 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
         inside: Option<bool>,
         stop: S,
     ) -> TraceOutcome {
+        match self.begin(ray, start, inside, &stop) {
+            Ok(b) => self.walk(ray, b.tet, b.entry, b.visited, b.scale, stop),
+            Err(out) => out,
+        }
+    }
+
+    /// Everything before the walk's loop: the ray's checks, the start
+    /// (see [`Tet80Tracer::trace_with`]) and the consistent walk's
+    /// projection factor; `Err` when the walk ended before its loop.
+    #[inline(always)]
+    fn begin<S: Fn(u32) -> bool>(
+        &self,
+        ray: &Ray,
+        start: Start,
+        inside: Option<bool>,
+        stop: &S,
+    ) -> Result<Begun, TraceOutcome> {
+        let lost = |tets_visited| TraceOutcome::Failed {
+            failure: Failure::Lost,
+            tets_visited,
+        };
         if !ray.is_valid() {
-            return TraceOutcome::Failed {
+            return Err(TraceOutcome::Failed {
                 failure: Failure::InvalidRay,
                 tets_visited: 0,
-            };
+            });
         }
         // The consistent walk's projection factor, the same as its start's
         // (`start_exit_face` takes it from the same tet).
@@ -321,57 +359,148 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
         } else {
             1.0
         };
+        let begun = |tet, entry, visited| Begun {
+            tet,
+            entry,
+            visited,
+            scale,
+        };
         match start {
             Start::Tet(t) => {
                 if t as usize >= self.layout.tets.len() {
-                    return TraceOutcome::Failed {
-                        failure: Failure::Lost,
-                        tets_visited: 0,
-                    };
+                    return Err(lost(0));
                 }
                 if stop(t) {
-                    return TraceOutcome::Miss { tets_visited: 1 };
+                    return Err(TraceOutcome::Miss { tets_visited: 1 });
                 }
                 let inside =
                     !CONSISTENT && inside.unwrap_or_else(|| self.strictly_inside(t, ray.origin));
                 let Some((t, k)) = self.start_tet(ray, t, inside) else {
-                    return TraceOutcome::Failed {
-                        failure: Failure::Lost,
-                        tets_visited: 1,
-                    };
+                    return Err(lost(1));
                 };
                 let f = self.layout.tets[t as usize].f[k];
-                match self.leave(ray, t, f, 1) {
-                    Ok((n, e)) => self.walk(ray, n, e, 1, scale, stop),
-                    Err(out) => out,
-                }
+                self.leave(ray, t, f, 1).map(|(n, e)| begun(n, e, 1))
             }
-            Start::Face { face, tet } => {
-                let side = self
-                    .mesh
-                    .constrained
-                    .get(face as usize)
-                    .and_then(|cf| cf.side_of(tet))
-                    .filter(|_| (tet as usize) < self.layout.tets.len());
-                match side {
-                    Some(s) => self.walk(ray, tet, s.face as usize, 0, scale, stop),
-                    None => TraceOutcome::Failed {
-                        failure: Failure::Lost,
-                        tets_visited: 0,
-                    },
-                }
-            }
+            Start::Face { face, tet } => self
+                .mesh
+                .constrained
+                .get(face as usize)
+                .and_then(|cf| cf.side_of(tet))
+                .filter(|_| (tet as usize) < self.layout.tets.len())
+                .map(|s| begun(tet, s.face as usize, 0))
+                .ok_or(lost(0)),
             Start::Entry { tet, face } => {
                 if self.mesh.is_boundary_face(tet, face) {
-                    self.walk(ray, tet, face as usize, 0, scale, stop)
+                    Ok(begun(tet, face as usize, 0))
                 } else {
-                    TraceOutcome::Failed {
-                        failure: Failure::Lost,
-                        tets_visited: 0,
-                    }
+                    Err(lost(0))
                 }
             }
         }
+    }
+
+    /// The start tet's interior test shared by a batch whose rays all
+    /// start in tet `t` from one origin (primary rays), made once.
+    fn shared_inside(&self, rays: &[Ray], start: Start) -> Option<bool> {
+        match (start, rays.first()) {
+            (Start::Tet(t), Some(r0))
+                if (t as usize) < self.layout.tets.len()
+                    && r0.origin.is_finite()
+                    && rays.iter().all(|r| r.origin == r0.origin) =>
+            {
+                Some(self.strictly_inside(t, r0.origin))
+            }
+            _ => None,
+        }
+    }
+
+    /// The scalar batch walk, one ray after the other (the reference of
+    /// the lockstep walk, [`Tet80Tracer::trace_batch_lockstep`]): rays
+    /// sharing one origin share the start tet's interior test.
+    pub fn trace_batch_scalar(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
+        let inside = self.shared_inside(rays, start);
+        for (r, o) in rays.iter().zip(out.iter_mut()) {
+            *o = self.trace_with(r, start, inside, |_| false);
+        }
+    }
+
+    /// [`Tracer::trace_batch_from`] ray after ray with the scalar walk.
+    pub fn trace_batch_from_scalar(
+        &self,
+        rays: &[Ray],
+        starts: Starts<'_>,
+        out: &mut [TraceOutcome],
+    ) {
+        let mut hint = EntryHint::default();
+        for (i, (r, o)) in rays.iter().zip(out.iter_mut()).enumerate() {
+            let start = match starts {
+                Starts::Same(s) => Ok(s),
+                Starts::Each(s) => match s.get(i) {
+                    Some(&s) => Ok(s),
+                    None => break,
+                },
+                Starts::Outside(entry) => self.start_outside(entry, r, &mut hint),
+            };
+            *o = match start {
+                Ok(s) => self.trace(r, s),
+                Err(done) => done,
+            };
+        }
+    }
+
+    /// The batch in SIMD lockstep at `width` ([`crate::lockstep`]'s
+    /// Plücker walk): `out[i]` is exactly the scalar walk's outcome of
+    /// `rays[i]` from its start, as [`Tracer::trace_batch_from`] gives it.
+    /// False (nothing traced) when the CPU lacks the width.
+    pub fn trace_batch_lockstep(
+        &self,
+        width: Width,
+        rays: &[Ray],
+        starts: Starts<'_>,
+        out: &mut [TraceOutcome],
+    ) -> bool {
+        let mut n = rays.len().min(out.len());
+        if let Starts::Each(s) = starts {
+            n = n.min(s.len());
+        }
+        let rays = &rays[..n];
+        let inside = match starts {
+            Starts::Same(s) => self.shared_inside(rays, s),
+            _ => None,
+        };
+        let mut hint = EntryHint::default();
+        let begin = |i: usize| {
+            let r = &rays[i];
+            let start = match starts {
+                Starts::Same(s) => s,
+                Starts::Each(s) => s[i],
+                Starts::Outside(entry) => self.start_outside(entry, r, &mut hint)?,
+            };
+            self.begin(r, start, inside, &|_| false)
+        };
+        lockstep::plucker::trace(width, self, rays, begin, &mut out[..n])
+    }
+}
+
+impl<const CONSISTENT: bool> PluckerWalk for Tet80Tracer<'_, CONSISTENT> {
+    const CONSISTENT: bool = CONSISTENT;
+    fn records(&self) -> &[Tet80] {
+        &self.layout.tets
+    }
+    fn cap(&self) -> u32 {
+        self.cap
+    }
+    fn leave(
+        &self,
+        ray: &Ray,
+        tet: u32,
+        f: Tet80Face,
+        visited: u32,
+    ) -> Result<(u32, usize), TraceOutcome> {
+        Tet80Tracer::leave(self, ray, tet, f, visited)
+    }
+    fn left_tie(pp: Vec2, p: Vec3, pq: Vec2, q: Vec3) -> bool {
+        left_projected(pp, p, pq, q)
     }
 }
 
@@ -449,7 +578,7 @@ fn lex_less(p: Vec3, q: Vec3) -> bool {
 /// positions `p`, `q`): the ray passes left of `p → q`. Exactly
 /// antisymmetric, with the projections' tie rule.
 #[inline(always)]
-fn left_projected(pp: glam::Vec2, p: Vec3, pq: glam::Vec2, q: Vec3) -> bool {
+fn left_projected(pp: Vec2, p: Vec3, pq: Vec2, q: Vec3) -> bool {
     let (ip, iq) = if lex_less(p, q) { (0, 1) } else { (1, 0) };
     left_f32(pp, ip, pq, iq)
 }
@@ -523,21 +652,24 @@ impl<const CONSISTENT: bool> Tracer for Tet80Tracer<'_, CONSISTENT> {
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
         ShadowTracer::trace_until(self, ray, start, stop)
     }
-    /// Rays sharing one origin (primary rays) share the start tet's interior
-    /// test: it is made once per batch.
+    /// In SIMD lockstep ([`Tet80Tracer::trace_batch_lockstep`]): 16 lanes
+    /// with AVX-512F (unless `TET_LOCKSTEP=avx2`), else 8 with AVX2; else,
+    /// or with `TET_LOCKSTEP=scalar`, the scalar walk
+    /// ([`Tet80Tracer::trace_batch_scalar`]). The outcomes are the same.
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
-        let inside = match (start, rays.first()) {
-            (Start::Tet(t), Some(r0))
-                if (t as usize) < self.layout.tets.len()
-                    && r0.origin.is_finite()
-                    && rays.iter().all(|r| r.origin == r0.origin) =>
-            {
-                Some(self.strictly_inside(t, r0.origin))
-            }
-            _ => None,
-        };
-        for (r, o) in rays.iter().zip(out.iter_mut()) {
-            *o = self.trace_with(r, start, inside, |_| false);
+        let done = lockstep_width()
+            .is_some_and(|w| self.trace_batch_lockstep(w, rays, Starts::Same(start), out));
+        if !done {
+            self.trace_batch_scalar(rays, start, out);
+        }
+    }
+    /// As [`Tracer::trace_batch`]: in lockstep where the CPU has AVX2 or
+    /// AVX-512F, else ray after ray.
+    fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
+        let done =
+            lockstep_width().is_some_and(|w| self.trace_batch_lockstep(w, rays, starts, out));
+        if !done {
+            self.trace_batch_from_scalar(rays, starts, out);
         }
     }
 }

@@ -116,6 +116,17 @@ impl Lanes for Avx2 {
         unsafe { _mm256_xor_si256(a, b) }
     }
     #[inline(always)]
+    fn and_i(self, a: __m256i, b: __m256i) -> __m256i {
+        // SAFETY: as `lane_mask`.
+        unsafe { _mm256_and_si256(a, b) }
+    }
+    #[inline(always)]
+    fn permute_i(self, table: [u32; 8], idx: __m256i) -> __m256i {
+        // `vpermd` reads the low 3 bits of each index: `idx mod 8`.
+        // SAFETY: as `lane_mask`.
+        unsafe { _mm256_permutevar8x32_epi32(bytemuck::cast(table), idx) }
+    }
+    #[inline(always)]
     fn min_u(self, a: __m256i, b: __m256i) -> __m256i {
         // SAFETY: as `lane_mask`.
         unsafe { _mm256_min_epu32(a, b) }
@@ -236,6 +247,12 @@ impl Lanes for Avx2 {
         // SAFETY: AVX2 as `lane_mask`; every lane of `idx` indexes `words`
         // (the caller's contract).
         unsafe { _mm256_i32gather_epi32::<4>(words.as_ptr() as *const i32, idx) }
+    }
+    #[inline(always)]
+    unsafe fn gather_f(self, words: &[u32], idx: __m256i) -> __m256 {
+        // SAFETY: AVX2 as `lane_mask`; every lane of `idx` indexes `words`
+        // (the caller's contract).
+        unsafe { _mm256_i32gather_ps::<4>(words.as_ptr() as *const f32, idx) }
     }
     #[inline(always)]
     unsafe fn gather_point(self, points: &[Vec3], i: __m256i) -> [__m256; 3] {

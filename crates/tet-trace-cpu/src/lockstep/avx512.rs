@@ -105,6 +105,19 @@ impl Lanes for Avx512 {
         unsafe { _mm512_xor_si512(a, b) }
     }
     #[inline(always)]
+    fn and_i(self, a: __m512i, b: __m512i) -> __m512i {
+        // SAFETY: AVX-512F, see above.
+        unsafe { _mm512_and_si512(a, b) }
+    }
+    #[inline(always)]
+    fn permute_i(self, table: [u32; 8], idx: __m512i) -> __m512i {
+        // `vpermd` reads the low 4 bits of each index; the table repeated
+        // twice makes that `table[idx mod 8]`.
+        let t: [u32; 16] = std::array::from_fn(|k| table[k % 8]);
+        // SAFETY: AVX-512F, see above.
+        unsafe { _mm512_permutexvar_epi32(idx, bytemuck::cast(t)) }
+    }
+    #[inline(always)]
     fn min_u(self, a: __m512i, b: __m512i) -> __m512i {
         // SAFETY: AVX-512F, see above.
         unsafe { _mm512_min_epu32(a, b) }
@@ -210,6 +223,12 @@ impl Lanes for Avx512 {
     }
     /// `(x, y)` as two 8-lane gathers of 64-bit pairs, deinterleaved (16
     /// loads instead of the 32 of two 16-lane gathers), then `z`.
+    #[inline(always)]
+    unsafe fn gather_f(self, words: &[u32], idx: __m512i) -> __m512 {
+        // SAFETY: AVX-512F, see above; every lane of `idx` indexes `words`
+        // (the caller's contract).
+        unsafe { _mm512_i32gather_ps::<4>(idx, words.as_ptr() as *const f32) }
+    }
     #[inline(always)]
     unsafe fn gather_point(self, points: &[Vec3], i: __m512i) -> [__m512; 3] {
         // `Vec3` is `#[repr(C)]` `{x, y, z}`: 3 f32 words per point.

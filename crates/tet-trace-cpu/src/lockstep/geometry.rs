@@ -64,6 +64,20 @@ pub(crate) struct PlanarRay<F> {
     c: [[F; 2]; 3],
 }
 
+impl<F: Copy> PlanarRay<F> {
+    /// Loads the basis of `p` into lane `k`.
+    #[inline(always)]
+    pub(crate) fn set<L: Lanes<F = F>>(&mut self, l: L, k: usize, p: &DuffF32) {
+        for (a, o) in self.o.iter_mut().enumerate() {
+            *o = l.set_f(*o, k, p.o[a]);
+        }
+        for (c, col) in self.c.iter_mut().zip([p.cx, p.cy, p.cz]) {
+            c[0] = l.set_f(c[0], k, col.x);
+            c[1] = l.set_f(c[1], k, col.y);
+        }
+    }
+}
+
 impl<L: Lanes> Geometry<L> for Planar {
     type Proj = DuffF32;
     type Ray = PlanarRay<L::F>;
@@ -81,14 +95,7 @@ impl<L: Lanes> Geometry<L> for Planar {
     }
     #[inline(always)]
     fn put(l: L, k: usize, ray: &mut Self::Ray, face: &mut [Self::Vert; 3], lane: &Lane<DuffF32>) {
-        let p = lane.proj;
-        for (a, o) in ray.o.iter_mut().enumerate() {
-            *o = l.set_f(*o, k, p.o[a]);
-        }
-        for (c, col) in ray.c.iter_mut().zip([p.cx, p.cy, p.cz]) {
-            c[0] = l.set_f(c[0], k, col.x);
-            c[1] = l.set_f(c[1], k, col.y);
-        }
+        ray.set(l, k, &lane.proj);
         for (s, v) in face.iter_mut().enumerate() {
             v[0] = l.set_f(v[0], k, lane.st.p.xs[s]);
             v[1] = l.set_f(v[1], k, lane.st.p.ys[s]);

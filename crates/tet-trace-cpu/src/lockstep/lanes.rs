@@ -58,6 +58,10 @@ pub(crate) trait Lanes: Copy {
     fn mul_i(self, a: Self::I, b: Self::I) -> Self::I;
     /// `a ⊕ b`.
     fn xor_i(self, a: Self::I, b: Self::I) -> Self::I;
+    /// `a ∧ b`, bitwise.
+    fn and_i(self, a: Self::I, b: Self::I) -> Self::I;
+    /// `table[idx mod 8]` per lane (one permute on AVX2 and AVX-512).
+    fn permute_i(self, table: [u32; 8], idx: Self::I) -> Self::I;
     /// `min(a, b)`, unsigned.
     fn min_u(self, a: Self::I, b: Self::I) -> Self::I;
     /// `x + 1` in the lanes of `m`, `x` elsewhere.
@@ -106,6 +110,12 @@ pub(crate) trait Lanes: Copy {
     /// Every lane of `idx` must be `< words.len()` (the SIMD
     /// implementations load without a bounds check).
     unsafe fn gather_words(self, words: &[u32], idx: Self::I) -> Self::I;
+    /// `words[idx]` per lane, read as the bits of an f32.
+    ///
+    /// # Safety
+    ///
+    /// As [`Lanes::gather_words`].
+    unsafe fn gather_f(self, words: &[u32], idx: Self::I) -> Self::F;
     /// `(x, y, z)` of `points[i]` per lane.
     ///
     /// # Safety

@@ -1,7 +1,9 @@
 //! SIMD lockstep walk: `W` rays of one batch walk side by side, one ray per
 //! SIMD lane, one tet per lane per round. This is the
 //! [`Tracer::trace_batch`](crate::Tracer::trace_batch) of every projected
-//! kernel with [`DuffF32`](crate::DuffF32) (Tet20, Tet16, Tet32); the scalar walks
+//! kernel with [`DuffF32`](crate::DuffF32) (Tet20, Tet16, Tet32), of ScTP
+//! (`sctp`) and of the Tet80 kernels (`plucker`, over the same lanes, see
+//! Dispatch); the scalar walks
 //! ([`crate::walk::trace`], [`crate::walk::trace_interleaved`], reachable as
 //! [`crate::kernel::Interleaved`]) stay as the reference.
 //!
@@ -35,6 +37,12 @@
 //!   for AVX2 (8 lanes, scalar loads through [`Topology`]);
 //! * otherwise: the portable lanes with 4 lanes on the baseline target
 //!   (SSE2 on x86-64), [`trace_lockstep_portable`].
+//!
+//! The Tet80 kernels ([`crate::tet80`], both side rules) walk their own
+//! records in lockstep (`plucker`): AVX-512F (16 lanes) unless
+//! `TET_LOCKSTEP=avx2`, else AVX2 (8 lanes), both with gathers; without
+//! either, or with `TET_LOCKSTEP=scalar`, their scalar walk
+//! ([`crate::tet80::Tet80Tracer::trace_batch_scalar`]).
 //!
 //! # One walk, generic over lanes
 //!
@@ -100,7 +108,10 @@
 //!   products);
 //! * `exit`: the record reads (gathers with the exit rules, or lane by lane);
 //! * `walk`: the walk itself, once;
-//! * `sctp`: ScTP's batch path (16-lane AVX-512 lockstep).
+//! * `sctp`: ScTP's batch path (16-lane AVX-512 lockstep);
+//! * `plucker`, `side`: the Tet80 walk (Maria et al.'s Plücker exit rule)
+//!   over the same lanes, with its two side rules in lanes (faithful and
+//!   consistent).
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -109,9 +120,11 @@ mod avx512;
 mod exit;
 mod geometry;
 mod lanes;
+pub(crate) mod plucker;
 mod portable;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod sctp;
+mod side;
 mod walk;
 
 use tet_core::TetMesh;

@@ -86,6 +86,14 @@ impl<const W: usize> Lanes for Portable<W> {
         from_fn(|l| a[l] ^ b[l])
     }
     #[inline(always)]
+    fn and_i(self, a: [u32; W], b: [u32; W]) -> [u32; W] {
+        from_fn(|l| a[l] & b[l])
+    }
+    #[inline(always)]
+    fn permute_i(self, table: [u32; 8], idx: [u32; W]) -> [u32; W] {
+        from_fn(|l| table[idx[l] as usize % 8])
+    }
+    #[inline(always)]
     fn min_u(self, a: [u32; W], b: [u32; W]) -> [u32; W] {
         from_fn(|l| a[l].min(b[l]))
     }
@@ -173,6 +181,10 @@ impl<const W: usize> Lanes for Portable<W> {
     #[inline(always)]
     unsafe fn gather_words(self, words: &[u32], idx: [u32; W]) -> [u32; W] {
         from_fn(|l| words[idx[l] as usize])
+    }
+    #[inline(always)]
+    unsafe fn gather_f(self, words: &[u32], idx: [u32; W]) -> [f32; W] {
+        from_fn(|l| f32::from_bits(words[idx[l] as usize]))
     }
     #[inline(always)]
     unsafe fn gather_point(self, points: &[Vec3], i: [u32; W]) -> [[f32; W]; 3] {
