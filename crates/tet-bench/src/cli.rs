@@ -112,14 +112,18 @@ pub struct BuildArgs {
     /// model of Erkoç et al., seed 003 §3.2) and exit without building.
     #[arg(long)]
     pub predict_memory: bool,
-    /// Keep every TetGen run's predicted peak under this size (bytes, or
-    /// with a unit K, M, G: powers of 1024, e.g. 512M): over it, the scene
-    /// is split into parts with exact seams, built by parallel workers and
-    /// merged.
+    /// Keep this process and its TetGen workers together under this size
+    /// (bytes, or with a unit K, M, G: powers of 1024, e.g. 512M): this
+    /// process sets a share aside for itself (`--predict-memory` says how
+    /// much), and when TetGen's predicted peak does not fit the rest, the
+    /// scene is split into parts with exact seams, built by parallel
+    /// workers (only as many at once as fit) and merged. With `--plan`: the
+    /// limit on each part's predicted TetGen peak (each part runs on its
+    /// own).
     #[arg(long, value_name = "BYTES", value_parser = parse_memory_limit)]
     pub memory_limit: Option<u64>,
     /// With `--memory-limit`: at most this many TetGen workers at once
-    /// (default: all cores); their predictions together stay under the limit.
+    /// (default: all cores); with this process, they stay under the limit.
     #[arg(long, requires = "memory_limit")]
     pub threads: Option<usize>,
     /// With `--memory-limit`: how to split (default: the paper's recursive
@@ -849,7 +853,7 @@ impl IsoMethod {
 
 impl BuildFlags {
     /// The TetGen options these flags ask for: every TetGen flag given
-    /// replaces its default, the rest keep [`TetgenOptions::default`]. The
+    /// replaces its default, the rest keep [`tet_build::tetgen::TetgenOptions::default`]. The
     /// one mapping for in-core, out-of-core and job builds.
     pub fn tetgen_options(&self) -> tet_build::tetgen::TetgenOptions {
         let d = tet_build::tetgen::TetgenOptions::default();

@@ -5,9 +5,25 @@
 //! ([`tet_build::outofcore::memory_model::predict_peak_memory`], TetGen's
 //! peak resident memory as a linear function of points + triangles of its
 //! input, with a safety margin) on the cleaned scene plus the enclosing
-//! box's 8 corners and 12 triangles. Over the limit, the scene is split
+//! box's 8 corners and 12 triangles.
+//!
+//! **The limit is on the whole process tree**: this process and its
+//! TetGen workers together. A model of the builder's own memory (the
+//! scene, its cleaned and clipped parts:
+//! [`tet_build::outofcore::admission::builder_bytes`]) is set aside first;
+//! each of `p` workers at once then gets a `p`-th of the rest, less this
+//! process's share of its result
+//! ([`tet_build::outofcore::admission::worker_share`]). While
+//! the parts run, a worker starts only when this process's resident
+//! memory *now* and the running parts' commitments leave room for it
+//! ([`tet_build::outofcore::admission`]), and the process tree's resident
+//! memory is sampled for the report (`tree_peak_kib`,
+//! [`tet_build::outofcore::tree_memory`]). The in-core build is taken
+//! when the whole scene's prediction fits the same share with one worker.
+//!
+//! Over the limit, the scene is split
 //! recursively by the paper's planes until every part's prediction fits
-//! the limit divided by the parts run at once
+//! its share
 //! ([`tet_build::outofcore::tree::build_tree_with_memory_limit`]), each
 //! part is tetrahedralized by its own TetGen worker with exact seams and
 //! the parts are merged; when no tree fits, parallel slabs are tried
@@ -23,18 +39,16 @@
 //! Hilbert-sorted on its own and the parts follow each other in the tree's
 //! leaf order, instead of one curve through the whole mesh.
 //! `--merge memory` ([`Limited::in_memory`]) merges in memory and sorts the
-//! whole mesh; the `tables` harness uses it (it traces the mesh right
-//! away, so holds it anyway). `build --tet20` reads the written file back
+//! whole mesh, which no limit on the process can bound: only the workers'
+//! predictions are held to their shares then. The `tables` harness runs
+//! the default (streamed) build in a process of its own and reads the file
+//! back. `build --tet20` reads the written file back
 //! and traces it, so the trade (memory, build time, render speed) of both
 //! merges and of the in-core build is measured the same way
 //! ([`tet20_speed`]).
 
-use anyhow::Result;
-use tet_build::scene::Scene;
-use tet_core::TetMesh;
-
-use crate::cli::{BuildFlags, Planner};
-use crate::load::BuildSummary;
+#[cfg(not(feature = "tetgen"))]
+use {crate::load::BuildSummary, anyhow::Result, tet_core::TetMesh};
 
 #[cfg(feature = "tetgen")]
 mod limited;
@@ -45,29 +59,6 @@ mod types;
 pub use predict::predict;
 pub use trace_speed::tet20_speed;
 pub use types::{Limited, MemoryReport};
-
-/// Builds `scene` so that every TetGen run's predicted peak fits
-/// `limit_bytes`, the parts merged in memory ([`Limited::in_memory`] with
-/// the default planner: the paper's tree, slabs when no tree fits).
-pub fn build_limited(
-    scene: &Scene,
-    flags: &BuildFlags,
-    limit_bytes: u64,
-    max_parallel: usize,
-    quiet: bool,
-    extra: &[glam::Vec3],
-) -> Result<(TetMesh, BuildSummary, MemoryReport)> {
-    Limited {
-        scene,
-        flags,
-        limit_bytes,
-        max_parallel,
-        quiet,
-        extra,
-        planner: Planner::Auto,
-    }
-    .in_memory()
-}
 
 /// Without TetGen, scenes cannot be built.
 #[cfg(not(feature = "tetgen"))]

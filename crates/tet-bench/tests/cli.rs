@@ -244,19 +244,19 @@ fn memory_limit_builds_in_parts_that_trace_like_the_in_core_mesh() {
     let whole = dir.path().join("whole.tmesh");
     let parts = dir.path().join("parts.tmesh");
     let (whole, parts) = (whole.to_str().unwrap(), parts.to_str().unwrap());
-    let predicted = json(&["build", "torus-knot", "--predict-memory"])["predicted_peak_bytes"]
-        .as_u64()
-        .unwrap();
+    let p = json(&["build", "torus-knot", "--predict-memory"]);
+    let predicted = p["predicted_peak_bytes"].as_u64().unwrap();
+    let builder = p["builder_bytes"].as_u64().unwrap();
 
-    // Over the prediction: in core, one part.
-    let big = format!("{}K", predicted / 1024 + 1);
+    // Room for the builder and the whole prediction: in core, one part.
+    let big = format!("{}K", (builder + predicted + predicted / 4) / 1024 + 1);
     let w = json(&["build", "torus-knot", "-o", whole, "--memory-limit", &big]);
     assert_eq!(w["memory"]["out_of_core"], false);
     assert_eq!(w["memory"]["parts"], 1);
     assert_eq!(w["build"]["scene_triangles"], 2880);
 
-    // Under it: slabs, each predicted under the limit.
-    let limit = predicted * 3 / 4;
+    // Less: parts, each predicted under what the limit leaves a worker.
+    let limit = limit_for_workers(builder, predicted * 3 / 4);
     let limit_arg = limit.to_string();
     let b = json(&[
         "build",
@@ -274,7 +274,8 @@ fn memory_limit_builds_in_parts_that_trace_like_the_in_core_mesh() {
     let n = m["parts"].as_u64().unwrap() as usize;
     assert!(n >= 2, "{m}");
     assert_eq!(m["planes"].as_array().unwrap().len(), n - 1);
-    // The parts running at once fit the limit together.
+    // The parts running at once fit the limit together with the builder
+    // and its quarter of each part's prediction.
     let at_once = m["parallel_parts"].as_u64().unwrap();
     assert!((1..=2).contains(&at_once), "{m}");
     let largest = m["part_predicted_bytes"]
@@ -284,7 +285,9 @@ fn memory_limit_builds_in_parts_that_trace_like_the_in_core_mesh() {
         .map(|p| p.as_u64().unwrap())
         .max()
         .unwrap();
-    assert!(at_once * largest <= limit, "{m}");
+    assert_eq!(m["own_bytes"].as_u64().unwrap(), builder);
+    assert!(builder + at_once * (largest + largest / 4) <= limit, "{m}");
+    assert!(m["tree_peak_kib"].as_u64().unwrap() * 1024 <= limit, "{m}");
     let part_tets: u64 = m["part_tets"]
         .as_array()
         .unwrap()
@@ -316,6 +319,15 @@ fn memory_limit_builds_in_parts_that_trace_like_the_in_core_mesh() {
     assert!((ha - hc).abs() <= 2, "in core {ha} hits, out of core {hc}");
 }
 
+/// The `--memory-limit` under which a local build of a scene whose
+/// builder sets `builder` bytes aside gives one worker at a time exactly
+/// `per_worker` bytes of predicted TetGen peak (with the builder's quarter
+/// of it): `per_worker` rounded down to a multiple of 4.
+fn limit_for_workers(builder: u64, per_worker: u64) -> u64 {
+    let w = per_worker & !3;
+    builder + w + w / 4
+}
+
 /// Under a limit the parts are streamed through part files by default;
 /// `--merge memory` gives the same mesh (counts) merged in memory;
 /// `--planner` forces the tree or slabs; `--tet20` traces the file written.
@@ -323,10 +335,12 @@ fn memory_limit_builds_in_parts_that_trace_like_the_in_core_mesh() {
 fn memory_limit_streams_by_default_and_the_planner_can_be_chosen() {
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
-    let predicted = json(&["build", "torus-knot", "--predict-memory"])["predicted_peak_bytes"]
-        .as_u64()
-        .unwrap();
-    let limit = (predicted * 3 / 4).to_string();
+    let p = json(&["build", "torus-knot", "--predict-memory"]);
+    let (predicted, builder) = (
+        p["predicted_peak_bytes"].as_u64().unwrap(),
+        p["builder_bytes"].as_u64().unwrap(),
+    );
+    let limit = limit_for_workers(builder, predicted * 3 / 4).to_string();
     let build = |out: &str, extra: &[&str]| {
         let mut args = vec!["build", "torus-knot", "-o", out, "--memory-limit", &limit];
         args.extend_from_slice(extra);
@@ -410,6 +424,7 @@ fn bad_memory_limits_are_explained() {
         "1M",
     ]);
     assert!(err.contains("raise --memory-limit"), "{err}");
+    assert!(err.contains("aside for itself"), "{err}");
     assert!(!out.exists(), "no mesh file is written");
     // Without -o (and without --predict-memory) clap asks for it.
     let err = stderr_of(&["build", "torus-knot"]);

@@ -1,8 +1,8 @@
 //! The job commands as a user scripts them: `build --plan`, `build-part`
 //! with the index from the engine's environment, `job status`, `merge`,
 //! `submit --dry-run`. The merged mesh is byte for byte the single-process
-//! `build --memory-limit` of the same scene and limit, and traces without
-//! failures.
+//! `build --memory-limit` of the same scene that leaves its one worker the
+//! job's per-part limit, and traces without failures.
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -50,10 +50,12 @@ fn a_planned_job_runs_part_by_part_and_merges_into_the_local_build() {
     let dir = tempfile::tempdir().unwrap();
     let jobdir = dir.path().join("job");
     let j = jobdir.to_str().unwrap();
-    let predicted = json(&["build", "torus-knot", "--predict-memory"])["predicted_peak_bytes"]
-        .as_u64()
-        .unwrap();
-    let limit = (predicted * 3 / 4).to_string();
+    let p = json(&["build", "torus-knot", "--predict-memory"]);
+    let predicted = p["predicted_peak_bytes"].as_u64().unwrap();
+    // A job's limit is on each part's predicted TetGen peak (each part
+    // runs on its own); a multiple of 4, for the local build below.
+    let per_part = (predicted * 3 / 4) & !3;
+    let limit = per_part.to_string();
     let plan = json(&["build", "torus-knot", "--plan", j, "--memory-limit", &limit]);
     let n = plan["parts"].as_u64().unwrap() as usize;
     assert!(n >= 2, "{plan}");
@@ -91,8 +93,12 @@ fn a_planned_job_runs_part_by_part_and_merges_into_the_local_build() {
     let m = json(&["merge", j, "-o", merged.to_str().unwrap()]);
     assert_eq!(m["parts"], n);
 
-    // The single-process out-of-core build, one worker at a time: the
-    // same plan, the same file.
+    // The single-process out-of-core build, one worker at a time, under
+    // the limit on its process tree that leaves that worker the job's
+    // per-part limit (beside what the builder sets aside for itself and
+    // its quarter of the part): the same plan, the same file.
+    let builder = p["builder_bytes"].as_u64().unwrap();
+    let local_limit = (builder + per_part + per_part / 4).to_string();
     let local = dir.path().join("local.tmesh");
     let b = json(&[
         "build",
@@ -100,7 +106,7 @@ fn a_planned_job_runs_part_by_part_and_merges_into_the_local_build() {
         "-o",
         local.to_str().unwrap(),
         "--memory-limit",
-        &limit,
+        &local_limit,
         "--threads",
         "1",
     ]);

@@ -4,7 +4,7 @@
 //! it; one array task is cancelled while it builds (the merge is then
 //! cancelled by Slurm), `submit` again runs only that part and the merge.
 //! The merged mesh is byte for byte the single-process out-of-core build
-//! of the same scene and limit, and traces without failures. Every
+//! that leaves its one worker the same limit, and traces without failures. Every
 //! task's measured peak (its TetGen worker and itself) fits the memory
 //! it asked for.
 //!
@@ -217,7 +217,15 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
         );
     }
 
-    // The single-process build of the same scene and limit, one worker.
+    // The single-process build, one worker, under the limit on its
+    // process tree that leaves that worker the job's 300 MiB per part
+    // (beside what the builder sets aside for itself and its quarter of
+    // the part).
+    let builder = json(&["build", scene, "--predict-memory"])["builder_bytes"]
+        .as_u64()
+        .unwrap();
+    let per_part: u64 = 300 << 20;
+    let local_limit = (builder + per_part + per_part / 4).to_string();
     let local = dir.path().join("local.tmesh");
     json(&[
         "build",
@@ -225,7 +233,7 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
         "-o",
         local.to_str().unwrap(),
         "--memory-limit",
-        limit,
+        &local_limit,
         "--threads",
         "1",
     ]);

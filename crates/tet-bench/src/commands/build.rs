@@ -210,7 +210,7 @@ fn run_predict(args: &BuildArgs, json: bool) -> Result<()> {
         print_json(&p)?;
     } else {
         outln!(
-            "{}: TetGen input {} points + {} triangles; predicted peak memory {:.1} MiB ({} bytes) = {:.3} × ({:.2} MB + {:.0} B × {})",
+            "{}: TetGen input {} points + {} triangles; predicted peak memory {:.1} MiB ({} bytes) = {:.3} × ({:.2} MB + {:.0} B × {}); a build under --memory-limit sets {:.1} MiB aside for its own process",
             p.name,
             p.points,
             p.triangles,
@@ -219,7 +219,8 @@ fn run_predict(args: &BuildArgs, json: bool) -> Result<()> {
             p.model.margin,
             p.model.base_bytes / 1e6,
             p.model.bytes_per_element,
-            p.points + p.triangles
+            p.points + p.triangles,
+            p.builder_bytes as f64 / (1024.0 * 1024.0)
         )?;
     }
     Ok(())

@@ -11,12 +11,14 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use tet_build::bbox::EnclosingBox;
+use tet_build::outofcore::admission::{builder_bytes, worker_share};
 use tet_build::outofcore::seam::{SeamOptions, SeamReport, build_slabs, build_slabs_to_file};
 use tet_build::outofcore::split::{SlabPlan, SplitOptions, plan_slabs, plan_split};
 use tet_build::outofcore::stream::{StreamOptions, StreamSummary};
 use tet_build::outofcore::tree::{
     CutTree, TreePlan, build_tree_with_memory_limit, build_tree_with_memory_limit_to_file,
 };
+use tet_build::outofcore::tree_memory::TreeSampler;
 use tet_core::TetMesh;
 use tet_core::scene::SceneInfo;
 
@@ -47,6 +49,8 @@ struct Plan {
     options: SeamOptions,
     /// Seconds spent cleaning the scene.
     clean_s: f64,
+    /// This process's resident memory set aside from the limit, bytes.
+    own_bytes: u64,
     /// Scene triangles after cleaning.
     scene_triangles: usize,
     /// Scene vertices after cleaning.
@@ -77,10 +81,16 @@ impl Limited<'_> {
     /// Builds in memory: the mesh, Hilbert-sorted as a whole unless
     /// `flags.no_sort`.
     pub fn in_memory(&self) -> Result<(TetMesh, BuildSummary, MemoryReport)> {
-        let Some(plan) = self.plan()? else {
-            let (mesh, build, report) = self.in_core()?;
+        let sampler = TreeSampler::start_own();
+        let Some(mut plan) = self.plan()? else {
+            let (mesh, build, mut report) = self.in_core()?;
+            report.tree_peak_kib = sampler.finish();
             return Ok((mesh, build, report));
         };
+        // This process gathers the whole mesh: the parts' results are not
+        // given back while the others run, so no gate on them can hold the
+        // limit; the workers' predictions still fit their shares.
+        plan.options.tree_limit_bytes = None;
         let spinner = crate::load::spinner(self.quiet);
         spinner.set_message(self.progress(&plan));
         let tetgen_start = Instant::now();
@@ -101,7 +111,7 @@ impl Limited<'_> {
             mode: "memory",
             stream: None,
         };
-        let (build, memory) = self.reports(
+        let (build, mut memory) = self.reports(
             &plan,
             report,
             &shape,
@@ -109,6 +119,7 @@ impl Limited<'_> {
             (tetgen_s, reorder_s),
             &merged,
         );
+        memory.tree_peak_kib = sampler.finish();
         Ok((mesh, build, memory))
     }
 
@@ -122,10 +133,12 @@ impl Limited<'_> {
         output: &Path,
         stored: &SceneInfo,
     ) -> Result<(Written, BuildSummary, MemoryReport)> {
+        let sampler = TreeSampler::start_own();
         let Some(plan) = self.plan()? else {
-            let (mesh, build, report) = self.in_core()?;
+            let (mesh, build, mut report) = self.in_core()?;
             tet_core::format::save_with_scene(output, &mesh, stored)
                 .with_context(|| format!("cannot write {}", output.display()))?;
+            report.tree_peak_kib = sampler.finish();
             let written = Written {
                 points: mesh.points.len(),
                 tets: mesh.tets.len(),
@@ -156,7 +169,7 @@ impl Limited<'_> {
             mode: "stream",
             stream: Some(&summary),
         };
-        let (build, memory) = self.reports(
+        let (build, mut memory) = self.reports(
             &plan,
             report,
             &shape,
@@ -164,6 +177,7 @@ impl Limited<'_> {
             (tetgen_s, 0.0),
             &merged,
         );
+        memory.tree_peak_kib = sampler.finish();
         let written = Written {
             points: summary.points as usize,
             tets: summary.tets as usize,
@@ -176,6 +190,7 @@ impl Limited<'_> {
     /// The in-core build when the whole scene's prediction fits.
     fn in_core(&self) -> Result<(TetMesh, BuildSummary, MemoryReport)> {
         let start = Instant::now();
+        let own = builder_bytes(self.scene.triangles.len());
         let predicted = predict(self.scene, self.flags.no_box)?.predicted_peak_bytes;
         let (mesh, build) =
             crate::load::build_scene_in(self.scene, self.flags, self.quiet, self.extra)?;
@@ -204,6 +219,8 @@ impl Limited<'_> {
             merge_all_parts_bytes: None,
             part_file_bytes: None,
             process_peak_kib: tet_build::tetgen::worker::peak_memory_kib(),
+            own_bytes: own,
+            tree_peak_kib: None,
         };
         Ok((mesh, build, report))
     }
@@ -221,16 +238,31 @@ impl Limited<'_> {
     }
 
     /// The split, or `None` when the whole scene's prediction fits.
+    ///
+    /// The limit bounds the whole process tree: this process's own memory
+    /// (a model of it, [`builder_bytes`], so that the same command plans
+    /// the same parts on every run) is set aside first, and each of `p`
+    /// workers at once gets a `p`-th of the rest, less this process's share
+    /// of its result ([`worker_share`]).
     fn plan(&self) -> Result<Option<Plan>> {
         let (scene, flags, limit_bytes) = (self.scene, self.flags, self.limit_bytes);
         let start = Instant::now();
         let predicted = predict(scene, flags.no_box)?.predicted_peak_bytes;
-        if predicted <= limit_bytes {
+        let own = builder_bytes(scene.triangles.len());
+        if own >= limit_bytes {
+            bail!(
+                "--memory-limit {:.1} MiB leaves nothing for TetGen: this process sets {:.1} MiB aside for itself (the scene `{}` and its parts); raise --memory-limit",
+                mib(limit_bytes),
+                mib(own),
+                scene.name
+            );
+        }
+        if predicted <= worker_share(limit_bytes, scene.triangles.len(), 1) {
             return Ok(None);
         }
         if flags.no_box {
             bail!(
-                "`{}` needs an out-of-core build (predicted {:.1} MiB > limit {:.1} MiB), which cuts the enclosing box into parts: drop --no-box",
+                "`{}` needs an out-of-core build (predicted {:.1} MiB > what the limit {:.1} MiB leaves a worker beside this process), which cuts the enclosing box into parts: drop --no-box",
                 scene.name,
                 mib(predicted),
                 mib(limit_bytes)
@@ -243,9 +275,49 @@ impl Limited<'_> {
         let box_spec = crate::load::enclosing_box(scene, self.extra, flags.wide_box);
         let b = EnclosingBox::new(cleaned.bounds(), box_spec)
             .with_context(|| format!("cannot build the enclosing box of `{}`", scene.name))?;
-        let bounds = (b.min, b.max);
+        let chosen = self.choose(&cleaned, (b.min, b.max), scene.triangles.len())?;
+        let (split, parallel) = chosen;
+        let options = SeamOptions {
+            enclosing_box: box_spec,
+            tetgen: flags.tetgen_options(),
+            isolation: crate::load::worker_isolation(flags.time_limit)?,
+            parallel_parts: parallel,
+            tree_limit_bytes: Some(limit_bytes),
+            resolve: (!flags.no_resolve).then(Default::default),
+        };
+        Ok(Some(Plan {
+            start,
+            predicted,
+            split,
+            parallel,
+            options,
+            clean_s,
+            own_bytes: builder_bytes(scene.triangles.len()),
+            scene_triangles: cleaned.triangles.len(),
+            scene_vertices: cleaned.vertices.len(),
+            cleaning: CleaningSummary {
+                merged_vertices: cm.report.merged_vertices.len(),
+                repeated_vertex_triangles: cm.report.repeated_vertex_triangles.len(),
+                zero_area_triangles: cm.report.zero_area_triangles.len(),
+                duplicate_triangles: cm.report.duplicate_triangles.len(),
+                unused_vertices: cm.report.unused_vertices.len(),
+            },
+        }))
+    }
+
+    /// The split and the workers at once for a scene of `triangles`
+    /// triangles: the paper's tree when one fits, else slabs (or what
+    /// `self.planner` forces).
+    fn choose(
+        &self,
+        cleaned: &tet_build::scene::Scene,
+        bounds: (glam::Vec3, glam::Vec3),
+        triangles: usize,
+    ) -> Result<(Split, usize)> {
+        let (scene, limit_bytes) = (self.scene, self.limit_bytes);
+        let own = builder_bytes(triangles);
         let share = |p: usize| SplitOptions {
-            limit_bytes: limit_bytes / p as u64,
+            limit_bytes: worker_share(limit_bytes, triangles, p),
             ..SplitOptions::default()
         };
         let max_parallel = self.max_parallel.max(1);
@@ -254,8 +326,8 @@ impl Limited<'_> {
         // Torus Knots in a Box it cut 10-12 triangles where slabs cut
         // 8-28 340 and was as fast or faster (tet-build's
         // tests/outofcore.rs `trade_torus_knots`). With `p` parts at once
-        // every leaf must be predicted under `limit / p`: the most
-        // parallel `p` with at least `p` leaves is taken.
+        // every leaf must be predicted under its share: the most parallel
+        // `p` with at least `p` leaves is taken.
         let tree = (self.planner != Planner::Slabs)
             .then(|| {
                 (1..=max_parallel).rev().find_map(|p| {
@@ -266,16 +338,18 @@ impl Limited<'_> {
                 })
             })
             .flatten();
-        let chosen = match (tree, self.planner) {
-            (Some(t), _) => t,
+        match (tree, self.planner) {
+            (Some(t), _) => Ok(t),
             (None, Planner::Tree) => bail!(
-                "no recursive split of `{}` keeps every part's predicted TetGen peak under {:.1} MiB: raise --memory-limit or try --planner slabs",
+                "no recursive split of `{}` keeps every part's predicted TetGen peak under {:.1} MiB (the limit {:.1} MiB less this process's own {:.1} MiB and its share of each part): raise --memory-limit or try --planner slabs",
                 scene.name,
-                mib(limit_bytes)
+                mib(share(1).limit_bytes),
+                mib(limit_bytes),
+                mib(own)
             ),
             (None, _) => {
                 // Slabs: one worker at a time, slabs predicted under the
-                // limit; with `p` at once under `limit / p` (more slabs,
+                // share; with `p` at once under a `p`-th of it (more slabs,
                 // more cut triangles and seam tets). The most parallel plan
                 // with at least `p` slabs and at most twice as many as the
                 // one-at-a-time plan.
@@ -283,9 +357,11 @@ impl Limited<'_> {
                     |p: usize| plan_slabs(&cleaned.vertices, &cleaned.triangles, bounds, &share(p));
                 let Some(base) = slabs(1) else {
                     bail!(
-                        "no split of `{}` keeps every part's predicted TetGen peak under {:.1} MiB (an empty part alone is predicted {:.1} MiB, and every part carries its seams and box): raise --memory-limit",
+                        "no split of `{}` keeps every part's predicted TetGen peak under {:.1} MiB (the limit {:.1} MiB less this process's own {:.1} MiB and its share of the part; an empty part alone is predicted {:.1} MiB, and every part carries its seams and box): raise --memory-limit",
                         scene.name,
+                        mib(share(1).limit_bytes),
                         mib(limit_bytes),
+                        mib(own),
                         mib(SplitOptions::default().model.predict(0, 0))
                     );
                 };
@@ -301,34 +377,9 @@ impl Limited<'_> {
                             .map(|plan| (plan, p))
                     })
                     .unwrap_or((base, 1));
-                (Split::Slabs(plan), p)
+                Ok((Split::Slabs(plan), p))
             }
-        };
-        let (split, parallel) = chosen;
-        let options = SeamOptions {
-            enclosing_box: box_spec,
-            tetgen: flags.tetgen_options(),
-            isolation: crate::load::worker_isolation(flags.time_limit)?,
-            parallel_parts: parallel,
-            resolve: (!flags.no_resolve).then(Default::default),
-        };
-        Ok(Some(Plan {
-            start,
-            predicted,
-            split,
-            parallel,
-            options,
-            clean_s,
-            scene_triangles: cleaned.triangles.len(),
-            scene_vertices: cleaned.vertices.len(),
-            cleaning: CleaningSummary {
-                merged_vertices: cm.report.merged_vertices.len(),
-                repeated_vertex_triangles: cm.report.repeated_vertex_triangles.len(),
-                zero_area_triangles: cm.report.zero_area_triangles.len(),
-                duplicate_triangles: cm.report.duplicate_triangles.len(),
-                unused_vertices: cm.report.unused_vertices.len(),
-            },
-        }))
+        }
     }
 
     /// Builds the planned split with `tree` or `slabs` (in memory or to a
@@ -437,6 +488,8 @@ impl Limited<'_> {
             merge_all_parts_bytes: s.map(|s| s.all_parts_bytes),
             part_file_bytes: s.map(|s| s.part_file_bytes),
             process_peak_kib: tet_build::tetgen::worker::peak_memory_kib(),
+            own_bytes: plan.own_bytes,
+            tree_peak_kib: None,
         };
         (summary, memory)
     }

@@ -36,6 +36,7 @@ pub fn predict(scene: &Scene, no_box: bool) -> Result<Prediction> {
             bytes_per_element: m.bytes_per_element,
             margin: m.margin,
         },
+        builder_bytes: tet_build::outofcore::admission::builder_bytes(scene.triangles.len()),
     })
 }
 

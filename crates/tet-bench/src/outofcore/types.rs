@@ -1,7 +1,7 @@
 //! The plain data of a build under a memory limit: the prediction, the
 //! request ([`Limited`]) and what the build did ([`MemoryReport`]).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use tet_build::scene::Scene;
 
 use crate::cli::{BuildFlags, Planner};
@@ -25,6 +25,11 @@ pub struct Prediction {
     pub predicted_peak_bytes: u64,
     /// The model: `margin × (base_bytes + bytes_per_element × (points + triangles))`.
     pub model: ModelDoc,
+    /// What a local `build --memory-limit` of this scene sets aside for
+    /// itself from the limit (its process; TetGen workers get the rest),
+    /// bytes: the in-core build is taken when the limit is at least this
+    /// plus 5/4 of `predicted_peak_bytes`.
+    pub builder_bytes: u64,
 }
 
 /// The memory model's constants.
@@ -40,7 +45,7 @@ pub struct ModelDoc {
 
 /// What a build under `--memory-limit` did (field `memory` of the `build`
 /// document, and rows of the out-of-core table).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MemoryReport {
     /// The limit, bytes.
     pub limit_bytes: u64,
@@ -99,6 +104,14 @@ pub struct MemoryReport {
     /// was done: planner, finished parts, merge (the TetGen workers are
     /// processes of their own: `part_peak_kib`); `null` without `/proc`.
     pub process_peak_kib: Option<u64>,
+    /// What this process set aside for itself from the limit before the
+    /// workers' shares (a model of its own memory from the scene's
+    /// triangles: `tet_build::outofcore::admission::builder_bytes`), bytes.
+    pub own_bytes: u64,
+    /// Peak resident memory of the whole process tree during the build
+    /// (this process and every TetGen worker together, sampled every
+    /// 2 ms), KiB: what the limit bounds; `null` without `/proc`.
+    pub tree_peak_kib: Option<u64>,
 }
 
 /// A build under a memory limit.

@@ -123,7 +123,7 @@ fn measure_scene(
     let out_of_core = if args.quick || !planned.first {
         Vec::new()
     } else {
-        out_of_core::measure(&loaded, &TABLE_FLAGS, &planned.extra, opts, frames, pool)
+        out_of_core::measure(spec, &loaded, opts, frames, pool)
     };
     Ok(SceneResult {
         ray_strips,

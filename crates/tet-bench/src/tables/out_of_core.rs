@@ -2,17 +2,26 @@
 //! each scene built in parts under ½ and ⅓ of its in-core TetGen peak,
 //! with build time, parts, peaks, tet quality and tet20 speed (full mode,
 //! first scene of each geometry only).
+//!
+//! Each limited build runs as `tet-bench build SCENE --memory-limit L
+//! --json` in a process of its own, as a user runs it: the limit bounds
+//! that process and its TetGen workers together, and this harness, which
+//! holds other meshes, would not fit under it. The merged mesh is read
+//! back from the file it wrote.
 
 use std::fmt::Write as _;
+use std::path::Path;
+use std::process::Command;
 
-use glam::Vec3;
+use anyhow::{Context, Result, bail};
+
 use tet_core::TetMesh;
 use tet_trace_cpu::render::RenderOptions;
 
-use super::doc::{OutOfCoreRow, Quality, TablesDoc};
-use crate::cli::{BuildFlags, Method};
+use super::doc::{OutOfCoreRow, Quality, TABLE_FLAGS, TablesDoc};
+use crate::cli::Method;
 use crate::load::{Loaded, with_mesh};
-use crate::outofcore::{build_limited, predict};
+use crate::outofcore::{MemoryReport, predict};
 use crate::output::error_chain;
 use crate::timing::time_method;
 
@@ -32,9 +41,8 @@ fn quality(mesh: &TetMesh) -> Option<Quality> {
 /// Out-of-core builds of a scene under ½ and ⅓ of its in-core TetGen
 /// peak, and tet20 on each merged mesh.
 pub fn measure(
+    spec: &str,
     loaded: &Loaded,
-    flags: &BuildFlags,
-    extra: &[Vec3],
     opts: &RenderOptions,
     frames: u32,
     pool: &rayon::ThreadPool,
@@ -44,7 +52,7 @@ pub fn measure(
     };
     let peak_bytes = match build.worker_peak_kib {
         Some(k) => k * 1024,
-        None => match predict(scene, flags.no_box) {
+        None => match predict(scene, TABLE_FLAGS.no_box) {
             Ok(p) => p.predicted_peak_bytes,
             Err(_) => return Vec::new(),
         },
@@ -71,13 +79,18 @@ pub fn measure(
             quality: None,
             error: None,
         };
-        let result = build_limited(scene, flags, limit, threads, false, extra).and_then(
-            |(mesh, summary, memory)| {
-                let merged = with_mesh(scene.clone(), mesh, Some(summary));
+        let file = std::env::temp_dir().join(format!(
+            "tet-bench-out-of-core-{}-{}.tmesh",
+            std::process::id(),
+            rows.len()
+        ));
+        let result =
+            build_in_own_process(spec, limit, threads, &file).and_then(|(mesh, memory)| {
+                let merged = with_mesh(scene.clone(), mesh, None);
                 let tet20 = time_method(&merged, Method::Tet20, opts, frames, pool)?.0;
                 Ok((merged.mesh.tets.len(), memory, tet20, quality(&merged.mesh)))
-            },
-        );
+            });
+        let _ = std::fs::remove_file(&file);
         match result {
             Ok((tets, memory, tet20, q)) => {
                 row.tets = tets;
@@ -92,6 +105,42 @@ pub fn measure(
     rows
 }
 
+/// `tet-bench build SPEC -o FILE --memory-limit LIMIT --threads THREADS
+/// --json`, with `build`'s default flags (the tables' own): the merged
+/// mesh, read back, and the build's memory report.
+fn build_in_own_process(
+    spec: &str,
+    limit: u64,
+    threads: usize,
+    file: &Path,
+) -> Result<(TetMesh, MemoryReport)> {
+    let exe = std::env::current_exe().context("cannot find this executable")?;
+    let out = Command::new(&exe)
+        .arg("build")
+        .arg(spec)
+        .arg("-o")
+        .arg(file)
+        .args(["--memory-limit", &limit.to_string()])
+        .args(["--threads", &threads.to_string()])
+        .arg("--json")
+        .output()
+        .with_context(|| format!("cannot run {}", exe.display()))?;
+    if !out.status.success() {
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        bail!(
+            "{}",
+            stderr.trim().lines().last().unwrap_or("the build failed")
+        );
+    }
+    let doc: serde_json::Value =
+        serde_json::from_slice(&out.stdout).context("the build's --json output")?;
+    let memory: MemoryReport =
+        serde_json::from_value(doc["memory"].clone()).context("the build's memory report")?;
+    let mesh = tet_core::format::load(file)
+        .with_context(|| format!("cannot read back {}", file.display()))?;
+    Ok((mesh, memory))
+}
+
 /// The table (or why there is none).
 pub fn markdown(m: &mut String, doc: &TablesDoc) {
     let _ = writeln!(
@@ -104,7 +153,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     }
     let _ = writeln!(
         m,
-        "Limits are ½ and ⅓ of the in-core TetGen worker's measured peak; the scene is split recursively (seed 003's planes, or slabs when no tree fits) until the parts' *predicted* peaks fit, built by parallel workers (as many at once as fit the limit together) with exact seams, merged and Hilbert-sorted. Parts are given as count, workers at once, planner and depth. Peaks are the workers' measured `VmHWM`; aspect ratio = longest edge ÷ smallest height (seed 003 Table 3).\n"
+        "Limits are ½ and ⅓ of the in-core TetGen worker's measured peak, on the whole process tree: each limited build runs as `tet-bench build SCENE --memory-limit L` in a process of its own, which sets its own resident memory aside, splits the scene recursively (seed 003's planes, or slabs when no tree fits) until the parts' *predicted* peaks fit what is left, starts parallel workers only while they fit together, and streams the merged mesh (exact seams, each part Hilbert-sorted) to a file read back for tet20. Parts are given as count, workers at once, planner and depth. Part peaks are the workers' measured `VmHWM`; tree peak is the builder and its workers together (resident memory sampled every 2 ms), what the limit bounds; aspect ratio = longest edge ÷ smallest height (seed 003 Table 3).\n"
     );
     let _ = writeln!(
         m,
@@ -112,9 +161,12 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     );
     let _ = writeln!(
         m,
-        "| scene | limit | limit MiB | parts (at once) | triangles cut | build s | × in-core | max part peak MiB | tets | aspect mean / max | tet20 Mrays/s |"
+        "| scene | limit | limit MiB | parts (at once) | triangles cut | build s | × in-core | max part peak MiB | tree peak MiB | tets | aspect mean / max | tet20 Mrays/s |"
     );
-    let _ = writeln!(m, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        m,
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
     let aspect = |q: &Option<Quality>| {
         q.as_ref().map_or("–".into(), |q| {
             format!("{:.2} / {:.0}", q.aspect_mean, q.aspect_max)
@@ -136,7 +188,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
             .map_or(f64::NAN, |r| r.mrays_per_s);
         let _ = writeln!(
             m,
-            "| {name} | in core | – | 1 | 0 | {:.2} | 1.00 | {} | {} | {} | {:.2} |",
+            "| {name} | in core | – | 1 | 0 | {:.2} | 1.00 | {} | – | {} | {} | {:.2} |",
             first.in_core_s,
             mib(first.in_core_peak_kib),
             first.in_core_tets,
@@ -149,7 +201,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
                 (Some(mem), _) => {
                     let _ = writeln!(
                         m,
-                        "| {name} | {label} | {:.1} | {} ({} at once, {} depth {}) | {} | {:.2} | {:.2} | {} | {} | {} | {:.2} |",
+                        "| {name} | {label} | {:.1} | {} ({} at once, {} depth {}) | {} | {:.2} | {:.2} | {} | {} | {} | {} | {:.2} |",
                         mem.limit_bytes as f64 / (1024.0 * 1024.0),
                         mem.parts,
                         mem.parallel_parts,
@@ -159,6 +211,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
                         mem.total_s,
                         mem.total_s / r.in_core_s,
                         mib(mem.max_part_peak_kib),
+                        mib(mem.tree_peak_kib),
                         r.tets,
                         aspect(&r.quality),
                         r.tet20.as_ref().map_or(f64::NAN, |t| t.mrays_per_s)
@@ -167,7 +220,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
                 (None, e) => {
                     let _ = writeln!(
                         m,
-                        "| {name} | {label} | failed: {} | | | | | | | | |",
+                        "| {name} | {label} | failed: {} | | | | | | | | | |",
                         e.as_deref().unwrap_or("")
                     );
                 }

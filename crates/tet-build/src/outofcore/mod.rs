@@ -33,6 +33,8 @@
 //!   keeps every facet.
 //! * `prepare`: the whole scene cleaned and, by default, its
 //!   self-intersections resolved ([`crate::resolve`]) before any cut.
+//! * [`admission`]: parts start only while the process tree fits the
+//!   limit ([`seam::SeamOptions::tree_limit_bytes`]).
 //! * `parts`: each part's TetGen run (parts run concurrently in worker
 //!   processes with `parallel_parts`) and the [`seam::SeamReport`].
 //! * `merge`: what becomes of finished parts. In memory: exact point
@@ -56,6 +58,8 @@
 //!   [`tree::build_tree_to_file`],
 //!   [`tree::build_tree_with_memory_limit_to_file`] stream).
 //! * [`report`]: tet quality at the seams vs elsewhere.
+//! * [`tree_memory`]: the resident memory of the whole process tree (the
+//!   builder and its TetGen workers), what a limit on one machine bounds.
 //! * [`job`]: the same build as a job any engine can run: a plan and one
 //!   input file per part in a directory, each part built by its own
 //!   process in any order ([`job::build_part`]), then the streamed merge
@@ -78,7 +82,11 @@
 //!   run, one finished part (TetGen's output, then its assembled and
 //!   sorted [`tet_core::TetMesh`]) per worker thread; the streamed merge
 //!   then holds one part plus the seam maps. The in-memory merge (and
-//!   the whole-mesh Hilbert sort after it) holds the whole mesh.
+//!   the whole-mesh Hilbert sort after it) holds the whole mesh. A caller
+//!   that bounds its whole process tree plans with
+//!   [`admission::worker_share`] and sets
+//!   [`seam::SeamOptions::tree_limit_bytes`], so that workers start only
+//!   while they fit beside it ([`admission`]).
 //! * The streamed mesh is Hilbert-sorted within each part only: the
 //!   whole-mesh order needs the whole mesh in memory.
 //! * A Steiner point whose f32 rounding flattens a tet is an error
@@ -89,6 +97,7 @@
 //!   points with the vertex); [`split::plan_slabs`] avoids such planes and
 //!   [`tree::build_tree_with_memory_limit`] moves them.
 
+pub mod admission;
 pub mod error;
 pub mod job;
 pub mod memory_model;
@@ -103,3 +112,4 @@ mod section;
 pub mod split;
 pub mod stream;
 pub mod tree;
+pub mod tree_memory;

@@ -7,6 +7,7 @@ use std::collections::HashMap;
 use glam::{DVec3, Vec3};
 use tet_core::face_key;
 
+use super::admission::Admission;
 use super::error::SeamError;
 use super::plane::{SplitPlane, key};
 use crate::bbox::BoxSpec;
@@ -63,6 +64,13 @@ pub struct SeamOptions {
     /// time; 0 or 1 = one after the other). Only worth it with
     /// [`Isolation::Worker`]: in-process TetGen runs are serialized.
     pub parallel_parts: usize,
+    /// A limit on the resident memory of the whole process tree (this
+    /// process and its workers), bytes: a part's worker starts only while
+    /// this process's resident memory, the parts already running and this
+    /// part's prediction (with this process's share of its result) fit
+    /// it ([`super::admission`]); one part alone always starts. `None`:
+    /// `parallel_parts` alone decides.
+    pub tree_limit_bytes: Option<u64>,
     /// Resolve the cleaned scene's self-intersections before splitting it
     /// ([`crate::resolve`], as the in-core build does); `None` hands
     /// crossing triangles to TetGen as they are.
@@ -78,6 +86,7 @@ impl Default for SeamOptions {
             tetgen: TetgenOptions::default(),
             isolation: Isolation::default(),
             parallel_parts: 0,
+            tree_limit_bytes: None,
             resolve: Some(ResolveOptions::default()),
         }
     }
@@ -186,10 +195,21 @@ impl PartPlc {
     }
 }
 
+/// Runs TetGen on one part's facets and checks the result.
 pub(super) fn run_part(
     part: usize,
     facets: &[([Vec3; 3], FacetKind)],
     box_faces: &[[Vec3; 3]],
+    options: &SeamOptions,
+) -> Result<PartMesh, SeamError> {
+    run_plc(part, facets, PartPlc::new(facets, box_faces), options)
+}
+
+/// Runs TetGen on a part's PLC (made of `facets`) and checks the result.
+fn run_plc(
+    part: usize,
+    facets: &[([Vec3; 3], FacetKind)],
+    plc: PartPlc,
     options: &SeamOptions,
 ) -> Result<PartMesh, SeamError> {
     let PartPlc {
@@ -197,7 +217,7 @@ pub(super) fn run_part(
         input,
         wall_points,
         wall_triangles,
-    } = PartPlc::new(facets, box_faces);
+    } = plc;
     let mut topts = options.tetgen.clone();
     topts.preserve_surface = true;
     let out = match tetrahedralize(&input, &topts, &options.isolation) {
@@ -304,7 +324,8 @@ pub(super) fn self_intersection(
     }
 }
 
-/// Runs TetGen on every part, at most `options.parallel_parts` at a time:
+/// Runs TetGen on every part, at most `options.parallel_parts` at a time
+/// (and, under `options.tree_limit_bytes`, only as many as fit it):
 /// that many threads take the next part from a queue as soon as their
 /// previous one finishes (largest input first, so a big part does not
 /// start last), which keeps both threads busy when parts differ in size.
@@ -326,6 +347,7 @@ pub(super) fn run_parts<T: Send>(
         (0..parts.len()).map(|_| Mutex::new(None)).collect();
     let next = AtomicUsize::new(0);
     let failed = AtomicBool::new(false);
+    let admission = Admission::new(options.tree_limit_bytes);
     let work = || {
         loop {
             let i = next.fetch_add(1, Ordering::Relaxed);
@@ -333,7 +355,11 @@ pub(super) fn run_parts<T: Send>(
                 break;
             }
             let k = order[i];
-            let r = run_part(k, &parts[k], &faces[k], options).and_then(|m| finish(k, m));
+            let plc = PartPlc::new(&parts[k], &faces[k]);
+            // Held until the part is handed on: this process's share of
+            // the result counts as long as the worker's.
+            let _ticket = admission.enter(plc.predicted_peak_bytes());
+            let r = run_plc(k, &parts[k], plc, options).and_then(|m| finish(k, m));
             if r.is_err() {
                 failed.store(true, Ordering::Relaxed);
             }
