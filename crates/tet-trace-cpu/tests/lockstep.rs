@@ -18,58 +18,13 @@ use tet_trace_cpu::kernel::{Interleaved, WalkTracer};
 use tet_trace_cpu::lockstep::{
     Width, trace_lockstep_at, trace_lockstep_avx2, trace_lockstep_portable, trace_lockstep_sctp,
 };
-use tet_trace_cpu::reference::{Aim, random_direction, random_point_inside, ray_from_feature};
+use tet_trace_cpu::reference::{Aim, random_point_inside, ray_from_feature};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Topology;
 use tet_trace_cpu::{DuffF32, Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint, locate};
 
 mod common;
-use common::{bits, grid};
-
-/// A batch from one origin: random directions, directions exactly at mesh
-/// vertices, edge midpoints and face centroids, axis directions, some with a
-/// `t_min`/`t_max` window, and a few invalid rays.
-fn batch(mesh: &TetMesh, rng: &mut SplitMix64, origin: Vec3, n: usize) -> Vec<Ray> {
-    let pt =
-        |rng: &mut SplitMix64| mesh.points[(rng.next_u64() % mesh.points.len() as u64) as usize];
-    (0..n)
-        .map(|i| {
-            let dir = match i % 7 {
-                0 | 1 => random_direction(rng),
-                2 => pt(rng) - origin,
-                3 => (pt(rng) + pt(rng)) * 0.5 - origin,
-                4 => {
-                    let t = mesh.tets[(rng.next_u64() % mesh.tets.len() as u64) as usize];
-                    let f = t.map(|v| mesh.points[v as usize]);
-                    (f[0] + f[1] + f[2]) / 3.0 - origin
-                }
-                5 => {
-                    let mut d = Vec3::ZERO;
-                    d[(rng.next_u64() % 3) as usize] = if rng.next_u64().is_multiple_of(2) {
-                        1.0
-                    } else {
-                        -1.0
-                    };
-                    d
-                }
-                _ => {
-                    if rng.next_u64().is_multiple_of(4) {
-                        Vec3::ZERO // invalid: reported, not traced
-                    } else {
-                        random_direction(rng)
-                    }
-                }
-            };
-            let mut r = Ray::new(origin, dir);
-            match rng.next_u64() % 5 {
-                0 => r.t_min = rng.range_f32(0.0, 2.0),
-                1 => r.t_max = rng.range_f32(0.0, 2.0),
-                _ => {}
-            }
-            r
-        })
-        .collect()
-}
+use common::{batch, bits, grid};
 
 /// The lockstep batch (dispatching, and portable at 1, 3, 4 and 8 lanes)
 /// equals the scalar single-ray walk and the interleaved batch bit for bit.

@@ -16,12 +16,12 @@ use tet_core::TetMesh;
 use tet_core::predicates::orient3d_f32;
 use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::lockstep::Width;
-use tet_trace_cpu::reference::{Aim, random_direction, random_point_inside, ray_from_feature};
+use tet_trace_cpu::reference::{Aim, random_point_inside, ray_from_feature};
 use tet_trace_cpu::tet80::Tet80Tracer;
 use tet_trace_cpu::{Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint, locate};
 
 mod common;
-use common::{adversarial_rays, bits, grid};
+use common::{adversarial_rays, batch, bits, grid};
 
 /// A fresh output buffer that no walk's outcome equals.
 fn fresh(n: usize) -> Vec<TraceOutcome> {
@@ -119,42 +119,6 @@ fn check_both(mesh: &TetMesh, rays: &[Ray], starts: Starts<'_>, cap: Option<u32>
     let consistent = one(Tet80Tracer::consistent(mesh).unwrap(), rays, starts, cap);
     assert_eq!(faithful, consistent);
     faithful
-}
-
-/// Rays from `origin`: random directions, directions exactly at mesh
-/// vertices, edge midpoints and face centroids, along the axes, some with
-/// a `t_min`/`t_max` window, and a few invalid ones.
-fn batch(mesh: &TetMesh, rng: &mut SplitMix64, origin: Vec3, n: usize) -> Vec<Ray> {
-    let pt =
-        |rng: &mut SplitMix64| mesh.points[(rng.next_u64() % mesh.points.len() as u64) as usize];
-    (0..n)
-        .map(|i| {
-            let dir = match i % 7 {
-                0 | 1 => random_direction(rng),
-                2 => pt(rng) - origin,
-                3 => (pt(rng) + pt(rng)) * 0.5 - origin,
-                4 => {
-                    let t = mesh.tets[(rng.next_u64() % mesh.tets.len() as u64) as usize];
-                    let f = t.map(|v| mesh.points[v as usize]);
-                    (f[0] + f[1] + f[2]) / 3.0 - origin
-                }
-                5 => {
-                    let mut d = Vec3::ZERO;
-                    d[(rng.next_u64() % 3) as usize] = 1.0 - 2.0 * (rng.next_u64() % 2) as f32;
-                    d
-                }
-                _ if rng.next_u64().is_multiple_of(4) => Vec3::ZERO, // invalid
-                _ => random_direction(rng),
-            };
-            let mut r = Ray::new(origin, dir);
-            match rng.next_u64() % 5 {
-                0 => r.t_min = rng.range_f32(0.0, 2.0),
-                1 => r.t_max = rng.range_f32(0.0, 2.0),
-                _ => {}
-            }
-            r
-        })
-        .collect()
 }
 
 /// Batches from random, vertex and edge-midpoint origins (one start for

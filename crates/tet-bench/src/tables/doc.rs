@@ -87,9 +87,11 @@ pub struct SceneResult {
 /// One out-of-core build of a scene.
 #[derive(Clone, Debug, Serialize)]
 pub struct OutOfCoreRow {
-    /// Fraction of the in-core peak used as the limit (0.5, 0.333…).
+    /// Fraction of the in-core peak in the limit (0.5, 0.333…): the limit
+    /// is the builder's own share (`memory.own_bytes`) plus this fraction
+    /// of the in-core TetGen peak.
     pub fraction: f64,
-    /// The in-core build's measured TetGen peak, KiB (the limit is a
+    /// The in-core build's measured TetGen peak, KiB (the limit holds a
     /// fraction of it; of the prediction when not measured).
     pub in_core_peak_kib: Option<u64>,
     /// The in-core build's total seconds.
