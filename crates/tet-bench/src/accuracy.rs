@@ -58,6 +58,7 @@ pub use crate::adversarial::adversarial_rays;
 use crate::bvh::unit_scale;
 use crate::cli::{BuildFlags, Method, Precision};
 use crate::extremes;
+use crate::failed_rays::{FailedRay, KEPT, ReferenceHit};
 use crate::load::Loaded;
 use crate::methods::{has_f64, tracer};
 use crate::output::error_chain;
@@ -387,6 +388,9 @@ pub struct MethodAccuracy {
     /// repeated passes over the same rays, timed for at least
     /// [`RayPlan::min_time_s`] in all (and at least [`MIN_PASSES`] passes).
     pub mrays_per_s: f64,
+    /// The first failing rays ([`crate::failed_rays::KEPT`] at most), to
+    /// reproduce them.
+    pub failed_rays: Vec<FailedRay>,
 }
 
 /// One case: the scene as given, or transformed (JSON `cases[]`).
@@ -562,7 +566,7 @@ impl MethodAccuracy {
         expected: &[Option<RefHit>],
     ) {
         self.rays += set.rays.len() as u64;
-        for (((ray, _), o), e) in set.rays.iter().zip(outcomes).zip(expected) {
+        for (((ray, start), o), e) in set.rays.iter().zip(outcomes).zip(expected) {
             // The method's own hit grazes an edge of its triangle, or lies
             // within the tolerance of the origin (a ray started on a surface
             // may count it or not): the reference may rightly have decided
@@ -572,7 +576,20 @@ impl MethodAccuracy {
                 (h.t as f64).abs() * d.length() < reference.tol
                     || reference.near_edge(h.face, ray, ray.origin.as_dvec3() + d * h.t as f64)
             };
-            self.count(classify(o, e.as_ref(), own_hit_grazes));
+            let verdict = classify(o, e.as_ref(), own_hit_grazes);
+            self.count(verdict);
+            if !matches!(verdict, Verdict::Agree | Verdict::Ambiguous)
+                && self.failed_rays.len() < KEPT
+            {
+                let r = e.as_ref().map(|r| ReferenceHit {
+                    triangle: r.triangle,
+                    t: r.t,
+                    near_edge: r.near_edge,
+                    closed: r.closed,
+                });
+                let kept = FailedRay::new(format!("{verdict:?}"), ray, start.as_ref(), o, r);
+                self.failed_rays.push(kept);
+            }
         }
     }
 

@@ -34,6 +34,7 @@ mod commands;
 mod embree;
 mod exitface;
 mod extremes;
+mod failed_rays;
 mod gpu;
 mod iso;
 mod layouts;

@@ -895,6 +895,25 @@ fn accuracy_counters_partition_the_rays_and_leaks_are_failures() {
             "{m}"
         );
         assert_eq!(n(m, "rays"), 1000 + 16 * 16);
+        // The first failing rays are kept to reproduce them, each with
+        // the verdict it was counted under.
+        let kept = m["failed_rays"].as_array().unwrap();
+        assert_eq!(kept.len() as u64, failures.min(8), "{m}");
+        for f in kept {
+            let key = match f["verdict"].as_str().unwrap() {
+                "Leak" => "leaks",
+                "WrongTriangle" => "wrong_triangle",
+                "FalseMiss" => "false_misses",
+                "FalseHit" => "false_hits",
+                "StepCap" => "step_cap",
+                "Lost" => "lost",
+                "Invalid" => "invalid",
+                "Nan" => "nans",
+                v => panic!("not a failure: {v}"),
+            };
+            assert!(n(m, key) > 0, "{f}");
+            assert_eq!(f["direction"].as_array().unwrap().len(), 3);
+        }
     }
 }
 
