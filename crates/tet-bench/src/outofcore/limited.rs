@@ -49,8 +49,6 @@ struct Plan {
     options: SeamOptions,
     /// Seconds spent cleaning the scene.
     clean_s: f64,
-    /// This process's resident memory set aside from the limit, bytes.
-    own_bytes: u64,
     /// Scene triangles after cleaning.
     scene_triangles: usize,
     /// Scene vertices after cleaning.
@@ -275,8 +273,7 @@ impl Limited<'_> {
         let box_spec = crate::load::enclosing_box(scene, self.extra, flags.wide_box);
         let b = EnclosingBox::new(cleaned.bounds(), box_spec)
             .with_context(|| format!("cannot build the enclosing box of `{}`", scene.name))?;
-        let chosen = self.choose(&cleaned, (b.min, b.max), scene.triangles.len())?;
-        let (split, parallel) = chosen;
+        let (split, parallel) = self.choose(&cleaned, (b.min, b.max), scene.triangles.len())?;
         let options = SeamOptions {
             enclosing_box: box_spec,
             tetgen: flags.tetgen_options(),
@@ -292,7 +289,6 @@ impl Limited<'_> {
             parallel,
             options,
             clean_s,
-            own_bytes: builder_bytes(scene.triangles.len()),
             scene_triangles: cleaned.triangles.len(),
             scene_vertices: cleaned.vertices.len(),
             cleaning: CleaningSummary {
@@ -488,7 +484,7 @@ impl Limited<'_> {
             merge_all_parts_bytes: s.map(|s| s.all_parts_bytes),
             part_file_bytes: s.map(|s| s.part_file_bytes),
             process_peak_kib: tet_build::tetgen::worker::peak_memory_kib(),
-            own_bytes: plan.own_bytes,
+            own_bytes: builder_bytes(self.scene.triangles.len()),
             tree_peak_kib: None,
         };
         (summary, memory)

@@ -28,11 +28,7 @@ pub const SAMPLE_INTERVAL: Duration = Duration::from_millis(2);
 /// The resident set (`VmRSS`) of process `pid` now, KiB; `None` where
 /// `/proc` is unavailable, the process is gone or is a zombie.
 pub fn resident_kib(pid: u32) -> Option<u64> {
-    let text = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
-    text.lines()
-        .find_map(|l| l.strip_prefix("VmRSS:"))
-        .and_then(|rest| rest.split_whitespace().next())
-        .and_then(|n| n.parse().ok())
+    crate::tetgen::worker::status_kib(&pid.to_string(), "VmRSS:")
 }
 
 /// The resident set (`VmRSS`) of this process now, bytes (0 without

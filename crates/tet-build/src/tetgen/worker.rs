@@ -55,10 +55,17 @@ const STATUS_BAD_REQUEST: i32 = -100;
 /// Peak resident set size of this process (`VmHWM` in `/proc/self/status`), KiB.
 /// `None` where `/proc` is unavailable.
 pub fn peak_memory_kib() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    status_kib("self", "VmHWM:")
+}
+
+/// Field `key` (e.g. `"VmRSS:"`) of `/proc/PROCESS/status` in KiB, for
+/// `PROCESS` a pid or `self`; `None` where `/proc` is unavailable, the
+/// process is gone or lacks the field (a zombie).
+pub fn status_kib(process: &str, key: &str) -> Option<u64> {
+    let status = std::fs::read_to_string(format!("/proc/{process}/status")).ok()?;
     status
         .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .find_map(|l| l.strip_prefix(key))
         .and_then(|rest| rest.split_whitespace().next())
         .and_then(|n| n.parse().ok())
 }
