@@ -1,5 +1,6 @@
 //! Out of core under a memory limit (Erkoç et al., seed 003 Tables 2–3):
-//! each scene built in parts under ½ and ⅓ of its in-core TetGen peak,
+//! each scene built in parts under the builder's own share plus ½ and ⅓
+//! of its in-core TetGen peak,
 //! with build time, parts, peaks, tet quality and tet20 speed (full mode,
 //! first scene of each geometry only).
 //!
@@ -38,8 +39,8 @@ fn quality(mesh: &TetMesh) -> Option<Quality> {
     })
 }
 
-/// Out-of-core builds of a scene under ½ and ⅓ of its in-core TetGen
-/// peak, and tet20 on each merged mesh.
+/// Out-of-core builds of a scene under the builder's own share plus ½ and
+/// ⅓ of its in-core TetGen peak, and tet20 on each merged mesh.
 pub fn measure(
     spec: &str,
     loaded: &Loaded,
