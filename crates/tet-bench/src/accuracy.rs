@@ -6,17 +6,17 @@
 //! come from a BVH over triangle boxes padded by the tolerance (so the f32
 //! box test cannot drop a triangle the ray passes within tolerance of).
 //!
-//! A ray that **leaks** slipped through a closed surface: the reference hit
-//! lies within `tol` of an edge of its triangle, every edge it lies that
-//! close to is shared by at least two constrained faces (and every vertex
-//! it lies that close to has only such edges around it), the ray crosses
-//! the surface there rather than touching its outline (moved sideways by
-//! `2·tol` in each of eight directions it still passes through a face
-//! around the hit triangle's vertices and meets it within 64·`tol` of the
-//! hit, so that a ray skimming a fold is not taken for one crossing it),
-//! and the method misses or hits
-//! something more than `2·tol` farther along than the reference hit. Leaks are failures, the worst a renderer can make: light
-//! passes through a watertight surface.
+//! A ray that **leaks** slipped through a closed surface: the method
+//! misses, or hits something more than `2·tol` farther along, where every
+//! line within `tol` of the ray crosses the surface — the reference hit
+//! lies within `tol` of edges or vertices of its triangle, and the faces
+//! around them cross every nearby line (an odd number of times; see
+//! [`crate::grazing`]: a ray entering a closed surface across an edge or
+//! through a vertex, not one clipping a convex edge or touching the
+//! outline); or the ray may pass such a grazed part by, and the method
+//! also skips the first watertight face beyond it (skipping one of an open
+//! surface is a wrong triangle or a false miss). Leaks are failures, the
+//! worst a renderer can make: light passes through a watertight surface.
 //!
 //! Otherwise a ray counts as **ambiguous** (grazing), not wrong, when the
 //! reference hit point lies within `tol` of an edge of its triangle (or
@@ -29,7 +29,6 @@
 //! for scenes far from the origin). A reference hit within `tol` of the ray
 //! origin is never a leak: the method may rightly place it behind the origin.
 
-use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
@@ -47,10 +46,7 @@ use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::Viewpoint;
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Failure, Hit, Ray, TraceOutcome};
-use tet_trace_cpu::reference::{
-    Aim, edge_distance, line_edge_distance, line_triangle, random_ray, ray_triangle,
-    segment_distance,
-};
+use tet_trace_cpu::reference::{Aim, edge_distance, line_edge_distance, random_ray, ray_triangle};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Start;
 
@@ -59,6 +55,7 @@ use crate::bvh::unit_scale;
 use crate::cli::{BuildFlags, Method, Precision};
 use crate::extremes;
 use crate::failed_rays::{FailedRay, KEPT, ReferenceHit};
+use crate::grazing::{Graze, Surface};
 use crate::load::Loaded;
 use crate::methods::{has_f64, tracer};
 use crate::output::error_chain;
@@ -76,15 +73,28 @@ pub(crate) struct RefHit {
     tol_t: f64,
     /// The hit point lies within `tol` of an edge of its face.
     near_edge: bool,
-    /// Every edge and vertex of the face that the hit point lies within
-    /// `tol` of is closed (see [`EdgeSharing`]), and the ray crosses the
-    /// surface there ([`Reference::crosses`]): a watertight part of the
-    /// surface is crossed. Meaningful with `near_edge`.
+    /// Every line within `tol` of the ray crosses the surface around the
+    /// edges and vertices the hit point grazes ([`Graze::MustCross`]): a
+    /// watertight part of the surface is crossed. Meaningful with
+    /// `near_edge`.
     closed: bool,
+    /// Where the ray may pass the grazed edges and vertices by
+    /// ([`Graze::MayPass`], e.g. it clips a convex edge): the first face
+    /// beyond them, when the ray meets it away from its edges.
+    beyond: Option<Beyond>,
     /// Another face is hit within `tol` along the ray.
     second_close: bool,
     /// The hit lies within `tol` of the ray origin.
     near_origin: bool,
+}
+
+/// The first face past a grazed part of the surface that a ray may skip.
+#[derive(Clone, Copy, Debug)]
+struct Beyond {
+    /// Its ray parameter.
+    t: f64,
+    /// It lies on a watertight part of the surface (every edge shared).
+    closed: bool,
 }
 
 impl RefHit {
@@ -94,95 +104,39 @@ impl RefHit {
         self.near_edge || self.second_close || self.near_origin
     }
 
-    /// True when `outcome` slipped through the closed surface this hit
-    /// grazes: it misses, or hits more than `2·tol` farther along (beyond
-    /// the window in which the reference looked for a second hit).
-    fn leaked_by(&self, outcome: &TraceOutcome) -> bool {
-        if !(self.near_edge && self.closed) || self.near_origin {
-            return false;
-        }
+    /// True when `outcome` misses, or hits more than `2·tol` beyond `t`
+    /// (beyond the window in which the reference looked for a second hit).
+    fn passes(&self, outcome: &TraceOutcome, t: f64) -> bool {
         match outcome {
             TraceOutcome::Miss { .. } => true,
-            TraceOutcome::Hit(h) => h.t as f64 > self.t + 2.0 * self.tol_t,
+            TraceOutcome::Hit(h) => h.t as f64 > t + 2.0 * self.tol_t,
             TraceOutcome::Failed { .. } => false,
         }
     }
-}
 
-/// Which edges of the constrained faces are closed: shared by at least two
-/// faces (two scene triangles meeting there, or one triangle split by the
-/// tetrahedralization), so that a ray crossing there must hit one of them.
-/// An edge of a single face is open (the boundary of an open surface).
-#[derive(Clone, Debug, Default)]
-struct EdgeSharing {
-    /// Faces per edge, the edge as its sorted vertex pair.
-    faces: HashMap<(u32, u32), u32>,
-    /// Vertices with an open edge.
-    open_vertices: std::collections::HashSet<u32>,
-    /// Faces around each vertex.
-    vertex_faces: HashMap<u32, Vec<u32>>,
-}
-
-/// The edge `a`–`b` as a key of [`EdgeSharing::faces`].
-fn edge_key(a: u32, b: u32) -> (u32, u32) {
-    (a.min(b), a.max(b))
-}
-
-impl EdgeSharing {
-    /// Counts the faces around every edge of `mesh.constrained`.
-    fn new(mesh: &TetMesh) -> Self {
-        let mut faces: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut vertex_faces: HashMap<u32, Vec<u32>> = HashMap::new();
-        for (f, cf) in mesh.constrained.iter().enumerate() {
-            let v = cf.vertices;
-            for k in 0..3 {
-                *faces.entry(edge_key(v[k], v[(k + 1) % 3])).or_default() += 1;
-                vertex_faces.entry(v[k]).or_default().push(f as u32);
-            }
+    /// True when `outcome` slipped through a closed surface: the one this
+    /// hit grazes, where every nearby line crosses it, or the first
+    /// watertight face beyond a grazed part it may skip.
+    fn leaked_by(&self, outcome: &TraceOutcome) -> bool {
+        if self.near_origin {
+            return false;
         }
-        let open_vertices = faces
-            .iter()
-            .filter(|(_, n)| **n < 2)
-            .flat_map(|(e, _)| [e.0, e.1])
-            .collect();
-        EdgeSharing {
-            faces,
-            open_vertices,
-            vertex_faces,
+        if self.near_edge && self.closed {
+            return self.passes(outcome, self.t);
         }
+        self.beyond
+            .is_some_and(|b| b.closed && self.passes(outcome, b.t))
     }
 
-    /// True when edge `a`–`b` is shared by at least two faces.
-    fn edge_closed(&self, a: u32, b: u32) -> bool {
-        self.faces.get(&edge_key(a, b)).is_some_and(|n| *n >= 2)
-    }
-
-    /// True when every edge at vertex `v` is closed.
-    fn vertex_closed(&self, v: u32) -> bool {
-        !self.open_vertices.contains(&v)
-    }
-
-    /// True when every edge of face `vertices` (positions `p`) that point
-    /// `x` lies within `tol` of is closed, and so is every vertex within
-    /// `tol` of `x`.
-    fn grazed_closed(&self, vertices: [u32; 3], p: [DVec3; 3], x: DVec3, tol: f64) -> bool {
-        (0..3).all(|k| {
-            let j = (k + 1) % 3;
-            let edge_ok = segment_distance(x, p[k], p[j]) >= tol
-                || self.edge_closed(vertices[k], vertices[j]);
-            let vertex_ok = (x - p[k]).length() >= tol || self.vertex_closed(vertices[k]);
-            edge_ok && vertex_ok
-        })
+    /// True when `outcome` skipped the first face beyond a grazed part
+    /// of the surface it may skip, that face being on an open surface.
+    fn skipped_beyond(&self, outcome: &TraceOutcome) -> bool {
+        !self.near_origin
+            && self
+                .beyond
+                .is_some_and(|b| !b.closed && self.passes(outcome, b.t))
     }
 }
-
-/// How far from the reference hit (in units of the tolerance) the shifted
-/// rays of [`Reference::crosses`] may meet the surface and still count as
-/// crossing it there. A shift of `2·tol` moves the hit on a face met at
-/// angle θ by `2·tol·cot θ` along the ray: rays meeting the surface at
-/// more than about 2° are judged, shallower ones near an edge stay
-/// grazing.
-const CROSSING_WINDOW: f64 = 64.0;
 
 /// f64 reference over a padded-box BVH.
 pub struct Reference<'m> {
@@ -190,8 +144,8 @@ pub struct Reference<'m> {
     mesh: &'m TetMesh,
     /// BVH over the faces' boxes, padded by the tolerance.
     bvh: Bvh2,
-    /// Which face edges are closed.
-    sharing: EdgeSharing,
+    /// The faces around every edge and vertex.
+    surface: Surface,
     /// Grazing tolerance (world units).
     pub tol: f64,
     /// The power of two the BVH was built at ([`unit_scale`]).
@@ -240,7 +194,7 @@ impl<'m> Reference<'m> {
         Reference {
             mesh,
             bvh,
-            sharing: EdgeSharing::new(mesh),
+            surface: Surface::new(mesh),
             tol,
             scale,
         }
@@ -249,6 +203,51 @@ impl<'m> Reference<'m> {
     /// The reference hit of `ray`: its closest constrained face in f64, or
     /// `None` when it hits none.
     fn closest(&self, ray: &Ray) -> Option<RefHit> {
+        let mesh = self.mesh;
+        let dlen = ray.direction.as_dvec3().length();
+        let tol_t = self.tol / dlen;
+        let (t, face, second) = self.first_hit(ray, &[])?;
+        let cf = &mesh.constrained[face as usize];
+        let v = cf.vertices.map(|k| mesh.points[k as usize].as_dvec3());
+        let p = ray.origin.as_dvec3() + ray.direction.as_dvec3() * t;
+        let near_edge = self.near_edge(face, ray, p);
+        let near_origin = t < tol_t;
+        let graze = if near_edge && !near_origin {
+            let d = ray.direction.as_dvec3();
+            self.surface.graze(mesh, cf.vertices, v, p, d, self.tol)
+        } else {
+            Graze::Undecided
+        };
+        // Past a star the ray may skip, the first face beyond it, where
+        // that one is hit away from its edges and from any other face.
+        let beyond = match &graze {
+            Graze::MayPass(star) => self.first_hit(ray, star).and_then(|(bt, bf, b2)| {
+                let q = ray.origin.as_dvec3() + ray.direction.as_dvec3() * bt;
+                let clear = !self.near_edge(bf, ray, q) && b2 - bt >= tol_t;
+                let closed = self
+                    .surface
+                    .face_closed(mesh.constrained[bf as usize].vertices);
+                clear.then_some(Beyond { t: bt, closed })
+            }),
+            _ => None,
+        };
+        Some(RefHit {
+            face,
+            triangle: cf.triangle,
+            t,
+            tol_t,
+            near_edge,
+            closed: graze == Graze::MustCross,
+            beyond,
+            second_close: second - t < tol_t,
+            near_origin,
+        })
+    }
+
+    /// The closest constrained face along `ray` in f64 that is not in
+    /// `skip` (sorted), as `(t, face, t of the next face hit)`; the next
+    /// face is looked for only within `2·tol` (∞ when none is there).
+    fn first_hit(&self, ray: &Ray, skip: &[u32]) -> Option<(f64, u32, f64)> {
         let mesh = self.mesh;
         let dlen = ray.direction.as_dvec3().length();
         let tol_t = self.tol / dlen;
@@ -264,6 +263,9 @@ impl<'m> Reference<'m> {
         let mut hit = RayHit::none();
         self.bvh.ray_traverse(r, &mut hit, |_, id| {
             let face = self.bvh.primitive_indices[id];
+            if skip.binary_search(&face).is_ok() {
+                return f32::INFINITY;
+            }
             let cf = &mesh.constrained[face as usize];
             let v = cf.vertices.map(|k| mesh.points[k as usize]);
             let Some((t, _)) = ray_triangle(ray, v) else {
@@ -284,57 +286,7 @@ impl<'m> Reference<'m> {
             // Keep looking a little beyond the closest hit for the gap test.
             (((best.unwrap().0 + 2.0 * tol_t) * bvh_t) as f32) * (1.0 + 1e-6)
         });
-        let (t, face) = best?;
-        let cf = &mesh.constrained[face as usize];
-        let v = cf.vertices.map(|k| mesh.points[k as usize].as_dvec3());
-        let p = ray.origin.as_dvec3() + ray.direction.as_dvec3() * t;
-        let near_edge = self.near_edge(face, ray, p);
-        Some(RefHit {
-            face,
-            triangle: cf.triangle,
-            t,
-            tol_t,
-            near_edge,
-            closed: near_edge
-                && self.sharing.grazed_closed(cf.vertices, v, p, self.tol)
-                && self.crosses(ray, cf.vertices, p),
-            second_close: second - t < tol_t,
-            near_origin: t < tol_t,
-        })
-    }
-
-    /// True when the ray crosses the surface around face `vertices` at the
-    /// hit point `x` rather than touching it: the ray moved sideways by
-    /// `2·tol` in each of eight directions still passes through a face
-    /// around one of those vertices, within [`CROSSING_WINDOW`]`·tol` of
-    /// `x`. A ray that grazes the outline of a closed surface (both faces
-    /// of the edge on one side of it) fails this, and stays grazing; so
-    /// does one that touches an edge and meets a face of the same ring
-    /// farther along (a ray skimming a fold), which a test of the whole
-    /// line would take for a crossing.
-    fn crosses(&self, ray: &Ray, vertices: [u32; 3], x: DVec3) -> bool {
-        let o = ray.origin.as_dvec3();
-        let d = ray.direction.as_dvec3();
-        let (u, w) = d.normalize().any_orthonormal_pair();
-        let ring: Vec<[DVec3; 3]> = vertices
-            .iter()
-            .flat_map(|v| self.sharing.vertex_faces.get(v).into_iter().flatten())
-            .map(|&f| {
-                self.mesh.constrained[f as usize]
-                    .vertices
-                    .map(|k| self.mesh.points[k as usize].as_dvec3())
-            })
-            .collect();
-        (0..8).all(|k| {
-            let a = k as f64 * std::f64::consts::FRAC_PI_4;
-            let shifted = o + (u * a.cos() + w * a.sin()) * (2.0 * self.tol);
-            ring.iter().any(|&v| {
-                line_triangle(shifted, d, v).is_some_and(|b| {
-                    let hit = v[0] * b[0] + v[1] * b[1] + v[2] * b[2];
-                    (hit - x).length() <= CROSSING_WINDOW * self.tol
-                })
-            })
-        })
+        best.map(|(t, face)| (t, face, second))
     }
 
     /// True when the hit point `p` of `ray` on constrained face `face`
@@ -656,6 +608,8 @@ fn classify(
         }
         (TraceOutcome::Miss { .. }, None) => Verdict::Agree,
         (o, Some(r)) if r.leaked_by(o) => Verdict::Leak,
+        (TraceOutcome::Miss { .. }, Some(r)) if r.skipped_beyond(outcome) => Verdict::FalseMiss,
+        (TraceOutcome::Hit(_), Some(r)) if r.skipped_beyond(outcome) => Verdict::WrongTriangle,
         (_, Some(r)) if r.ambiguous() => Verdict::Ambiguous,
         (TraceOutcome::Hit(h), _) if own_hit_grazes(h) => Verdict::Ambiguous,
         (TraceOutcome::Hit(_), None) => Verdict::FalseHit,
@@ -806,27 +760,30 @@ mod tests {
         }
     }
 
-    /// A method that reports the farthest constrained face along the ray
-    /// (brute force): it passes through every surface but the last.
-    struct Farthest<'m>(&'m TetMesh);
+    /// A method that reports, by brute force, the farthest constrained
+    /// face along the ray (`None`: it passes through every surface but the
+    /// last) or the first one at `t ≥ after`.
+    struct Along<'m>(&'m TetMesh, Option<f64>);
 
-    impl Tracer for Farthest<'_> {
+    impl Tracer for Along<'_> {
         fn name(&self) -> String {
-            "farthest".into()
+            "along".into()
         }
         fn mesh(&self) -> &TetMesh {
             self.0
         }
         fn trace(&self, ray: &Ray, _: Start) -> TraceOutcome {
             let m = self.0;
-            let far = (0..m.constrained.len() as u32)
-                .filter_map(|f| {
-                    let cf = &m.constrained[f as usize];
-                    let (t, b) = ray_triangle(ray, cf.vertices.map(|k| m.points[k as usize]))?;
-                    (t >= 0.0).then_some((t, b, f))
-                })
-                .max_by(|a, b| a.0.total_cmp(&b.0));
-            match far {
+            let crossings = (0..m.constrained.len() as u32).filter_map(|f| {
+                let cf = &m.constrained[f as usize];
+                let (t, b) = ray_triangle(ray, cf.vertices.map(|k| m.points[k as usize]))?;
+                (t >= self.1.unwrap_or(0.0)).then_some((t, b, f))
+            });
+            let pick = match self.1 {
+                None => crossings.max_by(|a, b| a.0.total_cmp(&b.0)),
+                Some(_) => crossings.min_by(|a, b| a.0.total_cmp(&b.0)),
+            };
+            match pick {
                 Some((t, b, f)) => TraceOutcome::Hit(Hit {
                     triangle: m.constrained[f as usize].triangle,
                     face: f,
@@ -929,7 +886,7 @@ mod tests {
             let e = e.expect("the top of the box is hit");
             assert!(e.near_edge && e.ambiguous(), "{e:?}");
         }
-        let m = check(&Farthest(&mesh), "f32", &reference, &exp, &set, 0.0);
+        let m = check(&Along(&mesh, None), "f32", &reference, &exp, &set, 0.0);
         assert_eq!(m.leaks, grazing.len() as u64, "{m:?}");
         assert_eq!(m.ambiguous + m.agree + m.wrong_triangle, 0, "{m:?}");
         assert_eq!(m.failures, m.leaks);
@@ -1027,6 +984,65 @@ mod tests {
         assert!(e.near_edge && e.closed, "{e:?}");
         let m = check(&AlwaysMiss(&mesh), "f32", &reference, &exp, &set, 0.0);
         assert_eq!((m.leaks, m.ambiguous, m.failures), (1, 1, 1), "{m:?}");
+    }
+
+    /// Two closed blocks side by side: [1, 2] and [3, 4] in x, both
+    /// [1, 2]×[1, 2] in y and z, in a 5×3×3 grid.
+    fn two_blocks() -> TetMesh {
+        let grid = kuhn_grid(&GridSpec {
+            cells: [5, 3, 3],
+            jitter: 0.0,
+            ..Default::default()
+        });
+        let solid = |c: Vec3| {
+            let x = (c.x > 1.0 && c.x < 2.0) || (c.x > 3.0 && c.x < 4.0);
+            x && c.y > 1.0 && c.y < 2.0 && c.z > 1.0 && c.z < 2.0
+        };
+        constrain_faces(
+            grid,
+            |v| {
+                (0..3).any(|a| {
+                    let m = (v[0] + v[1] + v[2]) / 3.0;
+                    let e = Vec3::AXES[a] * 0.5;
+                    let cell = |p: Vec3| p.floor() + Vec3::splat(0.5);
+                    v.iter().all(|p| p[a] == v[0][a]) && solid(cell(m - e)) != solid(cell(m + e))
+                })
+            },
+            None,
+        )
+    }
+
+    #[test]
+    fn a_ray_clipping_a_convex_edge_may_skip_it_but_not_the_face_beyond() {
+        // The ray meets the top of the left block within tol/4 of its
+        // convex edge x = 2 and leaves through its side at once (the two
+        // faces of the edge lie on one side of it: some nearby line passes
+        // both by), then crosses the right block's wall x = 3 at z = 1.5,
+        // far from any edge. Skipping the clipped corner is grazing;
+        // skipping the wall too slips through a closed surface.
+        let mesh = two_blocks();
+        let reference = Reference::new(&mesh);
+        let delta = (reference.tol / 4.0) as f32;
+        let d = Vec3::new(1.0, 0.0, -0.5);
+        let x = Vec3::new(2.0 - delta, 1.37, 2.0);
+        let set = RaySet {
+            rays: vec![(Ray::new(x - d * 0.5, d), Some(Start::Tet(0)))],
+            view: None,
+        };
+        let exp = expected(&reference, &set);
+        let e = exp[0].expect("the ray hits the left block");
+        assert!(e.near_edge && !e.closed, "{e:?}");
+        let b = e.beyond.expect("the right block's wall lies beyond");
+        assert!(b.closed && (b.t - 1.5).abs() < 1e-4, "{b:?}");
+        // Past the corner, at the wall: grazing.
+        let past = Along(&mesh, Some(e.t + 10.0 * e.tol_t));
+        let m = check(&past, "f32", &reference, &exp, &set, 0.0);
+        assert_eq!((m.ambiguous, m.failures), (1, 0), "{m:?}");
+        // Through the wall too, or nothing at all: leaks.
+        for method in [&Along(&mesh, None) as &dyn Tracer, &AlwaysMiss(&mesh)] {
+            let m = check(method, "f32", &reference, &exp, &set, 0.0);
+            assert_eq!((m.leaks, m.failures), (1, 1), "{m:?}");
+        }
     }
 
     #[test]

@@ -42,8 +42,8 @@ pub struct ReferenceHit {
     pub t: f64,
     /// Within the grazing tolerance of an edge of the triangle.
     pub near_edge: bool,
-    /// Every edge it grazes is closed and the ray crosses the surface
-    /// there (a leak is possible).
+    /// Every line near the ray crosses the surface around the edges and
+    /// vertices the hit grazes (a miss there is a leak).
     pub closed: bool,
 }
 

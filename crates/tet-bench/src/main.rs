@@ -36,6 +36,7 @@ mod exitface;
 mod extremes;
 mod failed_rays;
 mod gpu;
+mod grazing;
 mod iso;
 mod layouts;
 mod load;
