@@ -144,6 +144,28 @@ fn a_planned_job_runs_part_by_part_and_merges_into_the_local_build() {
         err.contains(&format!("run again {last} (missing {last})")),
         "{err}"
     );
+    // Being built on another node: running, and not to be run again.
+    let running = jobdir.join(format!("part-{last}.running.json"));
+    let record = serde_json::json!({
+        "part": last, "host": "another-node", "pid": 4242, "process_start": null,
+        "started_unix_s": 0, "slurm_task": "77_3",
+    });
+    std::fs::write(&running, record.to_string()).unwrap();
+    let status = json(&["job", "status", j]);
+    assert_eq!(
+        (status["running"].clone(), status["missing"].clone()),
+        (1.into(), 0.into())
+    );
+    assert_eq!(status["rerun"], serde_json::json!([]));
+    let reason = status["parts"][last]["reason"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert!(
+        reason.starts_with("on another-node (pid 4242, Slurm task 77_3)"),
+        "{reason}"
+    );
+    std::fs::remove_file(&running).unwrap();
 
     let s = json(&[
         "submit",

@@ -12,8 +12,8 @@ use std::path::Path;
 use std::time::Duration;
 
 use tet_build::outofcore::job::{
-    JobError, JobManifest, PartOutcome, PartState, PlanOptions, build_part, job_status, merge_job,
-    plan_job,
+    JobError, JobManifest, PartOutcome, PartState, PlanOptions, RunningRecord, build_part,
+    job_status, merge_job, plan_job,
 };
 use tet_build::outofcore::memory_model::knot_grid;
 use tet_build::outofcore::seam::SeamOptions;
@@ -48,7 +48,11 @@ fn not_ready(e: JobError) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
             missing,
             failed,
             stale,
-        } => (missing, failed, stale),
+            running,
+        } => {
+            assert!(running.is_empty(), "running {running:?}");
+            (missing, failed, stale)
+        }
         other => panic!("{other:?}"),
     }
 }
@@ -153,6 +157,30 @@ fn broken_parts_are_named_and_rebuilt_alone() {
     assert_eq!((missing, failed, stale), (vec![2], vec![], vec![1]));
     assert!(!out.exists());
 
+    // A run of part 2 in progress: a live process here (this one), or a
+    // process on another host, is running; a process here that is gone
+    // (killed before it could remove its record) is not.
+    let live = RunningRecord::this_process(2);
+    let elsewhere = RunningRecord {
+        host: format!("{}-other", live.host),
+        pid: 1,
+        ..live.clone()
+    };
+    let mut dead = live.clone();
+    dead.process_start = dead.process_start.map(|t| t + 1);
+    for (record, running) in [(&live, true), (&elsewhere, true), (&dead, false)] {
+        std::fs::write(paths(2).running, serde_json::to_string(record).unwrap()).unwrap();
+        let state = &job_status(&jobdir, &job, false).unwrap()[2];
+        if running {
+            assert_eq!(state, &PartState::Running(record.clone()));
+            let e = merge_job(&jobdir, &job, &out).unwrap_err();
+            assert!(e.to_string().ends_with("; running 2"), "{e}");
+            assert_eq!(e.rerun(), vec![1], "a running part is not run again");
+        } else {
+            assert_eq!(state, &PartState::Missing, "{record:?}");
+        }
+    }
+
     // A result with the right length but other bytes: only the digest
     // tells (the merge checks it; the quick status does not).
     let r0 = std::fs::read(paths(0).result).unwrap();
@@ -201,6 +229,10 @@ fn broken_parts_are_named_and_rebuilt_alone() {
         assert_eq!(mtime(k), t, "part {k} was rewritten");
     }
     assert!(!paths(3).error.exists(), "the error record is removed");
+    assert!(
+        (0..n).all(|k| !paths(k).running.exists()),
+        "every run removed its running record"
+    );
     merge_job(&jobdir, &job, &out).unwrap();
     assert_eq!(std::fs::read(&out).unwrap(), reference);
 }

@@ -1,9 +1,10 @@
-//! `job status JOB_DIR`: each part done, failed, stale or missing, with
-//! predicted and measured peak memory, from the job directory alone.
+//! `job status JOB_DIR`: each part done, failed, stale, running or
+//! missing, with predicted and measured peak memory, from the job
+//! directory alone.
 
 use anyhow::Result;
 use serde::Serialize;
-use tet_build::outofcore::job::{JobManifest, PartState, job_status};
+use tet_build::outofcore::job::{JobManifest, PartState, RunningRecord, job_status};
 
 use crate::cli::{JobArgs, JobCommand};
 use crate::output::{outln, print_json};
@@ -13,9 +14,10 @@ use crate::output::{outln, print_json};
 pub struct PartStatusDoc {
     /// The part.
     pub index: usize,
-    /// `done`, `failed`, `stale` or `missing`.
+    /// `done`, `failed`, `stale`, `running` or `missing`.
     pub state: &'static str,
-    /// Why (failed: the error kind and message; stale: what differs).
+    /// Why (failed: the error kind and message; stale: what differs;
+    /// running: where, since when).
     pub reason: Option<String>,
     /// The plan's prediction of the TetGen peak, bytes.
     pub predicted_peak_bytes: u64,
@@ -42,9 +44,11 @@ pub struct StatusDoc {
     pub failed: usize,
     /// Parts with a result that is not this plan's or is damaged.
     pub stale: usize,
-    /// Parts not built (or running).
+    /// Parts being built now.
+    pub running: usize,
+    /// Parts not built (and not being built).
     pub missing: usize,
-    /// Every part not done: what to run again.
+    /// Every part not done and not running: what to run again.
     pub rerun: Vec<usize>,
 }
 
@@ -67,6 +71,7 @@ pub fn job(args: &JobArgs, json: bool) -> Result<()> {
                 reason: match s {
                     PartState::Failed(e) => Some(format!("{}: {}", e.kind, e.message)),
                     PartState::Stale(why) => Some(why.clone()),
+                    PartState::Running(r) => Some(running_since(r)),
                     _ => None,
                 },
                 predicted_peak_bytes: job.parts[k].predicted_peak_bytes,
@@ -83,10 +88,11 @@ pub fn job(args: &JobArgs, json: bool) -> Result<()> {
         done: count("done"),
         failed: count("failed"),
         stale: count("stale"),
+        running: count("running"),
         missing: count("missing"),
         rerun: parts
             .iter()
-            .filter(|p| p.state != "done")
+            .filter(|p| p.state != "done" && p.state != "running")
             .map(|p| p.index)
             .collect(),
         parts,
@@ -97,18 +103,37 @@ pub fn job(args: &JobArgs, json: bool) -> Result<()> {
     print_status(&doc)
 }
 
+/// Where and since when a part is being built: `on HOST (pid P, Slurm
+/// task T) for 42 s`.
+fn running_since(r: &RunningRecord) -> String {
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let task = r
+        .slurm_task
+        .as_ref()
+        .map_or(String::new(), |t| format!(", Slurm task {t}"));
+    format!(
+        "on {} (pid {}{task}) for {} s",
+        r.host,
+        r.pid,
+        now.saturating_sub(r.started_unix_s)
+    )
+}
+
 /// The text form of the status.
 fn print_status(doc: &StatusDoc) -> Result<()> {
     let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
     let kib = |k: Option<u64>| k.map_or("-".into(), |k| format!("{:.1}", k as f64 / 1024.0));
     outln!(
-        "{} ({}): {} parts: {} done, {} failed, {} stale, {} missing",
+        "{} ({}): {} parts: {} done, {} failed, {} stale, {} running, {} missing",
         doc.job_dir,
         doc.scene,
         doc.parts.len(),
         doc.done,
         doc.failed,
         doc.stale,
+        doc.running,
         doc.missing
     )?;
     outln!("  part  state    predicted MiB  TetGen MiB  process MiB  seconds")?;

@@ -164,7 +164,7 @@ pub enum JobError {
         source: SeamError,
     },
     /// Parts are not finished (or not this plan's): the merge cannot run.
-    #[error("{}", not_ready(.missing, .failed, .stale))]
+    #[error("{}", not_ready(.missing, .failed, .stale, .running))]
     PartsNotReady {
         /// Parts with no result.
         missing: Vec<usize>,
@@ -172,6 +172,8 @@ pub enum JobError {
         failed: Vec<usize>,
         /// Parts whose result is not this plan's or is damaged.
         stale: Vec<usize>,
+        /// Parts being built now (wait for them rather than run them again).
+        running: Vec<usize>,
     },
     /// The streamed merge failed.
     #[error("merge: {0}")]
@@ -201,6 +203,7 @@ impl JobError {
                 missing,
                 failed,
                 stale,
+                ..
             } => {
                 let mut all: Vec<usize> =
                     missing.iter().chain(failed).chain(stale).copied().collect();
@@ -212,8 +215,8 @@ impl JobError {
     }
 }
 
-/// `parts not finished: run again 1, 4 (missing 1; failed 4)`.
-fn not_ready(missing: &[usize], failed: &[usize], stale: &[usize]) -> String {
+/// `parts not finished: run again 1, 4 (missing 1; failed 4); running 2`.
+fn not_ready(missing: &[usize], failed: &[usize], stale: &[usize], running: &[usize]) -> String {
     let list = |v: &[usize]| {
         v.iter()
             .map(|k| k.to_string())
@@ -228,11 +231,14 @@ fn not_ready(missing: &[usize], failed: &[usize], stale: &[usize]) -> String {
             why.push(format!("{name} {}", list(v)));
         }
     }
-    format!(
-        "parts not finished: run again {} ({})",
-        list(&all),
-        why.join("; ")
-    )
+    let mut text = String::from("parts not finished");
+    if !all.is_empty() {
+        text += &format!(": run again {} ({})", list(&all), why.join("; "));
+    }
+    if !running.is_empty() {
+        text += &format!("; running {}", list(running));
+    }
+    text
 }
 
 impl JobError {

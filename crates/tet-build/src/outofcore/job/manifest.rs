@@ -454,7 +454,8 @@ impl JobManifest {
         serde_json::to_string_pretty(self).expect("a job description serializes") + "\n"
     }
 
-    /// Path of part `k`'s input, result, done and error files in `dir`.
+    /// Path of part `k`'s input, result, done, error and running files in
+    /// `dir`.
     pub fn part_paths(&self, dir: &Path, k: usize) -> PartPaths {
         let p = &self.parts[k];
         PartPaths {
@@ -462,6 +463,7 @@ impl JobManifest {
             result: dir.join(&p.result),
             done: dir.join(format!("part-{k}.done.json")),
             error: dir.join(format!("part-{k}.error.json")),
+            running: dir.join(format!("part-{k}.running.json")),
         }
     }
 }
@@ -477,6 +479,8 @@ pub struct PartPaths {
     pub done: PathBuf,
     /// `part-K.error.json`: why the last run failed.
     pub error: PathBuf,
+    /// `part-K.running.json`: a run in progress (removed when it ends).
+    pub running: PathBuf,
 }
 
 /// A file name without directories (the job directory can move).

@@ -54,6 +54,6 @@ pub use error::{InputFault, JobError};
 pub use manifest::{JOB_FILE, JobManifest, PartPaths};
 pub use merge::merge_job;
 pub use plan::{PlanOptions, Planner, plan_job, scene_digest};
-pub use records::{DoneRecord, ErrorRecord};
+pub use records::{DoneRecord, ErrorRecord, RunningRecord};
 pub use run::{INDEX_VARIABLES, PartOutcome, build_part, part_index, verified_done};
 pub use status::{PartState, job_status, part_state, require_all_done};

@@ -1,6 +1,7 @@
-//! What a part's run leaves beside its result: `part-K.done.json`
-//! ([`DoneRecord`]) after a success, `part-K.error.json` ([`ErrorRecord`])
-//! after a failure. Both are written atomically (temporary file, rename).
+//! What a part's run leaves beside its result: `part-K.running.json`
+//! ([`RunningRecord`]) while it runs, `part-K.done.json` ([`DoneRecord`])
+//! after a success, `part-K.error.json` ([`ErrorRecord`]) after a failure.
+//! All are written atomically (temporary file, rename).
 
 use std::path::Path;
 
@@ -56,6 +57,76 @@ pub struct ErrorRecord {
     pub input_digest: String,
     /// Host that ran it.
     pub host: String,
+}
+
+/// `part-K.running.json`: a run of a part in progress, written when it
+/// starts and removed when it ends (whatever the outcome). A process
+/// killed outright leaves it behind: [`RunningRecord::is_dead`] tells on
+/// the host that ran it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunningRecord {
+    /// The part.
+    pub part: usize,
+    /// Host running it.
+    pub host: String,
+    /// Its process id there.
+    pub pid: u32,
+    /// When that process started, in clock ticks since boot (field 22 of
+    /// `/proc/PID/stat`), so that a reused pid is not taken for it;
+    /// `null` without `/proc`.
+    pub process_start: Option<u64>,
+    /// When the run started, seconds since the Unix epoch.
+    pub started_unix_s: u64,
+    /// The Slurm job and array task running it (`JOB_ARRAYTASK`), if any.
+    pub slurm_task: Option<String>,
+}
+
+impl RunningRecord {
+    /// The record of this process running part `k` now.
+    pub fn this_process(part: usize) -> RunningRecord {
+        let pid = std::process::id();
+        let env = |v: &str| std::env::var(v).ok().filter(|s| !s.is_empty());
+        RunningRecord {
+            part,
+            host: host_name(),
+            pid,
+            process_start: process_start(pid),
+            started_unix_s: std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs()),
+            slurm_task: env("SLURM_ARRAY_JOB_ID")
+                .zip(env("SLURM_ARRAY_TASK_ID"))
+                .map(|(j, t)| format!("{j}_{t}")),
+        }
+    }
+
+    /// True when the run is known to have ended without removing its
+    /// record: it ran on this host and its process is gone (or the pid
+    /// now belongs to another process). A run on another host is never
+    /// known dead here.
+    pub fn is_dead(&self) -> bool {
+        if self.host != host_name() || !Path::new("/proc/self/stat").exists() {
+            return false;
+        }
+        match process_start(self.pid) {
+            None => true,
+            Some(start) => self.process_start.is_some_and(|s| s != start),
+        }
+    }
+}
+
+/// Start time of process `pid` in clock ticks since boot (`/proc/PID/stat`
+/// field 22), `None` when there is no such process (or no `/proc`).
+fn process_start(pid: u32) -> Option<u64> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // The command name (field 2) may hold spaces: count after its `)`.
+    stat.rsplit_once(')')?
+        .1
+        .split_whitespace()
+        .nth(19)?
+        .parse()
+        .ok()
 }
 
 /// This machine's name (for the records), `unknown` when unreadable.

@@ -1,6 +1,6 @@
 //! Building one part of a job ([`build_part`]): idempotent, atomic, and
-//! leaving a record of what happened (`part-K.done.json` or
-//! `part-K.error.json`).
+//! leaving a record of what is happening (`part-K.running.json`) and of
+//! what happened (`part-K.done.json` or `part-K.error.json`).
 
 use std::path::Path;
 use std::time::Instant;
@@ -11,7 +11,9 @@ use super::digest::{digest, digest_file, format_digest};
 use super::error::JobError;
 use super::manifest::JobManifest;
 use super::part_input::decode;
-use super::records::{DoneRecord, ErrorRecord, host_name, read_json, write_atomic, write_json};
+use super::records::{
+    DoneRecord, ErrorRecord, RunningRecord, host_name, read_json, write_atomic, write_json,
+};
 use crate::outofcore::error::{SeamError, StreamError};
 use crate::outofcore::parts::{SeamOptions, run_part};
 use crate::tetgen::{Isolation, TetgenOptions};
@@ -107,6 +109,8 @@ pub fn build_part(
     }
     let paths = job.part_paths(dir, k);
     remove_if_present(&paths.done)?;
+    write_json(&paths.running, &RunningRecord::this_process(k))?;
+    let _running = RemoveOnDrop(&paths.running);
     match build(dir, job, k, isolation) {
         Ok(done) => {
             write_json(&paths.done, &done)?;
@@ -126,6 +130,17 @@ pub fn build_part(
             let _ = write_json(&paths.error, &record);
             Err(e)
         }
+    }
+}
+
+/// Removes the running record when the run ends, however it ends (a
+/// panic included; a process killed outright leaves it, see
+/// [`RunningRecord::is_dead`]).
+struct RemoveOnDrop<'p>(&'p Path);
+
+impl Drop for RemoveOnDrop<'_> {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(self.0);
     }
 }
 

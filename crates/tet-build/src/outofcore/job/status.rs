@@ -6,7 +6,7 @@ use std::path::Path;
 use super::digest::digest_file;
 use super::error::JobError;
 use super::manifest::JobManifest;
-use super::records::{DoneRecord, ErrorRecord, read_json};
+use super::records::{DoneRecord, ErrorRecord, RunningRecord, read_json};
 
 /// One part's state.
 #[derive(Clone, Debug, PartialEq)]
@@ -17,25 +17,30 @@ pub enum PartState {
     Failed(ErrorRecord),
     /// A result is there but not this plan's, or damaged: why.
     Stale(String),
-    /// Not built (or being built now).
+    /// Being built now (a run's record, not known to have died).
+    Running(RunningRecord),
+    /// Not built (and not being built).
     Missing,
 }
 
 impl PartState {
-    /// `done`, `failed`, `stale` or `missing`.
+    /// `done`, `failed`, `stale`, `running` or `missing`.
     pub fn name(&self) -> &'static str {
         match self {
             PartState::Done(_) => "done",
             PartState::Failed(_) => "failed",
             PartState::Stale(_) => "stale",
+            PartState::Running(_) => "running",
             PartState::Missing => "missing",
         }
     }
 }
 
-/// Part `k`'s state. With `verify`, a result counts as done only when its
-/// bytes have the recorded digest (the file is read); without, when its
-/// length is the recorded one.
+/// Part `k`'s state: done when a result of this plan is there, else
+/// running while a run's record says so (and, on its own host, its process
+/// lives), else failed, stale or missing. With `verify`, a result counts as
+/// done only when its bytes have the recorded digest (the file is read);
+/// without, when its length is the recorded one.
 pub fn part_state(
     dir: &Path,
     job: &JobManifest,
@@ -52,6 +57,12 @@ pub fn part_state(
         Ok(None) => None,
         Err(e) => Some(format!("unreadable done record: {e}")),
     };
+    // A run in progress is the news, whatever an earlier run left.
+    if let Ok(Some(running)) = read_json::<RunningRecord>(&paths.running)
+        && !running.is_dead()
+    {
+        return Ok(PartState::Running(running));
+    }
     if let Ok(Some(error)) = read_json::<ErrorRecord>(&paths.error) {
         return Ok(PartState::Failed(error));
     }
@@ -118,22 +129,25 @@ pub fn job_status(dir: &Path, job: &JobManifest, verify: bool) -> Result<Vec<Par
 /// [`JobError::PartsNotReady`] listing the parts that are not done, or
 /// `Ok` when every part is.
 pub fn require_all_done(states: &[PartState]) -> Result<(), JobError> {
-    let (mut missing, mut failed, mut stale) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut missing, mut failed, mut stale, mut running) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (k, s) in states.iter().enumerate() {
         match s {
             PartState::Done(_) => {}
             PartState::Failed(_) => failed.push(k),
             PartState::Stale(_) => stale.push(k),
+            PartState::Running(_) => running.push(k),
             PartState::Missing => missing.push(k),
         }
     }
-    if missing.is_empty() && failed.is_empty() && stale.is_empty() {
+    if missing.is_empty() && failed.is_empty() && stale.is_empty() && running.is_empty() {
         Ok(())
     } else {
         Err(JobError::PartsNotReady {
             missing,
             failed,
             stale,
+            running,
         })
     }
 }
