@@ -73,7 +73,7 @@ pub struct BuildFlags {
     /// passes (LEVEL 0 to 9) of flips (SCHEME bit 1), smoothing (2) and
     /// vertex insertion/deletion (4). Default: TetGen's 2/7.
     #[arg(long, value_name = "LEVEL/SCHEME", value_parser = parse_optimization)]
-    pub optimize: Option<tet_build::tetgen::Optimization>,
+    pub optimize: Option<tet_build::tetgen_options::Optimization>,
     /// Dihedral angle in degrees above which TetGen's optimisation works on
     /// a tet (`-o/`; TetGen's default 165).
     #[arg(long, value_name = "DEGREES")]
@@ -853,11 +853,12 @@ impl IsoMethod {
 
 impl BuildFlags {
     /// The TetGen options these flags ask for: every TetGen flag given
-    /// replaces its default, the rest keep [`tet_build::tetgen::TetgenOptions::default`]. The
+    /// replaces its default, the rest keep [`tet_build::tetgen_options::TetgenOptions::default`]. The
     /// one mapping for in-core, out-of-core and job builds.
-    pub fn tetgen_options(&self) -> tet_build::tetgen::TetgenOptions {
-        let d = tet_build::tetgen::TetgenOptions::default();
-        tet_build::tetgen::TetgenOptions {
+    #[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
+    pub fn tetgen_options(&self) -> tet_build::tetgen_options::TetgenOptions {
+        let d = tet_build::tetgen_options::TetgenOptions::default();
+        tet_build::tetgen_options::TetgenOptions {
             quality: self.quality,
             max_steiner: self.max_steiner,
             min_dihedral: self.min_dihedral.or(d.min_dihedral),
@@ -869,7 +870,7 @@ impl BuildFlags {
 }
 
 /// Parses `--optimize LEVEL/SCHEME` (`7/7`; a bare `LEVEL` keeps scheme 7).
-fn parse_optimization(s: &str) -> Result<tet_build::tetgen::Optimization, String> {
+fn parse_optimization(s: &str) -> Result<tet_build::tetgen_options::Optimization, String> {
     let (level, scheme) = s.split_once('/').unwrap_or((s, "7"));
     let digit = |x: &str, max: u8, what: &str| {
         x.parse::<u8>()
@@ -877,7 +878,7 @@ fn parse_optimization(s: &str) -> Result<tet_build::tetgen::Optimization, String
             .filter(|v| *v <= max)
             .ok_or_else(|| format!("{what} `{x}` is not a number from 0 to {max}"))
     };
-    Ok(tet_build::tetgen::Optimization {
+    Ok(tet_build::tetgen_options::Optimization {
         level: digit(level, 9, "level")?,
         scheme: digit(scheme, 7, "scheme")?,
     })

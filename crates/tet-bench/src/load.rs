@@ -300,13 +300,12 @@ fn light_at(position: Vec3) -> PointLight {
 }
 
 /// A progress spinner on stderr (hidden when `quiet`).
-#[cfg(feature = "tetgen")]
 pub fn spinner(quiet: bool) -> indicatif::ProgressBar {
     if quiet {
         indicatif::ProgressBar::hidden()
     } else {
         let pb = indicatif::ProgressBar::new_spinner();
-        pb.enable_steady_tick(Duration::from_millis(120));
+        pb.enable_steady_tick(std::time::Duration::from_millis(120));
         pb
     }
 }

@@ -17,6 +17,7 @@
 //!
 //! A cluster the script finds running is used and left running; one it
 //! starts is stopped at the end (`scripts/slurm/stop.sh`).
+#![cfg(feature = "tetgen")]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

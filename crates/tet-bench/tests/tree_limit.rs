@@ -2,6 +2,7 @@
 //! itself and every TetGen worker it starts — measured from outside: this
 //! test samples the resident memory of the command and its descendants
 //! while it runs, and checks the build's own report against the limit.
+#![cfg(feature = "tetgen")]
 
 use std::process::{Command, Stdio};
 

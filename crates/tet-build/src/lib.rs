@@ -52,6 +52,7 @@ pub mod resolve;
 pub mod scene;
 pub mod source;
 pub mod tetgen_files;
+pub mod tetgen_options;
 pub mod volume;
 pub mod vtk;
 

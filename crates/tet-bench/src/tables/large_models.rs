@@ -23,11 +23,11 @@ use tet_core::predicates::orient3d_f32;
 use tet_core::{Attributes, TetMesh};
 use tet_trace_cpu::render::RenderOptions;
 
-use super::doc::{LargeModelRow, LargeStructure, TABLE_FLAGS, TablesDoc};
+use super::doc::{LargeModelRow, LargeStructure, TablesDoc};
 use crate::bvh::BvhTracer;
 use crate::cli::Method;
-use crate::layouts::{layout_bytes, strips_bytes};
-use crate::load::{Loaded, from_scene};
+use crate::layouts::strips_bytes;
+use crate::load::Loaded;
 use crate::timing::time_method;
 
 /// Bytes each structure needs per triangle while it is built and timed
@@ -132,6 +132,20 @@ fn structure(
     })
 }
 
+/// Without TetGen there is no CDT to build.
+#[cfg(not(feature = "tetgen"))]
+fn tet20(
+    _: Scene,
+    _: &RenderOptions,
+    _: u32,
+    _: &rayon::ThreadPool,
+) -> Result<std::result::Result<LargeStructure, String>> {
+    Ok(Err(
+        "tet20 not built: this binary was built without TetGen".into()
+    ))
+}
+
+#[cfg(feature = "tetgen")]
 /// Tet20 over the scene's CDT, when TetGen's predicted peak fits in half
 /// the free memory; otherwise why not.
 fn tet20(
@@ -154,6 +168,9 @@ fn tet20(
         )));
     }
     eprintln!("  {}: building the CDT", scene.name);
+    use super::doc::TABLE_FLAGS;
+    use crate::layouts::layout_bytes;
+    use crate::load::from_scene;
     let loaded = from_scene(scene, &TABLE_FLAGS, true)?;
     let build_s = loaded.build.as_ref().map_or(0.0, |b| b.total_s);
     let bytes = layout_bytes(&loaded.mesh)

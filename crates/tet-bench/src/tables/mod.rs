@@ -120,11 +120,15 @@ fn measure_scene(
             )?),
         )
     };
+    #[cfg(feature = "tetgen")]
     let out_of_core = if args.quick || !planned.first {
         Vec::new()
     } else {
         out_of_core::measure(spec, &loaded, opts, frames, pool)
     };
+    // Out-of-core builds run TetGen.
+    #[cfg(not(feature = "tetgen"))]
+    let out_of_core = Vec::new();
     Ok(SceneResult {
         ray_strips,
         quality5,

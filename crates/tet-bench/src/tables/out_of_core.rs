@@ -11,137 +11,150 @@
 //! back from the file it wrote.
 
 use std::fmt::Write as _;
-use std::path::Path;
-use std::process::Command;
 
-use anyhow::{Context, Result, bail};
-use tet_build::outofcore::admission::builder_bytes;
-use tet_core::TetMesh;
-use tet_trace_cpu::render::RenderOptions;
-
-use super::doc::{OutOfCoreRow, Quality, TABLE_FLAGS, TablesDoc};
+use super::doc::{Quality, TablesDoc};
 use crate::cli::Method;
-use crate::load::{Loaded, with_mesh};
-use crate::outofcore::{MemoryReport, predict};
-use crate::output::error_chain;
-use crate::timing::time_method;
 
-/// Tet quality of a mesh (aspect and radius-edge ratios).
-fn quality(mesh: &TetMesh) -> Option<Quality> {
-    let q = tet_build::quality::mesh_quality(mesh)?;
-    Some(Quality {
-        aspect_min: q.aspect_ratio.min,
-        aspect_max: q.aspect_ratio.max,
-        aspect_mean: q.aspect_ratio.mean,
-        radius_edge_min: q.radius_edge.min,
-        radius_edge_max: q.radius_edge.max,
-        radius_edge_mean: q.radius_edge.mean,
-    })
-}
+#[cfg(feature = "tetgen")]
+pub use measuring::measure;
 
-/// Out-of-core builds of a scene under the builder's own share plus ½ and
-/// ⅓ of its in-core TetGen peak, and tet20 on each merged mesh.
-pub fn measure(
-    spec: &str,
-    loaded: &Loaded,
-    opts: &RenderOptions,
-    frames: u32,
-    pool: &rayon::ThreadPool,
-) -> Vec<OutOfCoreRow> {
-    let (Some(scene), Some(build)) = (&loaded.scene, &loaded.build) else {
-        return Vec::new();
-    };
-    let peak_bytes = match build.worker_peak_kib {
-        Some(k) => k * 1024,
-        None => match predict(scene, TABLE_FLAGS.no_box) {
-            Ok(p) => p.predicted_peak_bytes,
-            Err(_) => return Vec::new(),
-        },
-    };
-    let mut rows = Vec::new();
-    let threads = pool.current_num_threads();
-    let in_core_quality = quality(&loaded.mesh);
-    for fraction in [0.5, 1.0 / 3.0] {
-        // The builder's own share beside a fraction of TetGen's peak: the
-        // limit is on the builder and its workers together.
-        let limit = builder_bytes(scene.triangles.len()) + (peak_bytes as f64 * fraction) as u64;
-        eprintln!(
-            "  {}: out-of-core build under {:.1} MiB",
-            loaded.name,
-            limit as f64 / (1024.0 * 1024.0)
-        );
-        let mut row = OutOfCoreRow {
-            fraction,
-            in_core_peak_kib: build.worker_peak_kib,
-            in_core_s: build.total_s,
-            in_core_tets: loaded.mesh.tets.len(),
-            memory: None,
-            tets: 0,
-            tet20: None,
-            in_core_quality,
-            quality: None,
-            error: None,
+/// The measurement: limited builds in processes of their own (they run
+/// TetGen, so only with the `tetgen` feature).
+#[cfg(feature = "tetgen")]
+mod measuring {
+    use super::{Method, Quality};
+    use std::path::Path;
+    use std::process::Command;
+
+    use anyhow::{Context, Result, bail};
+    use tet_build::outofcore::admission::builder_bytes;
+    use tet_core::TetMesh;
+    use tet_trace_cpu::render::RenderOptions;
+
+    use super::super::doc::{OutOfCoreRow, TABLE_FLAGS};
+    use crate::load::{Loaded, with_mesh};
+    use crate::outofcore::{MemoryReport, predict};
+    use crate::output::error_chain;
+    use crate::timing::time_method;
+
+    /// Tet quality of a mesh (aspect and radius-edge ratios).
+    fn quality(mesh: &TetMesh) -> Option<Quality> {
+        let q = tet_build::quality::mesh_quality(mesh)?;
+        Some(Quality {
+            aspect_min: q.aspect_ratio.min,
+            aspect_max: q.aspect_ratio.max,
+            aspect_mean: q.aspect_ratio.mean,
+            radius_edge_min: q.radius_edge.min,
+            radius_edge_max: q.radius_edge.max,
+            radius_edge_mean: q.radius_edge.mean,
+        })
+    }
+
+    /// Out-of-core builds of a scene under the builder's own share plus ½ and
+    /// ⅓ of its in-core TetGen peak, and tet20 on each merged mesh.
+    pub fn measure(
+        spec: &str,
+        loaded: &Loaded,
+        opts: &RenderOptions,
+        frames: u32,
+        pool: &rayon::ThreadPool,
+    ) -> Vec<OutOfCoreRow> {
+        let (Some(scene), Some(build)) = (&loaded.scene, &loaded.build) else {
+            return Vec::new();
         };
-        let file = std::env::temp_dir().join(format!(
-            "tet-bench-out-of-core-{}-{}.tmesh",
-            std::process::id(),
-            rows.len()
-        ));
-        let result =
-            build_in_own_process(spec, limit, threads, &file).and_then(|(mesh, memory)| {
-                let merged = with_mesh(scene.clone(), mesh, None);
-                let tet20 = time_method(&merged, Method::Tet20, opts, frames, pool)?.0;
-                Ok((merged.mesh.tets.len(), memory, tet20, quality(&merged.mesh)))
-            });
-        let _ = std::fs::remove_file(&file);
-        match result {
-            Ok((tets, memory, tet20, q)) => {
-                row.tets = tets;
-                row.memory = Some(memory);
-                row.tet20 = Some(tet20);
-                row.quality = q;
+        let peak_bytes = match build.worker_peak_kib {
+            Some(k) => k * 1024,
+            None => match predict(scene, TABLE_FLAGS.no_box) {
+                Ok(p) => p.predicted_peak_bytes,
+                Err(_) => return Vec::new(),
+            },
+        };
+        let mut rows = Vec::new();
+        let threads = pool.current_num_threads();
+        let in_core_quality = quality(&loaded.mesh);
+        for fraction in [0.5, 1.0 / 3.0] {
+            // The builder's own share beside a fraction of TetGen's peak: the
+            // limit is on the builder and its workers together.
+            let limit =
+                builder_bytes(scene.triangles.len()) + (peak_bytes as f64 * fraction) as u64;
+            eprintln!(
+                "  {}: out-of-core build under {:.1} MiB",
+                loaded.name,
+                limit as f64 / (1024.0 * 1024.0)
+            );
+            let mut row = OutOfCoreRow {
+                fraction,
+                in_core_peak_kib: build.worker_peak_kib,
+                in_core_s: build.total_s,
+                in_core_tets: loaded.mesh.tets.len(),
+                memory: None,
+                tets: 0,
+                tet20: None,
+                in_core_quality,
+                quality: None,
+                error: None,
+            };
+            let file = std::env::temp_dir().join(format!(
+                "tet-bench-out-of-core-{}-{}.tmesh",
+                std::process::id(),
+                rows.len()
+            ));
+            let result =
+                build_in_own_process(spec, limit, threads, &file).and_then(|(mesh, memory)| {
+                    let merged = with_mesh(scene.clone(), mesh, None);
+                    let tet20 = time_method(&merged, Method::Tet20, opts, frames, pool)?.0;
+                    Ok((merged.mesh.tets.len(), memory, tet20, quality(&merged.mesh)))
+                });
+            let _ = std::fs::remove_file(&file);
+            match result {
+                Ok((tets, memory, tet20, q)) => {
+                    row.tets = tets;
+                    row.memory = Some(memory);
+                    row.tet20 = Some(tet20);
+                    row.quality = q;
+                }
+                Err(e) => row.error = Some(error_chain(&e)),
             }
-            Err(e) => row.error = Some(error_chain(&e)),
+            rows.push(row);
         }
-        rows.push(row);
+        rows
     }
-    rows
-}
 
-/// `tet-bench build SPEC -o FILE --memory-limit LIMIT --threads THREADS
-/// --json`, with `build`'s default flags (the tables' own): the merged
-/// mesh, read back, and the build's memory report.
-fn build_in_own_process(
-    spec: &str,
-    limit: u64,
-    threads: usize,
-    file: &Path,
-) -> Result<(TetMesh, MemoryReport)> {
-    let exe = std::env::current_exe().context("cannot find this executable")?;
-    let out = Command::new(&exe)
-        .arg("build")
-        .arg(spec)
-        .arg("-o")
-        .arg(file)
-        .args(["--memory-limit", &limit.to_string()])
-        .args(["--threads", &threads.to_string()])
-        .arg("--json")
-        .output()
-        .with_context(|| format!("cannot run {}", exe.display()))?;
-    if !out.status.success() {
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        bail!(
-            "{}",
-            stderr.trim().lines().last().unwrap_or("the build failed")
-        );
+    /// `tet-bench build SPEC -o FILE --memory-limit LIMIT --threads THREADS
+    /// --json`, with `build`'s default flags (the tables' own): the merged
+    /// mesh, read back, and the build's memory report.
+    fn build_in_own_process(
+        spec: &str,
+        limit: u64,
+        threads: usize,
+        file: &Path,
+    ) -> Result<(TetMesh, MemoryReport)> {
+        let exe = std::env::current_exe().context("cannot find this executable")?;
+        let out = Command::new(&exe)
+            .arg("build")
+            .arg(spec)
+            .arg("-o")
+            .arg(file)
+            .args(["--memory-limit", &limit.to_string()])
+            .args(["--threads", &threads.to_string()])
+            .arg("--json")
+            .output()
+            .with_context(|| format!("cannot run {}", exe.display()))?;
+        if !out.status.success() {
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            bail!(
+                "{}",
+                stderr.trim().lines().last().unwrap_or("the build failed")
+            );
+        }
+        let doc: serde_json::Value =
+            serde_json::from_slice(&out.stdout).context("the build's --json output")?;
+        let memory: MemoryReport =
+            serde_json::from_value(doc["memory"].clone()).context("the build's memory report")?;
+        let mesh = tet_core::format::load(file)
+            .with_context(|| format!("cannot read back {}", file.display()))?;
+        Ok((mesh, memory))
     }
-    let doc: serde_json::Value =
-        serde_json::from_slice(&out.stdout).context("the build's --json output")?;
-    let memory: MemoryReport =
-        serde_json::from_value(doc["memory"].clone()).context("the build's memory report")?;
-    let mesh = tet_core::format::load(file)
-        .with_context(|| format!("cannot read back {}", file.display()))?;
-    Ok((mesh, memory))
 }
 
 /// The table (or why there is none).

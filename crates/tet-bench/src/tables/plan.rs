@@ -47,6 +47,7 @@ pub struct Planned {
     /// Names of the other scenes of the group.
     pub shares_with: Vec<String>,
     /// First scene of its group.
+    #[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
     pub first: bool,
     /// Last scene of its group (the cached meshes are dropped after it).
     pub last: bool,
