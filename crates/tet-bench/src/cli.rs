@@ -665,6 +665,10 @@ pub struct IsoArgs {
     /// Time step of the field (0-based).
     #[arg(long, default_value_t = 0)]
     pub time_step: usize,
+    /// `buckycube` only: `N` bucky balls per axis, N³ in all (seed 004
+    /// Table 3; 1 to 8, default 2).
+    #[arg(long, value_name = "N")]
+    pub replications: Option<u32>,
     /// Image width.
     #[arg(long, default_value_t = 1024)]
     pub width: u32,

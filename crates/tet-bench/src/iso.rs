@@ -44,12 +44,17 @@ pub struct IsoVolume {
 
 /// Loads `spec` (a file with a scalar field, or a synthetic volume's name).
 pub fn load_iso_volume(spec: &str) -> Result<IsoVolume> {
-    let options = VolumeOptions::default();
-    let mesh = load_volume(spec, &options).with_context(|| format!("cannot load volume {spec}"))?;
+    load_iso_volume_with(spec, &VolumeOptions::default())
+}
+
+/// [`load_iso_volume`] with the synthetic volumes' `options` (size, steps,
+/// replications).
+pub fn load_iso_volume_with(spec: &str, options: &VolumeOptions) -> Result<IsoVolume> {
+    let mesh = load_volume(spec, options).with_context(|| format!("cannot load volume {spec}"))?;
     let Some(field) = &mesh.attributes.scalars else {
         bail!("{spec} has no scalar field (a VTK file needs point scalars)");
     };
-    let default_isovalue = match synthetic_volume_info(spec, &options) {
+    let default_isovalue = match synthetic_volume_info(spec, options) {
         Ok(info) => info.isovalue,
         Err(_) => {
             let (lo, hi) = field.range().unwrap_or((0.0, 0.0));

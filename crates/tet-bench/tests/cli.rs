@@ -966,6 +966,28 @@ fn iso_methods_agree() {
     ]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("time step 3"));
+    // The bucky cube grows by whole balls (seed 004 Table 3): 1 ball is
+    // one 27×33×33 grid in six, 8 balls eight of them.
+    for (n, tets) in [("1", 6 * 27 * 33 * 33), ("2", 8 * 6 * 27 * 33 * 33)] {
+        let d = json(&[
+            "iso",
+            "buckycube",
+            "--replications",
+            n,
+            "--method",
+            "walk-tet20",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--frames",
+            "1",
+        ]);
+        assert_eq!(d["tets"], tets, "{n}");
+        assert!(d["hits"].as_u64().unwrap() > 0, "{n}");
+    }
+    let err = stderr_of(&["iso", "buckycube", "--replications", "0"]);
+    assert!(err.contains("replications"), "{err}");
 }
 
 /// `convert`: a volume with a scalar field goes to `.vtu`, back to a mesh

@@ -230,6 +230,33 @@ fn named_volumes_have_the_documented_sizes() {
     assert_eq!(tets("blunt", &small), 6 * 27 * 33 * 33);
     assert_eq!(tets("buckycube", &small), 8 * 176_418);
     assert_eq!(tets("buckycube", &full), 64 * 176_418);
+    // Table 3's replications: n³ balls, the paper's counts within 0.5 %.
+    for (n, paper) in [(1, 177_000.0), (2, 1_400_000.0), (4, 11_300_000.0)] {
+        let o = VolumeOptions {
+            replications: Some(n),
+            ..VolumeOptions::default()
+        };
+        let info = synthetic_volume_info("buckycube", &o).unwrap();
+        assert_eq!(info.tet_count(), u64::from(n * n * n) * 176_418);
+        assert_eq!(info.paper_tets, Some(paper as u64));
+        assert!(
+            (info.tet_count() as f64 - paper).abs() / paper < 0.01,
+            "{n}"
+        );
+    }
+    for n in [0, 9] {
+        let o = VolumeOptions {
+            replications: Some(n),
+            ..VolumeOptions::default()
+        };
+        assert!(matches!(
+            synthetic_volume_info("buckycube", &o),
+            Err(VolumeError::BadParameter {
+                what: "replications",
+                ..
+            })
+        ));
+    }
     assert_eq!(tets("fusion", &small), 300_000);
     assert_eq!(tets("fusion", &full), 3_000_000);
     assert_eq!(synthetic_volume_info("fusion", &small).unwrap().steps, 16);

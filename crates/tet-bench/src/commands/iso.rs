@@ -8,13 +8,17 @@ use tet_trace_cpu::iso::{ClipBox, ClipMode};
 
 use crate::camera::apply_view;
 use crate::cli::{IsoArgs, IsoClipMode};
-use crate::iso::{IsoFrames, IsoLight, IsoView, load_iso_volume, measure, shade};
+use crate::iso::{IsoFrames, IsoLight, IsoView, load_iso_volume_with, measure, shade};
 use crate::output::{outln, print_json};
 use crate::timing::pool;
 
 /// `tet-bench iso`.
 pub fn run(args: &IsoArgs, json: bool) -> Result<()> {
-    let volume = load_iso_volume(&args.volume)?;
+    let options = tet_build::volume::VolumeOptions {
+        replications: args.replications,
+        ..Default::default()
+    };
+    let volume = load_iso_volume_with(&args.volume, &options)?;
     let isovalues = if args.isovalues.is_empty() {
         vec![volume.default_isovalue]
     } else {

@@ -156,6 +156,9 @@ pub struct TablesDoc {
     /// Isosurfaces of tet volumes (seed 004 Tables 1, 2, 4), per synthetic
     /// volume.
     pub isosurfaces: Vec<IsoRow>,
+    /// Isosurfaces as the model grows: the bucky cube replicated n³ times
+    /// (seed 004 Table 3).
+    pub iso_scaling: Vec<IsoScaleRow>,
     /// Why there is no out-of-core table, if there is none.
     pub out_of_core_note: Option<String>,
     /// Large models (seed 002 §6): Ray-Strips, the BVH and Tet20 as the
@@ -236,6 +239,19 @@ pub struct IsoRow {
     /// One `iso` document per method.
     pub docs: Vec<crate::iso::IsoDoc>,
     /// Why the volume failed, if it did.
+    pub error: Option<String>,
+}
+
+/// One size of the isosurface scaling table (JSON `iso_scaling[]`).
+#[derive(Clone, Debug, Serialize)]
+pub struct IsoScaleRow {
+    /// Balls per axis (`buckycube --replications N`).
+    pub replications: u32,
+    /// Balls in all (`replications³`).
+    pub balls: u32,
+    /// One `iso` document per method (`ibvh-packets`, `walk-tet20`).
+    pub docs: Vec<crate::iso::IsoDoc>,
+    /// Why the size failed, if it did.
     pub error: Option<String>,
 }
 

@@ -1,17 +1,19 @@
-//! Isosurfaces of tetrahedral volumes (Wald et al., seed 004 Tables 1, 2
-//! and 4) on the synthetic stand-ins for the paper's data sets (same tet
-//! counts; the originals are not public): IBVH build time BIH vs SAH and
-//! render speed, 16×16 packets, and the iso walk over our compact layouts
-//! beside them, every method on the same rays and camera. `--quick`
-//! measures `ell32p` alone at 256²; the full run the four static sets at
-//! 1024².
+//! Isosurfaces of tetrahedral volumes (Wald et al., seed 004 Tables 1–4)
+//! on the synthetic stand-ins for the paper's data sets (same tet counts;
+//! the originals are not public): IBVH build time BIH vs SAH and render
+//! speed, 16×16 packets, and the iso walk over our compact layouts beside
+//! them, every method on the same rays and camera. `--quick` measures
+//! `ell32p` alone at 256²; the full run the four static sets at 1024².
+//! Table 3, the model grown by replicating the bucky ball n³ times
+//! (`buckycube --replications n`), runs 1 and 2³ balls at 256² in quick
+//! mode, 1, 2³ and 4³ (11.3 M tets) at 1024² in full mode.
 
 use std::fmt::Write as _;
 
 use anyhow::Result;
 
-use super::doc::{IsoRow, TablesDoc};
-use crate::iso::{IsoFrames, IsoMethod, IsoView, load_iso_volume, measure};
+use super::doc::{IsoRow, IsoScaleRow, TablesDoc};
+use crate::iso::{IsoFrames, IsoMethod, IsoView, load_iso_volume, load_iso_volume_with, measure};
 
 /// The paper's figures per data set: tets (Table 1), BIH and SAH build
 /// ms (Table 1, dual Core 2 Duo), laptop fps at 1024² (Table 2, 2 cores),
@@ -112,8 +114,116 @@ pub fn measure_all(quick: bool, pool: &rayon::ThreadPool) -> Vec<IsoRow> {
     rows
 }
 
-/// The tables.
+/// Seed 004 Table 3: balls, tets and fps at 1024² on four 2.4 GHz
+/// Opteron cores, per replication of the bucky ball.
+const PAPER_SCALING: [(u32, &str, f64); 5] = [
+    (1, "177 k", 34.0),
+    (8, "1.4 M", 13.5),
+    (64, "11.3 M", 5.0),
+    (512, "90.4 M", 1.8),
+    (4096, "724 M", 0.66),
+];
+
+/// The bucky cube replicated n³ times (seed 004 Table 3), with the
+/// paper's packets (`ibvh-packets`) and the iso walk (`walk-tet20`).
+/// 8³ (90 M tets) and beyond are left out: the volume alone would take
+/// several GB and most of a run's time here.
+pub fn measure_scaling(quick: bool, pool: &rayon::ThreadPool) -> Vec<IsoScaleRow> {
+    let (sizes, side, frames): (&[u32], u32, u32) = if quick {
+        (&[1, 2], 256, 2)
+    } else {
+        (&[1, 2, 4], 1024, 3)
+    };
+    sizes
+        .iter()
+        .map(|&n| {
+            eprintln!("isosurfaces: buckycube, {}³ balls, {side}²", n);
+            let docs = (|| -> Result<Vec<crate::iso::IsoDoc>> {
+                let options = tet_build::volume::VolumeOptions {
+                    replications: Some(n),
+                    ..Default::default()
+                };
+                let volume = load_iso_volume_with("buckycube", &options)?;
+                let iso = [volume.default_isovalue];
+                let f = IsoFrames {
+                    width: side,
+                    height: side,
+                    frames,
+                    time_step: 0,
+                    view: IsoView::of(&volume.mesh),
+                };
+                [IsoMethod::IbvhPackets, IsoMethod::WalkTet20]
+                    .iter()
+                    .map(|&m| measure(&volume, &iso, m, f, pool).map(|x| x.0))
+                    .collect()
+            })();
+            let (docs, error) = match docs {
+                Ok(d) => (d, None),
+                Err(e) => (Vec::new(), Some(format!("{e:#}"))),
+            };
+            IsoScaleRow {
+                replications: n,
+                balls: n * n * n,
+                docs,
+                error,
+            }
+        })
+        .collect()
+}
+
+/// Table 3: fps as the model grows.
+fn scaling_markdown(m: &mut String, doc: &TablesDoc) {
+    if doc.iso_scaling.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        m,
+        "\n### Isosurfaces as the model grows (seed 004 Table 3)\n\nThe bucky ball replicated n³ times without instancing (`iso buckycube --replications n`), {} threads here; the paper's fps are at 1024² on four 2.4 GHz Opteron cores. Memory is the method's own structure beside the mesh.\n",
+        doc.setup.threads
+    );
+    let _ = writeln!(
+        m,
+        "| balls | tets (paper) | method | pixels | build ms | fps | Mrays/s | MB | paper fps |"
+    );
+    let _ = writeln!(m, "|---:|---:|---|---:|---:|---:|---:|---:|---:|");
+    for row in &doc.iso_scaling {
+        let paper = PAPER_SCALING.iter().find(|p| p.0 == row.balls);
+        let (paper_tets, paper_fps) = paper.map_or(("–".to_string(), "–".to_string()), |p| {
+            (p.1.to_string(), format!("{}", p.2))
+        });
+        if let Some(e) = &row.error {
+            let _ = writeln!(
+                m,
+                "| {} | ({paper_tets}) | failed: {e} | | | | | | {paper_fps} |",
+                row.balls
+            );
+            continue;
+        }
+        for d in &row.docs {
+            let _ = writeln!(
+                m,
+                "| {} | {} ({paper_tets}) | {} | {}² | {:.0} | {:.2} | {:.2} | {:.1} | {paper_fps} |",
+                row.balls,
+                d.tets,
+                d.method.name(),
+                d.width,
+                d.build_ms,
+                d.fps,
+                d.mrays_per_s,
+                d.bytes as f64 / 1e6,
+            );
+        }
+    }
+}
+
+/// The tables: 1, 2 and 4, then 3.
 pub fn markdown(m: &mut String, doc: &TablesDoc) {
+    static_markdown(m, doc);
+    scaling_markdown(m, doc);
+}
+
+/// Tables 1, 2 and 4 on the four static stand-ins.
+fn static_markdown(m: &mut String, doc: &TablesDoc) {
     if doc.isosurfaces.is_empty() {
         return;
     }

@@ -22,7 +22,7 @@
 //! * speed vs accuracy — Mrays/s beside the failure rate per method and
 //!   precision, as given and at the extremes ([`speed_accuracy`]);
 //! * seed 001 Table 5 — exit-face search cost per method ([`exit_face`]);
-//! * Wald et al. (seed 004) Tables 1, 2, 4 — isosurfaces of tet volumes:
+//! * Wald et al. (seed 004) Tables 1–4 — isosurfaces of tet volumes:
 //!   the implicit min-max BVH (BIH and SAH builds, single rays, 16×16
 //!   packets) beside the iso walk over our layouts ([`isosurfaces`]);
 //! * Lauterbach et al. (seed 002) §6 — large models: Ray-Strips, the BVH
@@ -231,6 +231,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
             speed_accuracy::measure(&spec, args.quick, args.min_time_s())
         });
     let isosurfaces = isosurfaces::measure_all(args.quick, &pool);
+    let iso_scaling = isosurfaces::measure_scaling(args.quick, &pool);
     let large_sizes = args.large_model_sizes();
     let large_models = large_models::measure_all(&large_sizes, &opts, frames, &pool);
     let mut doc = TablesDoc {
@@ -239,6 +240,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
         exit_face,
         speed_accuracy,
         isosurfaces,
+        iso_scaling,
         out_of_core_note: args.quick.then(|| {
             "skipped in --quick mode: each scene is built twice more, in parts (run without --quick)"
                 .to_string()

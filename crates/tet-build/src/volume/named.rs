@@ -8,7 +8,7 @@
 //! | `feok`      | 121,668 | 26×26×30, 6-split | 121,680 | Marschner–Lobb, iso 0.5 |
 //! | `bucky`     | 224,874 | 39×31×31, 6-split (a 40×32×32-point grid) | 224,874 | C60 Gaussians |
 //! | `blunt`     | 176,856 | 27×33×33, 6-split | 176,418 | ramp plus a Gaussian ridge |
-//! | `buckycube` | 11.3 M  | default 54×66×66 (2³ balls); `full`: 108×132×132 (4³ balls), 6-split | 1,411,344 / 11,290,752 | C60 Gaussians, tiled |
+//! | `buckycube` | 11.3 M  | default 54×66×66 (2³ balls); `full`: 108×132×132 (4³ balls); `replications` `n`: 27n×33n×33n (n³ balls), 6-split | 1,411,344 / 11,290,752 (176,418 · n³) | C60 Gaussians, tiled |
 //! | `fusion`    | 3 M × 116 steps | default 50×50×20 × 16 steps; `full`: 100×100×50 × 116 steps, 6-split | 300,000 / 3,000,000 | moving Gaussian + travelling wave |
 //! | `linear`    | — | 16³, 6-split | 24,576 | linear, isosurfaces are planes |
 //! | `marschner-lobb` | — | 40³, 5-split | 320,000 | Marschner–Lobb |
@@ -43,6 +43,10 @@ pub struct VolumeOptions {
     /// Number of time steps of a time-varying volume (default: its own);
     /// ignored by static volumes (always one step).
     pub steps: Option<usize>,
+    /// `buckycube`: `n` bucky balls along each axis, `n³` in all (seed 004
+    /// Table 3 replicates the ball 1, 2³, 4³… times; 1 to 8, default 2, 4
+    /// with `full`); ignored by the other volumes.
+    pub replications: Option<u32>,
 }
 
 /// What a named volume is, before it is built.
@@ -62,7 +66,8 @@ pub struct VolumeInfo {
     pub steps: usize,
     /// An isovalue that gives a meaningful surface.
     pub isovalue: f32,
-    /// The paper's tet count for the data set this stands in for (Table 1).
+    /// The paper's tet count for the data set this stands in for (Table 1;
+    /// Table 3 for a replicated bucky cube).
     pub paper_tets: Option<u64>,
 }
 
@@ -210,13 +215,29 @@ pub fn synthetic_volume_info(
             Some(176_856),
         ),
         "buckycube" => {
-            let n = if options.full { 4 } else { 2 };
+            let n = options
+                .replications
+                .unwrap_or(if options.full { 4 } else { 2 });
+            if !(1..=8).contains(&n) {
+                return Err(VolumeError::BadParameter {
+                    what: "replications",
+                    detail: format!("{n} balls per axis (1 to 8)"),
+                });
+            }
             info(
                 grid([27 * n, 33 * n, 33 * n], Split::Six),
                 tiled_bucky(lo, hi, n),
                 "c60",
                 0.5,
-                Some(11_300_000),
+                // Seed 004 Table 3: 177 k tets per ball, 1.4 M for 2³,
+                // 11.3 M for 4³ (the bucky cube of Table 1), 90.4 M for 8³.
+                match n {
+                    1 => Some(177_000),
+                    2 => Some(1_400_000),
+                    4 => Some(11_300_000),
+                    8 => Some(90_400_000),
+                    _ => None,
+                },
             )
         }
         "fusion" => {
