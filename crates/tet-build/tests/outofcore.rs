@@ -11,7 +11,9 @@ use tet_build::outofcore::memory_model::{
     MemoryModel, MemorySample, knot_grid, measure_peak_memory, measurement_scenes,
     predict_peak_memory,
 };
-use tet_build::outofcore::split::{Side, SplitOptions, SplitPlane, SplitTree, plan_split};
+use tet_build::outofcore::split::{
+    Side, SplitOptions, SplitPlane, SplitTree, peel_plane, plan_split,
+};
 use tet_build::tetgen::{Isolation, WorkerCommand};
 
 fn worker() -> Isolation {
@@ -203,6 +205,70 @@ fn plane_search_prefers_fewer_cuts() {
     };
     assert_eq!(plane.value, mean as f32);
     assert_eq!(triangles_cut, cuts_at(mean as f32));
+}
+
+/// A dense core in a large box: the first cut takes the thick empty margin
+/// off along the core (only the box's own faces are cut), and a scene that
+/// fills its box has no margin to take off.
+#[test]
+fn a_thick_empty_margin_is_cut_off_first() {
+    let knots = knot_grid(1, 60, 8);
+    let (klo, khi) = knots.bounds().unwrap();
+    let mut vertices = knots.vertices.clone();
+    let mut triangles = knots.triangles.clone();
+    // A box four times the core's size around it, 12 triangles.
+    let (c, h) = ((klo + khi) * 0.5, (khi - klo) * 2.0);
+    let base = vertices.len() as u32;
+    for i in 0..8u32 {
+        let s = |b: u32| if i & b != 0 { 1.0 } else { -1.0 };
+        vertices.push(c + h * Vec3::new(s(1), s(2), s(4)));
+    }
+    for q in [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ] {
+        triangles.push([base + q[0], base + q[1], base + q[2]]);
+        triangles.push([base + q[0], base + q[2], base + q[3]]);
+    }
+    let bounds = (c - h * 1.1, c + h * 1.1);
+    let part: Vec<u32> = (0..triangles.len() as u32).collect();
+    let tolerance = 1e-6 * (bounds.1 - bounds.0).max_element() as f64;
+    let (plane, cut) =
+        peel_plane(&vertices, &triangles, &part, bounds, tolerance).expect("the margin is cut off");
+    // 1 % of the box's extent outside the core, on one of its sides.
+    let (lo, hi) = (klo[plane.axis], khi[plane.axis]);
+    let pad = 0.01 * (bounds.1[plane.axis] - bounds.0[plane.axis]);
+    assert!(
+        (plane.value - (lo - pad)).abs() < 1e-4 || (plane.value - (hi + pad)).abs() < 1e-4,
+        "{plane:?} core {lo}..{hi}"
+    );
+    // Only box triangles are cut: the four faces the plane crosses, two
+    // triangles each.
+    assert_eq!(cut, 8);
+    let cut_knots = knots.triangles.iter().any(|t| {
+        plane.classify(t.map(|v| knots.vertices[v as usize])) != Side::Below
+            && plane.classify(t.map(|v| knots.vertices[v as usize])) != Side::Above
+    });
+    assert!(!cut_knots);
+    // The plan starts with it.
+    let opts = SplitOptions {
+        min_depth: 1,
+        max_depth: 1,
+        ..SplitOptions::default()
+    };
+    let SplitTree::Split { plane: first, .. } = plan_split(&vertices, &triangles, bounds, &opts)
+    else {
+        panic!("expected a split");
+    };
+    assert_eq!(first, plane);
+    // The knots alone in a box 10 % larger: no margin to cut.
+    let part: Vec<u32> = (0..knots.triangles.len() as u32).collect();
+    let tight = (klo - (khi - klo) * 0.05, khi + (khi - klo) * 0.05);
+    assert!(peel_plane(&knots.vertices, &knots.triangles, &part, tight, tolerance).is_none());
 }
 
 /// The split recurses until every leaf's prediction fits, the leaves cover

@@ -169,7 +169,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     }
     let _ = writeln!(
         m,
-        "Limits are on the whole process tree: the builder's own share (`build --predict-memory` prints it) plus ½ and ⅓ of the in-core TetGen worker's measured peak. Each limited build runs as `tet-bench build SCENE --memory-limit L` in a process of its own, which sets its share aside, splits the scene recursively (seed 003's planes, or slabs when no tree fits) until the parts' *predicted* peaks fit what is left, starts parallel workers only while they fit together, and streams the merged mesh (exact seams, each part Hilbert-sorted) to a file read back for tet20. Parts are given as count, workers at once, planner and depth. Part peaks are the workers' measured `VmHWM`; tree peak is the builder and its workers together (resident memory sampled every 2 ms), what the limit bounds; aspect ratio = longest edge ÷ smallest height (seed 003 Table 3).\n"
+        "Limits are on the whole process tree: the builder's own share (`build --predict-memory` prints it) plus ½ and ⅓ of the in-core TetGen worker's measured peak. Each limited build runs as `tet-bench build SCENE --memory-limit L` in a process of its own, which sets its share aside, splits the scene recursively (seed 003's planes, or slabs when no tree fits) until the parts' *predicted* peaks fit what is left, starts parallel workers only while they fit together, and streams the merged mesh (exact seams, each part Hilbert-sorted) to a file read back for tet20. Parts are given as count, workers at once, planner and depth. Part peaks are the workers' measured `VmHWM`; tree peak is the builder and its workers together (resident memory sampled every 2 ms), what the limit bounds; aspect ratio = longest edge ÷ smallest height (seed 003 Table 3); tets per ray of tet20 on the table's camera, beside the in-core mesh's (the seams' cost to every ray).\n"
     );
     let _ = writeln!(
         m,
@@ -177,11 +177,11 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     );
     let _ = writeln!(
         m,
-        "| scene | limit | limit MiB | parts (at once) | triangles cut | build s | × in-core | max part peak MiB | tree peak MiB | tets | aspect mean / max | tet20 Mrays/s |"
+        "| scene | limit | limit MiB | parts (at once) | triangles cut | build s | × in-core | max part peak MiB | tree peak MiB | tets | aspect mean / max | tet20 Mrays/s | tets per ray (× in-core) |"
     );
     let _ = writeln!(
         m,
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     let aspect = |q: &Option<Quality>| {
         q.as_ref().map_or("–".into(), |q| {
@@ -197,19 +197,18 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
             .info
             .as_ref()
             .map_or(sc.spec.as_str(), |i| i.name.as_str());
-        let tet20 = sc
-            .renders
-            .iter()
-            .find(|r| r.method == Method::Tet20)
-            .map_or(f64::NAN, |r| r.mrays_per_s);
+        let in_core = sc.renders.iter().find(|r| r.method == Method::Tet20);
+        let tet20 = in_core.map_or(f64::NAN, |r| r.mrays_per_s);
+        let in_core_tpr = in_core.map_or(f64::NAN, |r| r.tets_per_ray);
         let _ = writeln!(
             m,
-            "| {name} | in core | – | 1 | 0 | {:.2} | 1.00 | {} | – | {} | {} | {:.2} |",
+            "| {name} | in core | – | 1 | 0 | {:.2} | 1.00 | {} | – | {} | {} | {:.2} | {:.1} (1.00) |",
             first.in_core_s,
             mib(first.in_core_peak_kib),
             first.in_core_tets,
             aspect(&first.in_core_quality),
-            tet20
+            tet20,
+            in_core_tpr
         );
         for r in &sc.out_of_core {
             let label = if r.fraction > 0.4 { "½" } else { "⅓" };
@@ -217,7 +216,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
                 (Some(mem), _) => {
                     let _ = writeln!(
                         m,
-                        "| {name} | {label} | {:.1} | {} ({} at once, {} depth {}) | {} | {:.2} | {:.2} | {} | {} | {} | {} | {:.2} |",
+                        "| {name} | {label} | {:.1} | {} ({} at once, {} depth {}) | {} | {:.2} | {:.2} | {} | {} | {} | {} | {:.2} | {:.1} ({:.2}) |",
                         mem.limit_bytes as f64 / (1024.0 * 1024.0),
                         mem.parts,
                         mem.parallel_parts,
@@ -230,13 +229,15 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
                         mib(mem.tree_peak_kib),
                         r.tets,
                         aspect(&r.quality),
-                        r.tet20.as_ref().map_or(f64::NAN, |t| t.mrays_per_s)
+                        r.tet20.as_ref().map_or(f64::NAN, |t| t.mrays_per_s),
+                        r.tet20.as_ref().map_or(f64::NAN, |t| t.tets_per_ray),
+                        r.tet20.as_ref().map_or(f64::NAN, |t| t.tets_per_ray) / in_core_tpr
                     );
                 }
                 (None, e) => {
                     let _ = writeln!(
                         m,
-                        "| {name} | {label} | failed: {} | | | | | | | | | |",
+                        "| {name} | {label} | failed: {} | | | | | | | | | | |",
                         e.as_deref().unwrap_or("")
                     );
                 }

@@ -21,7 +21,8 @@
 //! * [`split`]: part planning. [`split::plan_split`] is the paper's
 //!   recursive rule (plane through the mean of the axis of largest
 //!   variance, moved to a nearby plane cutting fewer triangles — the
-//!   paper's future work) as a [`split::SplitTree`] with the triangles cut
+//!   paper's future work; a thick empty margin around the scene's detail
+//!   is cut off first, [`split::peel_plane`]) as a [`split::SplitTree`] with the triangles cut
 //!   at every node; [`split::plan_slabs`] cuts parallel slabs on the axis
 //!   of largest variance at corner quantiles, as many as needed for every
 //!   slab's prediction to fit (the fallback when no tree fits).
