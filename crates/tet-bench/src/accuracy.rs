@@ -938,6 +938,13 @@ mod tests {
             let upper = c.x > 1.0 && c.x < 2.0 && c.z > 2.0 && c.z < 3.0;
             c.y > 1.0 && c.y < 2.0 && (lower || upper)
         };
+        solid_faces(grid, solid)
+    }
+
+    /// `grid` with its faces between a cell of `solid` (a test on the
+    /// cell's centre) and a cell outside it constrained: the solid's
+    /// closed surface.
+    fn solid_faces(grid: TetMesh, solid: impl Fn(Vec3) -> bool) -> TetMesh {
         constrain_faces(
             grid,
             |v| {
@@ -998,18 +1005,7 @@ mod tests {
             let x = (c.x > 1.0 && c.x < 2.0) || (c.x > 3.0 && c.x < 4.0);
             x && c.y > 1.0 && c.y < 2.0 && c.z > 1.0 && c.z < 2.0
         };
-        constrain_faces(
-            grid,
-            |v| {
-                (0..3).any(|a| {
-                    let m = (v[0] + v[1] + v[2]) / 3.0;
-                    let e = Vec3::AXES[a] * 0.5;
-                    let cell = |p: Vec3| p.floor() + Vec3::splat(0.5);
-                    v.iter().all(|p| p[a] == v[0][a]) && solid(cell(m - e)) != solid(cell(m + e))
-                })
-            },
-            None,
-        )
+        solid_faces(grid, solid)
     }
 
     #[test]

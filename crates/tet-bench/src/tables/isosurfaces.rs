@@ -13,7 +13,9 @@ use std::fmt::Write as _;
 use anyhow::Result;
 
 use super::doc::{IsoRow, IsoScaleRow, TablesDoc};
-use crate::iso::{IsoFrames, IsoMethod, IsoView, load_iso_volume, load_iso_volume_with, measure};
+use crate::iso::{
+    IsoFrames, IsoMethod, IsoView, IsoVolume, load_iso_volume, load_iso_volume_with, measure,
+};
 
 /// The paper's figures per data set: tets (Table 1), BIH and SAH build
 /// ms (Table 1, dual Core 2 Duo), laptop fps at 1024² (Table 2, 2 cores),
@@ -75,6 +77,29 @@ const PAPER: [Paper; 4] = [
     },
 ];
 
+/// `methods` on `volume` at its own isovalue, `side`² pixels, from its
+/// default view: one `iso` document each.
+fn measure_methods(
+    volume: &IsoVolume,
+    methods: &[IsoMethod],
+    side: u32,
+    frames: u32,
+    pool: &rayon::ThreadPool,
+) -> Result<Vec<crate::iso::IsoDoc>> {
+    let iso = [volume.default_isovalue];
+    let f = IsoFrames {
+        width: side,
+        height: side,
+        frames,
+        time_step: 0,
+        view: IsoView::of(&volume.mesh),
+    };
+    methods
+        .iter()
+        .map(|&m| measure(volume, &iso, m, f, pool).map(|x| x.0))
+        .collect()
+}
+
 /// Every method on the stand-ins (`quick`: ell32p at 256²).
 pub fn measure_all(quick: bool, pool: &rayon::ThreadPool) -> Vec<IsoRow> {
     let (names, side, frames): (&[&str], u32, u32) = if quick {
@@ -87,18 +112,7 @@ pub fn measure_all(quick: bool, pool: &rayon::ThreadPool) -> Vec<IsoRow> {
         eprintln!("isosurfaces: {name}, {side}², every method");
         let row = (|| -> Result<IsoRow> {
             let volume = load_iso_volume(name)?;
-            let iso = [volume.default_isovalue];
-            let f = IsoFrames {
-                width: side,
-                height: side,
-                frames,
-                time_step: 0,
-                view: IsoView::of(&volume.mesh),
-            };
-            let docs = IsoMethod::ALL
-                .iter()
-                .map(|&m| measure(&volume, &iso, m, f, pool).map(|x| x.0))
-                .collect::<Result<Vec<_>>>()?;
+            let docs = measure_methods(&volume, &IsoMethod::ALL, side, frames, pool)?;
             Ok(IsoRow {
                 volume: name.to_string(),
                 docs,
@@ -144,18 +158,8 @@ pub fn measure_scaling(quick: bool, pool: &rayon::ThreadPool) -> Vec<IsoScaleRow
                     ..Default::default()
                 };
                 let volume = load_iso_volume_with("buckycube", &options)?;
-                let iso = [volume.default_isovalue];
-                let f = IsoFrames {
-                    width: side,
-                    height: side,
-                    frames,
-                    time_step: 0,
-                    view: IsoView::of(&volume.mesh),
-                };
-                [IsoMethod::IbvhPackets, IsoMethod::WalkTet20]
-                    .iter()
-                    .map(|&m| measure(&volume, &iso, m, f, pool).map(|x| x.0))
-                    .collect()
+                let methods = [IsoMethod::IbvhPackets, IsoMethod::WalkTet20];
+                measure_methods(&volume, &methods, side, frames, pool)
             })();
             let (docs, error) = match docs {
                 Ok(d) => (d, None),
