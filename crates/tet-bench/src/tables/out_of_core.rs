@@ -22,7 +22,8 @@ pub use measuring::measure;
 /// TetGen, so only with the `tetgen` feature).
 #[cfg(feature = "tetgen")]
 mod measuring {
-    use super::{Method, Quality};
+    use crate::cli::Method;
+    use crate::tables::doc::{OutOfCoreRow, Quality, TABLE_FLAGS};
     use std::path::Path;
     use std::process::Command;
 
@@ -31,7 +32,6 @@ mod measuring {
     use tet_core::TetMesh;
     use tet_trace_cpu::render::RenderOptions;
 
-    use super::super::doc::{OutOfCoreRow, TABLE_FLAGS};
     use crate::load::{Loaded, with_mesh};
     use crate::outofcore::{MemoryReport, predict};
     use crate::output::error_chain;
