@@ -1220,7 +1220,7 @@ fn stretched_uv_sphere(nu: u32, rings: u32) -> Scene {
         let th = std::f64::consts::PI * f64::from(j) / f64::from(rings);
         for i in 0..nu {
             let (x, y) = match 4 * i {
-                k if k == 0 => (1.0, 0.0),
+                0 => (1.0, 0.0),
                 k if k == nu => (0.0, 1.0),
                 k if k == 2 * nu => (-1.0, 0.0),
                 k if k == 3 * nu => (0.0, -1.0),

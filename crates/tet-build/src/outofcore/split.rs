@@ -330,10 +330,7 @@ pub fn peel_plane(
             let mut clean = true;
             for &t in part {
                 let tri = triangles[t as usize].map(|v| vertices[v as usize]);
-                let near = tri.iter().any(|p| {
-                    let d = (p[axis] as f64 - value as f64).abs();
-                    d > 0.0 && d < tolerance
-                });
+                let near = near_plane_vertex(&tri, plane, tolerance).is_some();
                 let side = plane.classify(tri);
                 if near || side == Side::InPlane || (side == Side::Cut && small(tri)) {
                     clean = false;
