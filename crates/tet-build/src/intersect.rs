@@ -81,7 +81,32 @@ fn c3(p: DVec3) -> Coord3D<f64> {
 
 /// Exact orientation sign of `d` relative to plane `abc` (−1, 0, +1; the
 /// sign convention only needs to be consistent within this module).
+///
+/// Shewchuk's first, static-bound stage is inlined here (most calls end
+/// there); the rest of his adaptive predicate runs only when the rounded
+/// determinant is within its error bound.
+#[inline]
 fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> i8 {
+    // Shewchuk's `o3derrboundA`, with his ε = 2⁻⁵³.
+    const EPS: f64 = f64::EPSILON / 2.0;
+    const BOUND: f64 = (7.0 + 56.0 * EPS) * EPS;
+    let (ad, bd, cd) = (a - d, b - d, c - d);
+    let (bc, ca, ab) = (
+        bd.y * cd.z - bd.z * cd.y,
+        cd.y * ad.z - cd.z * ad.y,
+        ad.y * bd.z - ad.z * bd.y,
+    );
+    let det = ad.x * bc + bd.x * ca + cd.x * ab;
+    let permanent = ((bd.y * cd.z).abs() + (bd.z * cd.y).abs()) * ad.x.abs()
+        + ((cd.y * ad.z).abs() + (cd.z * ad.y).abs()) * bd.x.abs()
+        + ((ad.y * bd.z).abs() + (ad.z * bd.y).abs()) * cd.x.abs();
+    let bound = BOUND * permanent;
+    if det > bound {
+        return 1;
+    }
+    if -det > bound {
+        return -1;
+    }
     let o = robust::orient3d(c3(a), c3(b), c3(c), c3(d));
     (o > 0.0) as i8 - (o < 0.0) as i8
 }
@@ -248,6 +273,17 @@ fn classify(a: &[DVec3; 3], ax: usize, b: &[DVec3; 3], bx: usize) -> Option<Inte
     }
 }
 
+/// A triangle in one cell of the broad phase's grid.
+#[derive(Clone, Copy)]
+struct Entry {
+    triangle: u32,
+    /// Its box.
+    lo: [f32; 3],
+    hi: [f32; 3],
+    /// Its lowest cell.
+    cell: [u32; 3],
+}
+
 /// Find all pairs of triangles that meet beyond shared vertices/edges.
 ///
 /// Indices out of range or non-finite coordinates make the affected
@@ -351,15 +387,34 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
     for i in 0..ncells {
         counts[i + 1] += counts[i];
     }
+    // Each entry carries its triangle's box (exact: the corners are f32)
+    // and lowest cell, so that a cell's pairs are tested from contiguous
+    // memory.
     let mut fill = counts.clone();
-    let mut entries = vec![0u32; counts[ncells] as usize];
+    let total = counts[ncells] as usize;
+    let mut entries = vec![
+        Entry {
+            triangle: 0,
+            lo: [0.0; 3],
+            hi: [0.0; 3],
+            cell: [0; 3],
+        };
+        total
+    ];
     for (k, &t) in live.iter().enumerate() {
         let (cl, ch) = ranges[k];
+        let (l, h) = bb(t as usize);
+        let entry = Entry {
+            triangle: t,
+            lo: l.as_vec3().to_array(),
+            hi: h.as_vec3().to_array(),
+            cell: cl.map(|i| i as u32),
+        };
         for z in cl[2]..=ch[2] {
             for y in cl[1]..=ch[1] {
                 for x in cl[0]..=ch[0] {
                     let c = (z * ny + y) * nx + x;
-                    entries[fill[c] as usize] = t;
+                    entries[fill[c] as usize] = entry;
                     fill[c] += 1;
                 }
             }
@@ -371,20 +426,21 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
         .fold(
             || (0u64, Vec::new()),
             |(mut candidates, mut pairs), c| {
-                let cell_xyz = [c % nx, c / nx % ny, c / (nx * ny)];
+                let cell_xyz = [c % nx, c / nx % ny, c / (nx * ny)].map(|i| i as u32);
                 let list = &entries[counts[c] as usize..counts[c + 1] as usize];
-                for (i, &s) in list.iter().enumerate() {
-                    let (sl, sh) = bb(s as usize);
-                    for &t in &list[i + 1..] {
-                        let (tl, th) = bb(t as usize);
-                        if sl.cmpgt(th).any() || tl.cmpgt(sh).any() {
+                for (i, s) in list.iter().enumerate() {
+                    for t in &list[i + 1..] {
+                        if (0..3).any(|k| s.lo[k] > t.hi[k] || t.lo[k] > s.hi[k]) {
                             continue;
                         }
-                        // Test the pair only in the cell of the overlap's lower corner.
-                        if cell_of(sl.max(tl)) != cell_xyz {
+                        // Test the pair only in the cell of the overlap's
+                        // lower corner (`cell_of` is monotonic, so that is
+                        // the larger of the two lowest cells per axis).
+                        if (0..3).any(|k| s.cell[k].max(t.cell[k]) != cell_xyz[k]) {
                             continue;
                         }
                         candidates += 1;
+                        let (s, t) = (s.triangle, t.triangle);
                         let (a, b) = (s.min(t) as usize, s.max(t) as usize);
                         if let Some(kind) =
                             classify(&tris[a], axes[a] as usize, &tris[b], axes[b] as usize)
@@ -444,4 +500,53 @@ pub fn find_self_intersections_brute_force(
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The inlined filter gives robust's exact sign on random points and on
+    /// points on, or a few ulps off, a plane (where the filter must defer).
+    #[test]
+    fn filtered_orientation_matches_the_exact_predicate() {
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut rnd = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut deferred = 0;
+        for i in 0..20_000 {
+            let mut p: [DVec3; 4] =
+                std::array::from_fn(|_| DVec3::new(rnd(), rnd(), rnd()) * 10f64.powi((i % 7) - 3));
+            if i % 4 == 2 {
+                // Exactly coplanar (a plane z = const), one point possibly
+                // an ulp off it.
+                let z = p[0].z as f32;
+                for v in &mut p {
+                    v.z = f64::from(z);
+                }
+                let nudge = (i % 3) as f32 - 1.0;
+                p[3].z = f64::from(z + nudge * f32::EPSILON * z.abs());
+            } else if i % 2 == 1 {
+                // d on the plane of a, b, c (up to rounding), then nudged
+                // by a few ulps, as f32 coordinates are.
+                let (s, t) = (rnd(), rnd());
+                let q = p[0] + s * (p[1] - p[0]) + t * (p[2] - p[0]);
+                let nudge = (i % 5) as f32 - 2.0;
+                p[3] = q.as_vec3().as_dvec3();
+                p[3].z = f64::from((p[3].z as f32) + nudge * f32::EPSILON * (p[3].z as f32).abs());
+                for v in &mut p {
+                    *v = v.as_vec3().as_dvec3();
+                }
+            }
+            let exact = robust::orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3]));
+            let expected = (exact > 0.0) as i8 - (exact < 0.0) as i8;
+            assert_eq!(orient(p[0], p[1], p[2], p[3]), expected, "{p:?}");
+            deferred += usize::from(expected == 0);
+        }
+        assert!(deferred > 0, "no point exactly on a plane was tested");
+    }
 }

@@ -49,7 +49,9 @@ pub const NAMES: &[&str] = &[
 /// Parameterised names accepted by [`by_name`] besides [`NAMES`]:
 /// `dense-knots:N` is "Torus Knots" with about `N` triangles
 /// ([`dense_torus_knots`]; `N` may end in `k` or `m`).
-pub const PATTERNS: &[&str] = &["dense-knots:N"];
+/// `fan-sphere:N` is a bumpy UV sphere of about `N` triangles whose poles
+/// are fans of about `√N` long thin triangles ([`fan_sphere_by_count`]).
+pub const PATTERNS: &[&str] = &["dense-knots:N", "fan-sphere:N"];
 
 /// Build a procedural scene by name (see [`NAMES`] and [`PATTERNS`]).
 pub fn by_name(name: &str) -> Option<Scene> {
@@ -63,7 +65,13 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "sphere" => single("sphere", icosphere(2)),
         "two-quads" => single("two-quads", two_quads(0.5)),
         "thin-slab" => single("thin-slab", thin_slab(0.01)),
-        _ => return dense_knots_by_name(name),
+        _ => {
+            if let Some(n) = name.strip_prefix("fan-sphere:") {
+                let mesh = fan_sphere(&fan_sphere_by_count(parse_count(n)?));
+                return Some(single(name, mesh));
+            }
+            return dense_knots_by_name(name);
+        }
     })
 }
 
@@ -470,4 +478,91 @@ pub fn thin_slab(thickness: f32) -> MeshData {
         Vec3::new(-1.0, -1.0, -thickness / 2.0),
         Vec3::new(1.0, 1.0, thickness / 2.0),
     )
+}
+
+/// Parameters of [`fan_sphere`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FanSphereParams {
+    /// Vertices per ring (and triangles per pole fan). A multiple of 4
+    /// puts whole meridians exactly in the planes x = 0 and y = 0.
+    pub meridians: u32,
+    /// Rings of latitude plus one (`rings − 1` rings of vertices). Even
+    /// puts a ring exactly at z = 0.
+    pub rings: u32,
+    /// Scale along z (1: a sphere; larger: longer, thinner fan triangles).
+    pub stretch: f64,
+    /// Relative height of the bumps on the radius (0: smooth).
+    pub bump: f64,
+}
+
+/// A closed UV sphere around the origin, `meridians · (rings − 1) + 2`
+/// vertices and `2 · meridians · (rings − 1)` triangles, wound outward,
+/// whose poles are fans of `meridians` long thin triangles meeting at one
+/// vertex on the z axis. Such fans are what cut planes through a pole
+/// (out-of-core builds) must survive: every plane through the axis passes
+/// through both apexes, and with `meridians` a multiple of 4 the planes
+/// x = 0 and y = 0 run along whole meridians of edges (their coordinates
+/// there are exactly 0). The radius is `1 + bump · sin(9θ) · cos(7φ)`
+/// (colatitude θ, longitude φ), z is scaled by `stretch`.
+pub fn fan_sphere(params: &FanSphereParams) -> MeshData {
+    let FanSphereParams {
+        meridians: nu,
+        rings,
+        stretch,
+        bump,
+    } = *params;
+    let (nu, rings) = (nu.max(3), rings.max(2));
+    let mut positions = vec![Vec3::new(0.0, 0.0, stretch as f32)];
+    for j in 1..rings {
+        let th = std::f64::consts::PI * f64::from(j) / f64::from(rings);
+        for i in 0..nu {
+            let ph = std::f64::consts::TAU * f64::from(i) / f64::from(nu);
+            let (x, y) = match 4 * i {
+                0 => (1.0, 0.0),
+                k if k == nu => (0.0, 1.0),
+                k if k == 2 * nu => (-1.0, 0.0),
+                k if k == 3 * nu => (0.0, -1.0),
+                _ => (ph.cos(), ph.sin()),
+            };
+            let r = 1.0 + bump * (9.0 * th).sin() * (7.0 * ph).cos();
+            let s = r * th.sin();
+            let z = if 2 * j == rings {
+                0.0
+            } else {
+                stretch * r * th.cos()
+            };
+            positions.push(Vec3::new((s * x) as f32, (s * y) as f32, z as f32));
+        }
+    }
+    positions.push(Vec3::new(0.0, 0.0, -stretch as f32));
+    let at = |j: u32, i: u32| 1 + (j - 1) * nu + i % nu;
+    let south = positions.len() as u32 - 1;
+    let mut triangles = Vec::with_capacity(2 * (nu * (rings - 1)) as usize);
+    for i in 0..nu {
+        triangles.push([0, at(1, i), at(1, i + 1)]);
+        triangles.push([south, at(rings - 1, i + 1), at(rings - 1, i)]);
+    }
+    for j in 1..rings - 1 {
+        for i in 0..nu {
+            let (a, b, c, d) = (at(j, i), at(j, i + 1), at(j + 1, i), at(j + 1, i + 1));
+            triangles.push([a, c, d]);
+            triangles.push([a, d, b]);
+        }
+    }
+    MeshData::single_index(positions, triangles, None)
+}
+
+/// The [`fan_sphere`] of about `triangles` triangles: `meridians` the
+/// multiple of 4 nearest `√triangles` (at least 8), bumps of 2 %. At 10⁶
+/// triangles its poles are fans of 1,000 triangles.
+pub fn fan_sphere_by_count(triangles: u64) -> FanSphereParams {
+    let t = triangles as f64;
+    let meridians = (t.sqrt() / 4.0).round().max(2.0) as u32 * 4;
+    let rings = (t / (2.0 * f64::from(meridians))).round().max(1.0) as u32 + 1;
+    FanSphereParams {
+        meridians,
+        rings,
+        stretch: 1.0,
+        bump: 0.02,
+    }
 }

@@ -317,3 +317,54 @@ fn dense_knots_reach_the_asked_size_closed_and_oriented() {
         assert!(procedural::by_name(bad).is_none(), "{bad}");
     }
 }
+
+/// The fan sphere: hand counts, closed and outward (positive volume near
+/// the sphere's 4π/3·stretch), poles that are fans of `meridians`
+/// triangles around one vertex, whole meridians exactly in x = 0 and
+/// y = 0, no self-intersection; `fan-sphere:N` reaches about N triangles.
+#[test]
+fn fan_spheres_are_closed_with_fans_at_the_poles() {
+    use tet_build::procedural::{FanSphereParams, fan_sphere, fan_sphere_by_count};
+    let p = FanSphereParams {
+        meridians: 24,
+        rings: 10,
+        stretch: 3.0,
+        bump: 0.05,
+    };
+    let m = fan_sphere(&p);
+    assert_eq!(m.positions.len(), 24 * 9 + 2);
+    assert_eq!(m.triangles.len(), 2 * 24 * 9);
+    assert_closed_oriented(&m.triangles);
+    let v = signed_volume(&m.positions, &m.triangles);
+    let sphere = 4.0 / 3.0 * std::f64::consts::PI * 3.0;
+    assert!(
+        v > 0.8 * sphere && v < 1.05 * sphere,
+        "volume {v} vs {sphere}"
+    );
+    for pole in [0u32, m.positions.len() as u32 - 1] {
+        let fan = m.triangles.iter().filter(|t| t.contains(&pole)).count();
+        assert_eq!(fan, 24);
+        assert_eq!(m.positions[pole as usize].x, 0.0);
+        assert_eq!(m.positions[pole as usize].y, 0.0);
+    }
+    // Meridians 0 and 6 (a quarter turn) lie exactly in y = 0 and x = 0.
+    for j in 0..9 {
+        assert_eq!(m.positions[1 + j * 24].y, 0.0);
+        assert_eq!(m.positions[1 + j * 24 + 6].x, 0.0);
+    }
+    // The ring at z = 0 (rings even).
+    assert!((0..24).all(|i| m.positions[1 + 4 * 24 + i].z == 0.0));
+    assert!(find_self_intersections(&m.positions, &m.triangles).is_clean());
+    for n in [10_000u64, 1_000_000] {
+        let q = fan_sphere_by_count(n);
+        assert_eq!(q.meridians % 4, 0);
+        let t = 2 * u64::from(q.meridians) * u64::from(q.rings - 1);
+        assert!(t.abs_diff(n) * 50 < n, "{n}: {t} triangles");
+    }
+    assert_eq!(fan_sphere_by_count(1_000_000).meridians, 1000);
+    let scene = procedural::by_name("fan-sphere:10k").unwrap();
+    assert_eq!(
+        scene.triangles.len(),
+        fan_sphere(&fan_sphere_by_count(10_000)).triangles.len()
+    );
+}

@@ -83,6 +83,10 @@ pub struct MemoryReport {
     pub part_peak_kib: Vec<Option<u64>>,
     /// Largest measured part peak, KiB.
     pub max_part_peak_kib: Option<u64>,
+    /// Scene pieces of each part that TetGen returned split in two or
+    /// more faces by Steiner points it could not move off the surface
+    /// (kept as constrained faces of the same input triangle).
+    pub part_split_pieces: Vec<usize>,
     /// Wall time of the build (parts, merge, validation), s.
     pub total_s: f64,
     /// How the parts were merged: `in-core` (one part), `memory` (the

@@ -148,6 +148,19 @@ pub enum SeamError {
         /// Faces carrying its marker.
         faces: usize,
     },
+    /// TetGen split a scene piece of a part in a way the merge cannot take
+    /// (see [`super::facet_faces`]).
+    #[error("part {part}: facet {facet} came back as {faces} faces and {why}")]
+    FacetSplitBadly {
+        /// Part index (0 = lowest slab).
+        part: usize,
+        /// Facet index in the part's PLC.
+        facet: usize,
+        /// Faces carrying its marker.
+        faces: usize,
+        /// What is wrong with the split.
+        why: String,
+    },
     /// TetGen moved or dropped an input point.
     #[error("part {part}: TetGen moved or dropped input point {point}")]
     InputPointChanged {

@@ -1,16 +1,17 @@
 //! The parts of a split and their TetGen runs: [`SeamOptions`], each part's
-//! PLC run through TetGen `-pY` (every facet must come back as exactly one
-//! face), several parts at a time, and the [`SeamReport`] of a split build.
+//! PLC run through TetGen `-pY` (every seam facet must come back as exactly
+//! one face, see [`super::facet_faces`]), several parts at a time, and the [`SeamReport`] of a split build.
 
 use std::collections::HashMap;
 
 use glam::{DVec3, Vec3};
-use tet_core::face_key;
 
 use super::admission::Admission;
 use super::error::SeamError;
+use super::facet_faces::{TetgenFaces, constrained_faces};
 use super::plane::{SplitPlane, key};
 use crate::bbox::BoxSpec;
+use crate::pipeline::rounding::{orient_tets, snap_steiner_points};
 use crate::resolve::{ResolveOptions, ResolveReport};
 use crate::tetgen::{Isolation, TetgenError, TetgenInput, TetgenOptions, tetrahedralize};
 
@@ -46,6 +47,10 @@ pub struct SeamReport {
     /// Predicted peak memory of each part's TetGen run from its real input
     /// ([`super::memory_model::predict_part_peak_memory`], bytes, with margin).
     pub part_predicted_bytes: Vec<u64>,
+    /// Scene pieces of each part that TetGen returned split by Steiner
+    /// points it could not move off the surface (kept: see
+    /// [`super::facet_faces`]).
+    pub part_split_pieces: Vec<usize>,
     /// What resolving the whole scene's self-intersections did, before it
     /// was split (`None` when [`SeamOptions::resolve`] is off).
     pub resolve: Option<ResolveReport>,
@@ -112,6 +117,8 @@ pub(super) struct PartStats {
     pub(super) wall_triangles: usize,
     pub(super) tets: usize,
     pub(super) peak_kib: Option<u64>,
+    /// Scene pieces TetGen returned split by boundary Steiner points.
+    pub(super) split_pieces: usize,
 }
 
 /// One part after TetGen: f32 points, positive tets, constrained faces.
@@ -205,7 +212,22 @@ pub(super) fn run_part(
     run_plc(part, facets, PartPlc::new(facets, box_faces), options)
 }
 
+/// TetGen runs on one part before rounding gives up: the first, then
+/// re-runs with rounded Steiner points as input points.
+const MAX_PART_ROUNDS: usize = 4;
+
 /// Runs TetGen on a part's PLC (made of `facets`) and checks the result.
+///
+/// Rounding TetGen's Steiner points to f32 may flatten or invert tets;
+/// those points are first snapped to a neighbouring f32 value
+/// ([`snap_steiner_points`]), and where that is not enough TetGen runs
+/// again with the rounded Steiner points of the tets still flat as input
+/// points, so that its exact predicates see the coordinates the mesh
+/// stores. Only those points: feeding back every Steiner point (as the
+/// in-core build does) made TetGen's re-run of one part of the
+/// 1 M-triangle fan sphere take minutes instead of a second. Fed-back
+/// points lie strictly inside the part's box (TetGen keeps every wall
+/// facet whole), so the walls, and the seams, do not change.
 fn run_plc(
     part: usize,
     facets: &[([Vec3; 3], FacetKind)],
@@ -214,81 +236,101 @@ fn run_plc(
 ) -> Result<PartMesh, SeamError> {
     let PartPlc {
         points,
-        input,
+        mut input,
         wall_points,
         wall_triangles,
     } = plc;
+    let plc_points = input.points.len();
+    let plc_triangles = input.triangles.len();
     let mut topts = options.tetgen.clone();
     topts.preserve_surface = true;
-    let out = match tetrahedralize(&input, &topts, &options.isolation) {
-        Ok(out) => out,
-        Err(TetgenError::SelfIntersection) => {
-            return Err(self_intersection(part, facets, &points, &input.triangles));
+    let mut last_bad = 0;
+    for round in 1..=MAX_PART_ROUNDS {
+        let out = match tetrahedralize(&input, &topts, &options.isolation) {
+            Ok(out) => out,
+            // A repair round failed (a rounded point too close to a facet).
+            Err(_) if round > 1 => {
+                return Err(SeamError::RoundingFlattens {
+                    part,
+                    count: last_bad,
+                });
+            }
+            Err(TetgenError::SelfIntersection) => {
+                return Err(self_intersection(part, facets, &points, &input.triangles));
+            }
+            Err(source) => return Err(SeamError::Tetgen { part, source }),
+        };
+        if let Some(i) =
+            (0..input.points.len()).find(|&i| out.points.get(i) != Some(&input.points[i]))
+        {
+            return Err(SeamError::InputPointChanged { part, point: i });
         }
-        Err(source) => return Err(SeamError::Tetgen { part, source }),
-    };
-    if let Some(i) = (0..input.points.len()).find(|&i| out.points.get(i) != Some(&input.points[i]))
-    {
-        return Err(SeamError::InputPointChanged { part, point: i });
-    }
-    // Every facet must be exactly one face with its own vertices.
-    let mut count = vec![0usize; facets.len()];
-    let mut same = vec![false; facets.len()];
-    for (face, &m) in out.faces.iter().zip(&out.face_markers) {
-        if m <= 0 || m as usize > facets.len() {
-            continue;
+        // Seam facets must be exactly one face with their own vertices;
+        // scene pieces may be split inside the part (see `facet_faces`).
+        let returned = TetgenFaces {
+            points: &out.points,
+            faces: &out.faces,
+            markers: &out.face_markers,
+        };
+        let constrained = constrained_faces(part, facets, &input.triangles, plc_points, &returned)?;
+        let mut p32: Vec<Vec3> = out
+            .points
+            .iter()
+            .map(|p| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32))
+            .collect();
+        let (tets, mut bad) = orient_tets(&out.points, &p32, &out.tets);
+        if !bad.is_empty() {
+            (_, bad) = snap_steiner_points(
+                &|v| DVec3::from_array(out.points[v as usize]),
+                &mut p32,
+                &tets,
+                &bad,
+                input.points.len(),
+            );
         }
-        let f = m as usize - 1;
-        count[f] += 1;
-        same[f] = face_key(*face) == face_key(input.triangles[f]);
-    }
-    if let Some(f) = (0..facets.len()).find(|&f| count[f] != 1 || !same[f]) {
-        return Err(SeamError::FacetNotPreserved {
-            part,
-            facet: f,
-            faces: count[f],
-        });
-    }
-    let p32: Vec<Vec3> = out
-        .points
-        .iter()
-        .map(|p| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32))
-        .collect();
-    let mut tets = Vec::with_capacity(out.tets.len());
-    let mut bad = 0;
-    for &t in &out.tets {
-        let [a, b, c, d] = t.map(|v| DVec3::from_array(out.points[v as usize]));
-        let o = tet_core::predicates::orient3d(a, b, c, d);
-        let t = if o < 0.0 { [t[1], t[0], t[2], t[3]] } else { t };
-        let [a, b, c, d] = t.map(|v| p32[v as usize]);
-        if o == 0.0 || tet_core::predicates::orient3d_f32(a, b, c, d) <= 0.0 {
-            bad += 1;
+        if bad.is_empty() {
+            return Ok(PartMesh {
+                stats: PartStats {
+                    input_points: plc_points,
+                    input_triangles: plc_triangles,
+                    wall_points,
+                    wall_triangles,
+                    tets: tets.len(),
+                    peak_kib: out.worker_peak_kib,
+                    split_pieces: constrained.split_pieces,
+                },
+                points: p32,
+                tets,
+                constrained: constrained.faces,
+            });
         }
-        tets.push(t);
+        last_bad = bad.len();
+        // Feed the rounded Steiner points of the bad tets back (those not
+        // equal to a known point), as TetGen's coordinates of the f32
+        // values; the other Steiner points stay TetGen's to place.
+        let mut known: std::collections::HashSet<[u32; 3]> =
+            p32[..input.points.len()].iter().map(|&p| key(p)).collect();
+        let before = input.points.len();
+        let mut steiner: Vec<u32> = bad
+            .iter()
+            .flat_map(|&t| tets[t as usize])
+            .filter(|&v| v as usize >= before)
+            .collect();
+        steiner.sort_unstable();
+        steiner.dedup();
+        for v in steiner {
+            let p = p32[v as usize];
+            if known.insert(key(p)) {
+                input.points.push(p.as_dvec3().to_array());
+            }
+        }
+        if input.points.len() == before {
+            break;
+        }
     }
-    if bad > 0 {
-        return Err(SeamError::RoundingFlattens { part, count: bad });
-    }
-    let constrained = facets
-        .iter()
-        .zip(&input.triangles)
-        .filter_map(|((_, k), &t)| match k {
-            FacetKind::Scene(s) => Some((t, *s)),
-            FacetKind::Seam => None,
-        })
-        .collect();
-    Ok(PartMesh {
-        stats: PartStats {
-            input_points: input.points.len(),
-            input_triangles: input.triangles.len(),
-            wall_points,
-            wall_triangles,
-            tets: tets.len(),
-            peak_kib: out.worker_peak_kib,
-        },
-        points: p32,
-        tets,
-        constrained,
+    Err(SeamError::RoundingFlattens {
+        part,
+        count: last_bad,
     })
 }
 

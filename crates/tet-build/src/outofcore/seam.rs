@@ -20,8 +20,10 @@
 //!    are seam-only faces.
 //! 3. **Slabs**: each slab's PLC is its pieces + all triangles of the
 //!    seams bounding it + the other faces of its slab box; every facet has its own marker, and
-//!    TetGen with `-pY` keeps every facet as exactly one face (checked), so
-//!    both slabs next to a seam have the very same seam faces.
+//!    TetGen with `-pY` keeps every seam facet as exactly one face
+//!    (checked), so both slabs next to a seam have the very same seam
+//!    faces; a scene piece it returns split inside the slab keeps its
+//!    faces ([`super::facet_faces`]).
 //! 4. **Merge**: points are deduplicated by their exact f32 bits, tets are
 //!    concatenated, and [`TetMesh::assemble`] pairs the two slabs' seam
 //!    faces by vertex triple (a seam face carrying an in-plane scene
@@ -31,10 +33,10 @@
 //!    [`build_slabs_to_file`] streams the parts through part files instead
 //!    ([`super::stream`]), with the same result.
 //!
-//! TetGen's Steiner points (interior only, with `-Y`) are rounded to f32;
-//! a tet flattened by that rounding is reported as
-//! [`SeamError::RoundingFlattens`] (the in-core pipeline's snapping repair
-//! is not applied here yet).
+//! TetGen's Steiner points (never on a wall, with `-Y`) are rounded to
+//! f32; tets flattened by that rounding are repaired as in the in-core
+//! pipeline (snapping, then TetGen re-runs with the rounded points as
+//! input), and what remains is [`SeamError::RoundingFlattens`].
 
 use glam::Vec3;
 use tet_core::TetMesh;

@@ -33,7 +33,7 @@ pub mod options;
 mod prepare;
 mod reorder;
 mod resolve;
-mod rounding;
+pub(crate) mod rounding;
 mod validate;
 
 use std::time::Instant;

@@ -125,8 +125,7 @@ pub(super) fn tetrahedralize_rounded(
         if !bad.is_empty() {
             let snapped;
             (snapped, bad) = snap_steiner_points(
-                &out.points,
-                frame,
+                &|v| frame.user_point_f64(out.points[v as usize]),
                 &mut points,
                 &tets,
                 &bad,
@@ -192,7 +191,7 @@ fn key(p: Vec3) -> [u32; 3] {
 /// Swapping slots 0 and 1 is the only change made to a tet, so a tet differs
 /// from TetGen's exactly when it was flipped ([`super::assemble`] relies on
 /// this). Runs in parallel; the result does not depend on the thread count.
-pub(super) fn orient_tets(
+pub(crate) fn orient_tets(
     p64: &[[f64; 3]],
     p32: &[Vec3],
     tets: &[[u32; 4]],
@@ -219,11 +218,11 @@ pub(super) fn orient_tets(
 
 /// Snaps the Steiner points (index ≥ `first_steiner`) of the `bad` tets to
 /// a nearby f32 value that makes all their tets positive (exact test),
-/// nearest to TetGen's point first (`p64`, in `frame`). Returns how many
-/// points moved and the tets still bad.
-fn snap_steiner_points(
-    p64: &[[f64; 3]],
-    frame: &Frame,
+/// nearest to TetGen's point first (`target(v)`: point `v` as TetGen
+/// computed it, in user coordinates). Returns how many points moved and
+/// the tets still bad. The out-of-core parts use it too.
+pub(crate) fn snap_steiner_points(
+    target: &dyn Fn(u32) -> DVec3,
     p32: &mut [Vec3],
     tets: &[[u32; 4]],
     bad: &[u32],
@@ -272,7 +271,7 @@ fn snap_steiner_points(
             if incident.iter().all(|&t| positive(p32, t)) {
                 continue;
             }
-            let target = frame.user_point_f64(p64[v as usize]);
+            let target = target(v);
             let r = p32[v as usize];
             let mut candidates = Vec::with_capacity(125);
             for x in steps(r.x) {
@@ -345,7 +344,8 @@ mod tests {
         let (tets, bad) = orient_tets(&p64, &p32, &[[0, 1, 2, 3]]);
         assert_eq!(bad, vec![0]);
         let frame = Frame::IDENTITY;
-        let (moved, still) = snap_steiner_points(&p64, &frame, &mut p32, &tets, &bad, 3);
+        let target = |v: u32| frame.user_point_f64(p64[v as usize]);
+        let (moved, still) = snap_steiner_points(&target, &mut p32, &tets, &bad, 3);
         assert_eq!((moved, still), (1, vec![]));
         assert!(p32[3].z > 0.0 && p32[3].z <= 3.0 * f32::from_bits(1));
         assert_eq!(p32[3].x, 0.25);
@@ -354,7 +354,7 @@ mod tests {
             .iter()
             .map(|p| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32))
             .collect();
-        let (moved, still) = snap_steiner_points(&p64, &frame, &mut q32, &tets, &bad, 4);
+        let (moved, still) = snap_steiner_points(&target, &mut q32, &tets, &bad, 4);
         assert_eq!((moved, still), (0, vec![0]));
     }
 }
