@@ -11,7 +11,7 @@ use super::error::SeamError;
 use super::facet_faces::{TetgenFaces, constrained_faces};
 use super::plane::{SplitPlane, key};
 use crate::bbox::BoxSpec;
-use crate::pipeline::rounding::{orient_tets, snap_steiner_points};
+use crate::pipeline::rounding::{feed_back_steiner_points, orient_tets, snap_steiner_points};
 use crate::resolve::{ResolveOptions, ResolveReport};
 use crate::tetgen::{Isolation, TetgenError, TetgenInput, TetgenOptions, tetrahedralize};
 
@@ -223,9 +223,7 @@ const MAX_PART_ROUNDS: usize = 4;
 /// ([`snap_steiner_points`]), and where that is not enough TetGen runs
 /// again with the rounded Steiner points of the tets still flat as input
 /// points, so that its exact predicates see the coordinates the mesh
-/// stores. Only those points: feeding back every Steiner point (as the
-/// in-core build does) made TetGen's re-run of one part of the
-/// 1 M-triangle fan sphere take minutes instead of a second. Fed-back
+/// stores ([`feed_back_steiner_points`], as the in-core build does). Fed-back
 /// points lie strictly inside the part's box (TetGen keeps every wall
 /// facet whole), so the walls, and the seams, do not change.
 fn run_plc(
@@ -305,26 +303,9 @@ fn run_plc(
             });
         }
         last_bad = bad.len();
-        // Feed the rounded Steiner points of the bad tets back (those not
-        // equal to a known point), as TetGen's coordinates of the f32
-        // values; the other Steiner points stay TetGen's to place.
-        let mut known: std::collections::HashSet<[u32; 3]> =
-            p32[..input.points.len()].iter().map(|&p| key(p)).collect();
-        let before = input.points.len();
-        let mut steiner: Vec<u32> = bad
-            .iter()
-            .flat_map(|&t| tets[t as usize])
-            .filter(|&v| v as usize >= before)
-            .collect();
-        steiner.sort_unstable();
-        steiner.dedup();
-        for v in steiner {
-            let p = p32[v as usize];
-            if known.insert(key(p)) {
-                input.points.push(p.as_dvec3().to_array());
-            }
-        }
-        if input.points.len() == before {
+        // Feed the rounded Steiner points of the tets still flat back.
+        let to_tetgen = |p: Vec3| p.as_dvec3().to_array();
+        if feed_back_steiner_points(&mut input.points, &p32, &tets, &bad, &to_tetgen) == 0 {
             break;
         }
     }

@@ -16,8 +16,9 @@
 //! connectivity — the mesh stays a valid tetrahedralization of the same
 //! domain with the same constrained faces, only no longer exactly Delaunay
 //! near that point. Where snapping cannot fix a tet, TetGen is run again
-//! with the rounded Steiner points as ordinary input points (its exact
-//! predicates then see the very coordinates we store), up to
+//! with the rounded Steiner points of the tets still flat as ordinary input
+//! points (its exact predicates then see the very coordinates we store),
+//! up to
 //! [`BuildOptions::max_rounding_rounds`] times; a failure of such a re-run
 //! (e.g. a rounded point landing on a facet) or exhausting the rounds is
 //! [`BuildError::RoundingFlattens`], naming the tets. Input points (and
@@ -144,8 +145,14 @@ pub(super) fn tetrahedralize_rounded(
                 stats,
             });
         }
-        let steiner = &points[input.points.len()..];
-        if round > options.max_rounding_rounds || steiner.is_empty() {
+        // Feed the rounded Steiner points of the tets still flat back as
+        // input points, in the frame: exact, so TetGen sees the very f32
+        // values we store.
+        if round > options.max_rounding_rounds
+            || feed_back_steiner_points(&mut input.points, &points, &tets, &bad, &|p| {
+                frame.tetgen_point(p)
+            }) == 0
+        {
             return Err(BuildError::RoundingFlattens {
                 count: bad.len(),
                 tets: bad.into_iter().take(16).collect(),
@@ -153,24 +160,6 @@ pub(super) fn tetrahedralize_rounded(
             });
         }
         last_bad = bad;
-        // Feed the rounded Steiner points back as input points (deduplicated,
-        // and without any that coincide with an existing point), in the
-        // frame: exact, so TetGen sees the very f32 values we store.
-        let mut known: Vec<[u32; 3]> = points[..input.points.len()]
-            .iter()
-            .map(|&p| key(p))
-            .collect();
-        known.sort_unstable();
-        let mut extra: Vec<Vec3> = steiner
-            .iter()
-            .copied()
-            .filter(|&p| known.binary_search(&key(p)).is_err())
-            .collect();
-        extra.sort_by_key(|&p| key(p));
-        extra.dedup_by_key(|p| key(*p));
-        input
-            .points
-            .extend(extra.into_iter().map(|p| frame.tetgen_point(p)));
     }
 }
 
@@ -183,6 +172,35 @@ const SNAP_ULPS: usize = 4;
 /// The bits of an f32 point (`-0.0` as `0.0`), for sorting and equality.
 fn key(p: Vec3) -> [u32; 3] {
     (p + Vec3::ZERO).to_array().map(f32::to_bits)
+}
+
+/// Appends to TetGen's input `points` (the first `points.len()` of `p32`)
+/// the rounded Steiner points of the `bad` tets, once each and without any
+/// equal to an input point, in TetGen's coordinates (`to_tetgen`), sorted
+/// by their bits. Only those points: feeding back every Steiner point made
+/// one TetGen re-run take minutes instead of a second (a part of the
+/// 1 M-triangle fan sphere, out of core). Returns how many were added.
+pub(crate) fn feed_back_steiner_points(
+    points: &mut Vec<[f64; 3]>,
+    p32: &[Vec3],
+    tets: &[[u32; 4]],
+    bad: &[u32],
+    to_tetgen: &dyn Fn(Vec3) -> [f64; 3],
+) -> usize {
+    let first = points.len();
+    let mut known: Vec<[u32; 3]> = p32[..first].iter().map(|&p| key(p)).collect();
+    known.sort_unstable();
+    let mut extra: Vec<Vec3> = bad
+        .iter()
+        .flat_map(|&t| tets[t as usize])
+        .filter(|&v| v as usize >= first)
+        .map(|v| p32[v as usize])
+        .filter(|&p| known.binary_search(&key(p)).is_err())
+        .collect();
+    extra.sort_by_key(|&p| key(p));
+    extra.dedup_by_key(|p| key(*p));
+    points.extend(extra.iter().map(|&p| to_tetgen(p)));
+    extra.len()
 }
 
 /// Orients TetGen's tets positively by their exact f64 orientation, and lists
