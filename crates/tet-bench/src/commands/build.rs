@@ -240,12 +240,26 @@ fn print_memory(m: &MemoryReport) -> Result<()> {
         )?;
         return Ok(());
     }
+    // Slabs are cut along one axis; a tree's planes alternate.
+    let axis = |a: usize| ["x", "y", "z"][a.min(2)];
+    let cuts = if m.planner == "slabs" {
+        format!("{} parts along {}", m.parts, axis(m.axis.unwrap_or(0)))
+    } else {
+        let mut axes: Vec<&str> = m.plane_axes.iter().map(|&a| axis(a)).collect();
+        axes.sort_unstable();
+        axes.dedup();
+        format!(
+            "{} parts ({} planner, {} planes along {})",
+            m.parts,
+            m.planner,
+            m.plane_axes.len(),
+            axes.join(", ")
+        )
+    };
     outln!(
-        "  memory: predicted in-core peak {:.1} MiB > limit {:.1} MiB: {} parts along {} ({} at a time), {} scene triangles cut, {:.2} s",
+        "  memory: predicted in-core peak {:.1} MiB > limit {:.1} MiB: {cuts} ({} at a time), {} scene triangles cut, {:.2} s",
         mb(m.predicted_in_core_bytes),
         mb(m.limit_bytes),
-        m.parts,
-        ["x", "y", "z"][m.axis.unwrap_or(0).min(2)],
         m.parallel_parts,
         m.triangles_cut,
         m.total_s
