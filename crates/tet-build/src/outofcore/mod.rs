@@ -100,7 +100,7 @@
 
 pub mod admission;
 pub mod error;
-mod facet_faces;
+pub mod facet_faces;
 pub mod job;
 pub mod memory_model;
 mod merge;
