@@ -23,7 +23,15 @@ use glam::DVec3;
 use tet_core::face_key;
 
 use super::error::SeamError;
-use super::parts::FacetKind;
+
+/// A facet of a part's PLC and what it becomes in the merged mesh.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum FacetKind {
+    /// A scene-triangle piece (cleaned index).
+    Scene(u32),
+    /// A seam-only face.
+    Seam,
+}
 
 /// Relative tolerance on the area of a split piece: TetGen's Steiner points
 /// on a segment are computed in f64, so the faces' areas add up to the

@@ -8,6 +8,7 @@ use glam::{DVec3, Vec3};
 
 use super::admission::Admission;
 use super::error::SeamError;
+pub(super) use super::facet_faces::FacetKind;
 use super::facet_faces::{TetgenFaces, constrained_faces};
 use super::plane::{SplitPlane, key};
 use crate::bbox::BoxSpec;
@@ -95,15 +96,6 @@ impl Default for SeamOptions {
             resolve: Some(ResolveOptions::default()),
         }
     }
-}
-
-/// A facet of a part's PLC and what it becomes in the merged mesh.
-#[derive(Clone, Copy, Debug)]
-pub(super) enum FacetKind {
-    /// A scene-triangle piece (cleaned index).
-    Scene(u32),
-    /// A seam-only face.
-    Seam,
 }
 
 /// What one part's TetGen run took and gave (the per-part report fields).
