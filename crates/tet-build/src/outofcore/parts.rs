@@ -12,7 +12,9 @@ pub(super) use super::facet_faces::FacetKind;
 use super::facet_faces::{TetgenFaces, constrained_faces};
 use super::plane::{SplitPlane, key};
 use crate::bbox::BoxSpec;
-use crate::pipeline::rounding::{feed_back_steiner_points, orient_tets, snap_steiner_points};
+use crate::pipeline::rounding::{
+    FeedBack, feed_back_steiner_points, orient_tets, snap_steiner_points,
+};
 use crate::resolve::{ResolveOptions, ResolveReport};
 use crate::tetgen::{Isolation, TetgenError, TetgenInput, TetgenOptions, tetrahedralize};
 
@@ -215,7 +217,7 @@ const MAX_PART_ROUNDS: usize = 4;
 /// ([`snap_steiner_points`]), and where that is not enough TetGen runs
 /// again with the rounded Steiner points of the tets still flat as input
 /// points, so that its exact predicates see the coordinates the mesh
-/// stores ([`feed_back_steiner_points`], as the in-core build does). Fed-back
+/// stores ([`FeedBack::FlatTets`]: only those, unlike the in-core build). Fed-back
 /// points lie strictly inside the part's box (TetGen keeps every wall
 /// facet whole), so the walls, and the seams, do not change.
 fn run_plc(
@@ -297,7 +299,8 @@ fn run_plc(
         last_bad = bad.len();
         // Feed the rounded Steiner points of the tets still flat back.
         let to_tetgen = |p: Vec3| p.as_dvec3().to_array();
-        if feed_back_steiner_points(&mut input.points, &p32, &tets, &bad, &to_tetgen) == 0 {
+        let which = FeedBack::FlatTets;
+        if feed_back_steiner_points(&mut input.points, &p32, which, &tets, &bad, &to_tetgen) == 0 {
             break;
         }
     }

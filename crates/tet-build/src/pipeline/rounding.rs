@@ -16,9 +16,8 @@
 //! connectivity — the mesh stays a valid tetrahedralization of the same
 //! domain with the same constrained faces, only no longer exactly Delaunay
 //! near that point. Where snapping cannot fix a tet, TetGen is run again
-//! with the rounded Steiner points of the tets still flat as ordinary input
-//! points (its exact predicates then see the very coordinates we store),
-//! up to
+//! with the rounded Steiner points as ordinary input points (its exact
+//! predicates then see the very coordinates we store), up to
 //! [`BuildOptions::max_rounding_rounds`] times; a failure of such a re-run
 //! (e.g. a rounded point landing on a facet) or exhausting the rounds is
 //! [`BuildError::RoundingFlattens`], naming the tets. Input points (and
@@ -145,13 +144,18 @@ pub(super) fn tetrahedralize_rounded(
                 stats,
             });
         }
-        // Feed the rounded Steiner points of the tets still flat back as
-        // input points, in the frame: exact, so TetGen sees the very f32
-        // values we store.
+        // Feed the rounded Steiner points back as input points, in the
+        // frame: exact, so TetGen sees the very f32 values we store.
+        let to_tetgen = |p| frame.tetgen_point(p);
         if round > options.max_rounding_rounds
-            || feed_back_steiner_points(&mut input.points, &points, &tets, &bad, &|p| {
-                frame.tetgen_point(p)
-            }) == 0
+            || feed_back_steiner_points(
+                &mut input.points,
+                &points,
+                FeedBack::All,
+                &tets,
+                &bad,
+                &to_tetgen,
+            ) == 0
         {
             return Err(BuildError::RoundingFlattens {
                 count: bad.len(),
@@ -174,15 +178,28 @@ fn key(p: Vec3) -> [u32; 3] {
     (p + Vec3::ZERO).to_array().map(f32::to_bits)
 }
 
+/// Which rounded Steiner points a TetGen re-run takes as input points
+/// ([`feed_back_steiner_points`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum FeedBack {
+    /// Every Steiner point: TetGen then sees the whole rounded mesh's
+    /// points (the in-core build; with only the flat tets' points, Neptune
+    /// in its wide box still had two flat tets after three runs).
+    All,
+    /// Only the Steiner points of the flat tets (the out-of-core parts:
+    /// feeding back every one made TetGen's re-run of a part of the
+    /// 1 M-triangle fan sphere take minutes instead of a second).
+    FlatTets,
+}
+
 /// Appends to TetGen's input `points` (the first `points.len()` of `p32`)
-/// the rounded Steiner points of the `bad` tets, once each and without any
+/// the rounded Steiner points `which` says, once each and without any
 /// equal to an input point, in TetGen's coordinates (`to_tetgen`), sorted
-/// by their bits. Only those points: feeding back every Steiner point made
-/// one TetGen re-run take minutes instead of a second (a part of the
-/// 1 M-triangle fan sphere, out of core). Returns how many were added.
+/// by their bits. Returns how many were added.
 pub(crate) fn feed_back_steiner_points(
     points: &mut Vec<[f64; 3]>,
     p32: &[Vec3],
+    which: FeedBack,
     tets: &[[u32; 4]],
     bad: &[u32],
     to_tetgen: &dyn Fn(Vec3) -> [f64; 3],
@@ -190,11 +207,17 @@ pub(crate) fn feed_back_steiner_points(
     let first = points.len();
     let mut known: Vec<[u32; 3]> = p32[..first].iter().map(|&p| key(p)).collect();
     known.sort_unstable();
-    let mut extra: Vec<Vec3> = bad
-        .iter()
-        .flat_map(|&t| tets[t as usize])
-        .filter(|&v| v as usize >= first)
-        .map(|v| p32[v as usize])
+    let candidates: Vec<Vec3> = match which {
+        FeedBack::All => p32[first..].to_vec(),
+        FeedBack::FlatTets => bad
+            .iter()
+            .flat_map(|&t| tets[t as usize])
+            .filter(|&v| v as usize >= first)
+            .map(|v| p32[v as usize])
+            .collect(),
+    };
+    let mut extra: Vec<Vec3> = candidates
+        .into_iter()
         .filter(|&p| known.binary_search(&key(p)).is_err())
         .collect();
     extra.sort_by_key(|&p| key(p));
