@@ -371,11 +371,20 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
     // Counting sort of (cell, triangle) entries.
     let ncells = nx * ny * nz;
     let mut counts = vec![0u32; ncells + 1];
+    // Each entry carries its triangle's box (exact: the corners are f32)
+    // and lowest cell, so that a cell's pairs are tested from contiguous
+    // memory.
     let mut ranges = Vec::with_capacity(live.len());
     for &t in &live {
         let (l, h) = bb(t as usize);
         let (cl, ch) = (cell_of(l), cell_of(h));
-        ranges.push((cl, ch));
+        let entry = Entry {
+            triangle: t,
+            lo: l.as_vec3().to_array(),
+            hi: h.as_vec3().to_array(),
+            cell: cl.map(|i| i as u32),
+        };
+        ranges.push((entry, ch));
         for z in cl[2]..=ch[2] {
             for y in cl[1]..=ch[1] {
                 for x in cl[0]..=ch[0] {
@@ -387,9 +396,6 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
     for i in 0..ncells {
         counts[i + 1] += counts[i];
     }
-    // Each entry carries its triangle's box (exact: the corners are f32)
-    // and lowest cell, so that a cell's pairs are tested from contiguous
-    // memory.
     let mut fill = counts.clone();
     let total = counts[ncells] as usize;
     let mut entries = vec![
@@ -401,15 +407,8 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
         };
         total
     ];
-    for (k, &t) in live.iter().enumerate() {
-        let (cl, ch) = ranges[k];
-        let (l, h) = bb(t as usize);
-        let entry = Entry {
-            triangle: t,
-            lo: l.as_vec3().to_array(),
-            hi: h.as_vec3().to_array(),
-            cell: cl.map(|i| i as u32),
-        };
+    for &(entry, ch) in &ranges {
+        let cl = entry.cell.map(|i| i as usize);
         for z in cl[2]..=ch[2] {
             for y in cl[1]..=ch[1] {
                 for x in cl[0]..=ch[0] {

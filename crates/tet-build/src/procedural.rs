@@ -65,21 +65,24 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "sphere" => single("sphere", icosphere(2)),
         "two-quads" => single("two-quads", two_quads(0.5)),
         "thin-slab" => single("thin-slab", thin_slab(0.01)),
-        _ => {
-            if let Some(n) = name.strip_prefix("fan-sphere:") {
-                let mesh = fan_sphere(&fan_sphere_by_count(parse_count(n)?));
-                return Some(single(name, mesh));
-            }
-            return dense_knots_by_name(name);
-        }
+        _ => return by_pattern(name),
     })
 }
 
-/// `dense-knots:N`: [`dense_torus_knots`] with about `N` triangles
-/// ([`parse_count`]), e.g. `dense-knots:10m`.
-fn dense_knots_by_name(name: &str) -> Option<Scene> {
-    let n = parse_count(name.strip_prefix("dense-knots:")?)?;
-    Some(dense_torus_knots(n))
+/// The scenes of [`PATTERNS`]: `dense-knots:N` ([`dense_torus_knots`]) and
+/// `fan-sphere:N` ([`fan_sphere_by_count`]), `N` a count as
+/// [`parse_count`] reads it, e.g. `dense-knots:10m`.
+fn by_pattern(name: &str) -> Option<Scene> {
+    let (pattern, count) = name.split_once(':')?;
+    let n = parse_count(count)?;
+    match pattern {
+        "dense-knots" => Some(dense_torus_knots(n)),
+        "fan-sphere" => Some(single_object_scene(
+            name,
+            &fan_sphere(&fan_sphere_by_count(n)),
+        )),
+        _ => None,
+    }
 }
 
 /// A count written as digits with an optional `k` or `m` suffix

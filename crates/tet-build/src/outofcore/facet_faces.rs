@@ -86,49 +86,15 @@ pub(super) fn constrained_faces(
             FacetKind::Scene(source) if whole => result.faces.push((tri, *source)),
             FacetKind::Seam if whole => {}
             FacetKind::Scene(source) if faces.len() > 1 => {
-                let bad = |why: String| SeamError::FacetSplitBadly {
-                    part,
-                    facet: f,
-                    faces: faces.len(),
-                    why,
-                };
-                let p = |v: u32| DVec3::from_array(out.points[v as usize]);
-                for &v in faces.iter().flatten() {
-                    if tri.contains(&v) {
-                        continue;
+                let kept = split_piece(tri, faces, out, input_points, (lo, hi)).map_err(|why| {
+                    SeamError::FacetSplitBadly {
+                        part,
+                        facet: f,
+                        faces: faces.len(),
+                        why,
                     }
-                    if (v as usize) < input_points {
-                        return Err(bad(format!("it passes through input point {v}")));
-                    }
-                    let q = p(v);
-                    if (0..3).any(|a| q[a] <= lo[a] || q[a] >= hi[a]) {
-                        return Err(bad(format!("Steiner point {q:?} lies on a wall")));
-                    }
-                }
-                if let Some(&v) = tri
-                    .iter()
-                    .find(|v| !faces.iter().flatten().any(|w| w == *v))
-                {
-                    return Err(bad(format!("no face uses its vertex {v}")));
-                }
-                let normal = |t: [u32; 3]| (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
-                let n = normal(tri);
-                let pieces: f64 = faces.iter().map(|&t| normal(t).length()).sum();
-                if (pieces - n.length()).abs() > AREA_TOLERANCE * n.length() {
-                    return Err(bad(format!(
-                        "its faces' area {} differs from its own {}",
-                        pieces / 2.0,
-                        n.length() / 2.0
-                    )));
-                }
-                for &t in faces {
-                    let t = if normal(t).dot(n) < 0.0 {
-                        [t[1], t[0], t[2]]
-                    } else {
-                        t
-                    };
-                    result.faces.push((t, *source));
-                }
+                })?;
+                result.faces.extend(kept.into_iter().map(|t| (t, *source)));
                 result.split_pieces += 1;
             }
             _ => {
@@ -141,6 +107,57 @@ pub(super) fn constrained_faces(
         }
     }
     Ok(result)
+}
+
+/// The faces of a scene piece `tri` that TetGen returned split, wound like
+/// the piece, when the split follows the module's rules; else what is
+/// wrong with it. `(lo, hi)` is the part's box.
+fn split_piece(
+    tri: [u32; 3],
+    faces: &[[u32; 3]],
+    out: &TetgenFaces<'_>,
+    input_points: usize,
+    (lo, hi): (DVec3, DVec3),
+) -> Result<Vec<[u32; 3]>, String> {
+    let p = |v: u32| DVec3::from_array(out.points[v as usize]);
+    for &v in faces.iter().flatten() {
+        if tri.contains(&v) {
+            continue;
+        }
+        if (v as usize) < input_points {
+            return Err(format!("it passes through input point {v}"));
+        }
+        let q = p(v);
+        if (0..3).any(|a| q[a] <= lo[a] || q[a] >= hi[a]) {
+            return Err(format!("Steiner point {q:?} lies on a wall"));
+        }
+    }
+    if let Some(&v) = tri
+        .iter()
+        .find(|v| !faces.iter().flatten().any(|w| w == *v))
+    {
+        return Err(format!("no face uses its vertex {v}"));
+    }
+    let normal = |t: [u32; 3]| (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
+    let n = normal(tri);
+    let pieces: f64 = faces.iter().map(|&t| normal(t).length()).sum();
+    if (pieces - n.length()).abs() > AREA_TOLERANCE * n.length() {
+        return Err(format!(
+            "its faces' area {} differs from its own {}",
+            pieces / 2.0,
+            n.length() / 2.0
+        ));
+    }
+    Ok(faces
+        .iter()
+        .map(|&t| {
+            if normal(t).dot(n) < 0.0 {
+                [t[1], t[0], t[2]]
+            } else {
+                t
+            }
+        })
+        .collect())
 }
 
 /// The box of the part's input points (its walls' corners are among them).

@@ -1,6 +1,7 @@
 //! The parts of a split and their TetGen runs: [`SeamOptions`], each part's
 //! PLC run through TetGen `-pY` (every seam facet must come back as exactly
-//! one face, see [`super::facet_faces`]), several parts at a time, and the [`SeamReport`] of a split build.
+//! one face, see [`super::facet_faces`]), several parts at a time, and the
+//! [`SeamReport`] of a split build.
 
 use std::collections::HashMap;
 
@@ -217,9 +218,9 @@ const MAX_PART_ROUNDS: usize = 4;
 /// ([`snap_steiner_points`]), and where that is not enough TetGen runs
 /// again with the rounded Steiner points of the tets still flat as input
 /// points, so that its exact predicates see the coordinates the mesh
-/// stores ([`FeedBack::FlatTets`]: only those, unlike the in-core build). Fed-back
-/// points lie strictly inside the part's box (TetGen keeps every wall
-/// facet whole), so the walls, and the seams, do not change.
+/// stores ([`FeedBack::FlatTets`]: only those, unlike the in-core build).
+/// Fed-back points lie strictly inside the part's box (TetGen keeps every
+/// wall facet whole), so the walls, and the seams, do not change.
 fn run_plc(
     part: usize,
     facets: &[([Vec3; 3], FacetKind)],
