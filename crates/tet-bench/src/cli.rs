@@ -66,7 +66,10 @@ pub struct BuildFlags {
     /// `--quality`.
     #[arg(long, value_name = "DEGREES")]
     pub min_dihedral: Option<f64>,
-    /// Cap on Steiner points (`-S`).
+    /// Cap on the Steiner points of the quality refinement (`-S`; the
+    /// points TetGen adds to recover the scene's edges and faces do not
+    /// count). With `--min-dihedral 2`, a few hundred already remove the
+    /// worst slivers.
     #[arg(long)]
     pub max_steiner: Option<u64>,
     /// TetGen's mesh optimisation `LEVEL/SCHEME` (`-O`): up to 2^LEVEL − 1

@@ -4,6 +4,7 @@
 #include "tet_shim.h"
 #include "tetgen.h"
 
+#include <climits>
 #include <cstdio>
 #include <new>
 #include <unistd.h>
@@ -12,12 +13,75 @@ namespace {
 struct Result {
     tetgenio out;
 };
+
+// TetGen's own driver (tetrahedralize() in tetgen.cxx) reduced to the
+// switches tet-build writes (-p, -Y, -c, -n/-nn, -q, -S, -O, -o/, -T, -z,
+// -Q), with one change: -S<n> caps the Steiner points of the quality
+// refinement alone. TetGen counts the points its boundary recovery added
+// (thousands on some scenes) against -S too, so a cap smaller than those
+// stopped the refinement before it began.
+int run_tetgen(tetgenbehavior *b, tetgenio *in, tetgenio *out) {
+    tetgenmesh m;
+    m.b = b;
+    m.in = in;
+    m.addin = nullptr;
+    m.initializepools();
+    m.transfernodes();
+    if (exactinit(b->verbose, b->noexact, b->nostaticfilter, m.xmax - m.xmin,
+                  m.ymax - m.ymin, m.zmax - m.zmin) != 0) {
+        return 1;
+    }
+    clock_t ts = clock();
+    m.incrementaldelaunay(ts);
+    m.meshsurface();
+    if (b->nobisect) {
+        m.recoverboundary(ts);
+    } else {
+        m.constraineddelaunay(ts);
+    }
+    m.carveholes();
+    if (b->nobisect) {
+        if (m.subvertstack->objects > 0l) {
+            m.suppresssteinerpoints();
+        }
+        m.recoverdelaunay();
+    }
+    if (b->quality) {
+        if (b->steinerleft > 0) {
+            long recovery = m.st_segref_count + m.st_facref_count + m.st_volref_count;
+            long cap = (long)b->steinerleft + recovery;
+            b->steinerleft = cap > INT_MAX ? INT_MAX : (int)cap;
+        }
+        m.delaunayrefinement();
+    }
+    if (b->optlevel > 0) {
+        m.optimizemesh();
+    }
+    if (!b->nojettison && (m.dupverts > 0 || m.unuverts > 0)) {
+        m.jettisonnodes();
+    }
+    out->firstnumber = in->firstnumber;
+    out->mesh_dim = in->mesh_dim;
+    m.outnodes(out);
+    if (m.tetrahedrons->items > 0l) {
+        m.outelements(out);
+    }
+    if (m.subfaces->items > 0l) {
+        m.outsubfaces(out);
+    }
+    m.outsubsegments(out);
+    if (b->neighout) {
+        m.outneighbors(out);
+    }
+    return 0;
+}
 }
 
 extern "C" int32_t tetshim_tetrahedralize(const double *points, int32_t npoints,
                                           const int32_t *triangles, const int32_t *markers,
                                           int32_t ntriangles, const char *switches,
-                                          void **handle, TetShimView *view) {
+                                          int32_t library_driver, void **handle,
+                                          TetShimView *view) {
     *handle = nullptr;
     if (npoints < 0 || ntriangles < 0 || points == nullptr ||
         (ntriangles > 0 && triangles == nullptr)) {
@@ -55,7 +119,8 @@ extern "C" int32_t tetshim_tetrahedralize(const double *points, int32_t npoints,
             }
         }
         res = new Result();
-        int status = tetrahedralize(&b, &in, &res->out, nullptr, nullptr);
+        int status = library_driver ? tetrahedralize(&b, &in, &res->out, nullptr, nullptr)
+                                    : run_tetgen(&b, &in, &res->out);
         if (status != 0) {
             delete res;
             return TETSHIM_FLAT_INPUT;

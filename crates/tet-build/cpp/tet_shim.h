@@ -30,10 +30,13 @@ typedef struct TetShimView {
 // 2 internal error, 3 self-intersection, 4 small feature, 5 close facets,
 // 10 input error, 0 stopped).
 
+// library_driver = 0 runs the shim's driver (-S caps the refinement's
+// Steiner points alone); 1 runs TetGen's tetrahedralize() (for comparison).
 int32_t tetshim_tetrahedralize(const double *points, int32_t npoints,
                                const int32_t *triangles, const int32_t *markers,
                                int32_t ntriangles, const char *switches,
-                               void **handle, TetShimView *view);
+                               int32_t library_driver, void **handle,
+                               TetShimView *view);
 
 void tetshim_free(void *handle);
 

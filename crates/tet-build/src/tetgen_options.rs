@@ -13,8 +13,11 @@ pub struct TetgenOptions {
     /// angle is below `degrees` (slivers). Without [`Self::quality`] the
     /// ratio bound is [`NO_RATIO`] (no radius-edge refinement).
     pub min_dihedral: Option<f64>,
-    /// `-S<n>`: at most `n` Steiner points. Caps `-q` refinement, which
-    /// otherwise may not terminate between near-parallel facets.
+    /// `-S<n>`: at most `n` Steiner points from the quality refinement
+    /// (`-q`), which otherwise may not terminate between near-parallel
+    /// facets. Unlike TetGen's own driver, ours does not count the points
+    /// the boundary recovery added (thousands on some scenes, which left a
+    /// smaller cap no refinement at all).
     pub max_steiner: Option<u64>,
     /// `-T<tol>`: coplanarity tolerance (TetGen's default 1e-8).
     pub coplanar_tolerance: Option<f64>,

@@ -59,7 +59,9 @@ pub const UNKNOWN_EXCEPTION: i32 = -4;
 
 unsafe extern "C" {
     /// Runs TetGen on a PLC of triangles (one facet per triangle, marker per
-    /// facet). Returns 0 and fills `handle`/`view`, or an error code.
+    /// facet) with the shim's driver (`library_driver` = 0: `-S` caps the
+    /// refinement's Steiner points alone) or TetGen's own (1). Returns 0
+    /// and fills `handle`/`view`, or an error code.
     pub fn tetshim_tetrahedralize(
         points: *const f64,
         npoints: i32,
@@ -67,6 +69,7 @@ unsafe extern "C" {
         markers: *const i32,
         ntriangles: i32,
         switches: *const c_char,
+        library_driver: i32,
         handle: *mut *mut c_void,
         view: *mut TetShimView,
     ) -> i32;

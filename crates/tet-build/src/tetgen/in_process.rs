@@ -7,10 +7,30 @@ use super::error::TetgenError;
 use super::ffi;
 use super::types::{TetgenInput, TetgenOptions, TetgenOutput};
 
+/// Which TetGen driver runs the stages (`-S` is counted differently).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Driver {
+    /// The shim's: `-S` caps the quality refinement's Steiner points alone.
+    Shim,
+    /// TetGen's own `tetrahedralize()`: `-S` counts the boundary
+    /// recovery's Steiner points too (kept to compare the two).
+    #[cfg_attr(not(test), allow(dead_code))]
+    Library,
+}
+
 /// Runs TetGen in this process (input already checked).
 pub(crate) fn run_in_process(
     input: &TetgenInput,
     options: &TetgenOptions,
+) -> Result<TetgenOutput, TetgenError> {
+    run_with_driver(input, options, Driver::Shim)
+}
+
+/// [`run_in_process`] with the given driver.
+pub(crate) fn run_with_driver(
+    input: &TetgenInput,
+    options: &TetgenOptions,
+    driver: Driver,
 ) -> Result<TetgenOutput, TetgenError> {
     let switches = options.switches();
     let c_switches =
@@ -43,6 +63,7 @@ pub(crate) fn run_in_process(
             input.markers.as_ptr(),
             input.triangles.len() as i32,
             c_switches.as_ptr(),
+            i32::from(driver == Driver::Library),
             &mut handle,
             &mut view,
         )
@@ -154,4 +175,116 @@ unsafe fn copy_view(view: &ffi::TetShimView) -> Result<TetgenOutput, TetgenError
         worker_peak_kib: None,
         seconds: 0.0,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bbox::{BoxSpec, EnclosingBox};
+    use crate::tetgen_options::Optimization;
+
+    /// The single torus knot in an enclosing box: TetGen's boundary
+    /// recovery adds Steiner points to it (about a hundred).
+    fn knot_in_a_box() -> TetgenInput {
+        let scene = crate::procedural::by_name("torus-knot").unwrap();
+        let (mut vertices, mut triangles) = (scene.vertices.clone(), scene.triangles.clone());
+        EnclosingBox::new(scene.bounds(), BoxSpec::default())
+            .unwrap()
+            .append_to(&mut vertices, &mut triangles);
+        let points = vertices.iter().map(|v| v.as_dvec3().to_array()).collect();
+        TetgenInput::with_index_markers(points, triangles)
+    }
+
+    fn base() -> TetgenOptions {
+        TetgenOptions {
+            face_tets: true,
+            ..TetgenOptions::default()
+        }
+    }
+
+    #[test]
+    fn the_shim_driver_builds_what_tetgens_own_builds() {
+        let input = knot_in_a_box();
+        let cases = [
+            base(),
+            TetgenOptions {
+                min_dihedral: Some(2.0),
+                ..base()
+            },
+            TetgenOptions {
+                quality: Some(5.0),
+                max_dihedral: Some(150.0),
+                ..base()
+            },
+            TetgenOptions {
+                preserve_surface: false,
+                optimization: Some(Optimization {
+                    level: 0,
+                    scheme: 0,
+                }),
+                ..base()
+            },
+        ];
+        for options in cases {
+            let ours = run_with_driver(&input, &options, Driver::Shim).unwrap();
+            let theirs = run_with_driver(&input, &options, Driver::Library).unwrap();
+            let s = options.switches();
+            assert_eq!(ours.points, theirs.points, "{s}");
+            assert_eq!(ours.tets, theirs.tets, "{s}");
+            assert_eq!(ours.neighbors, theirs.neighbors, "{s}");
+            assert_eq!(ours.faces, theirs.faces, "{s}");
+            assert_eq!(ours.face_markers, theirs.face_markers, "{s}");
+            // TetGen leaves the outer side of a hull face uninitialised
+            // (any value, changing from run to run): only the sides that
+            // name a tet holding the face count.
+            let sides = |o: &TetgenOutput| {
+                let holds = |t: i32, f: &[u32; 3]| {
+                    usize::try_from(t)
+                        .ok()
+                        .and_then(|t| o.tets.get(t))
+                        .is_some_and(|tet| f.iter().all(|v| tet.contains(v)))
+                };
+                let sides = o.face_tets.as_ref().unwrap();
+                (o.faces.iter().zip(sides))
+                    .map(|(f, s)| s.map(|t| if holds(t, f) { t } else { -1 }))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(sides(&ours), sides(&theirs), "{s}");
+        }
+    }
+
+    #[test]
+    fn the_steiner_cap_counts_the_refinements_points_only() {
+        let input = knot_in_a_box();
+        let no_optimization = Some(Optimization {
+            level: 0,
+            scheme: 0,
+        });
+        let plain = TetgenOptions {
+            optimization: no_optimization,
+            ..base()
+        };
+        let recovered = run_in_process(&input, &plain).unwrap().points.len();
+        let recovery = recovered - input.points.len();
+        let cap = 20;
+        assert!(recovery > cap, "the recovery added only {recovery} points");
+        let refined = |max_steiner, driver| {
+            let options = TetgenOptions {
+                min_dihedral: Some(5.0),
+                max_steiner,
+                ..plain.clone()
+            };
+            run_with_driver(&input, &options, driver)
+                .unwrap()
+                .points
+                .len()
+        };
+        let uncapped = refined(None, Driver::Shim);
+        assert!(uncapped > recovered + cap, "{uncapped} points");
+        // Ours: exactly `cap` refinement points on top of the recovery's.
+        assert_eq!(refined(Some(cap as u64), Driver::Shim), recovered + cap);
+        // TetGen's own driver counts the recovery's points against the
+        // cap, which they already exceed: no refinement at all.
+        assert_eq!(refined(Some(cap as u64), Driver::Library), recovered);
+    }
 }

@@ -10,6 +10,11 @@
 //!   surface-preserving constrained Delaunay tetrahedralization the papers'
 //!   construction times correspond to (Aman et al. §5, Maria et al. §6); `-q`
 //!   (quality), `-S` (Steiner cap) and `-T` (coplanarity tolerance) are opt-in.
+//! * The shim runs TetGen's stages with its own short driver (TetGen's
+//!   `tetrahedralize()` reduced to our switches, same output), which
+//!   changes one thing: `-S` caps the quality refinement's Steiner points
+//!   alone. TetGen counts the points its boundary recovery added (2,735 on
+//!   Torus Knots) against `-S`, so a cap below those refined nothing.
 //! * [`Isolation`] chooses where TetGen runs. TetGen can abort (failed
 //!   assertions, segmentation faults) or refine without end on some inputs;
 //!   [`Isolation::Worker`] runs it in a child process (see [`worker`]) that
