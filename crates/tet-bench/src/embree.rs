@@ -6,7 +6,9 @@
 //! their source winding, so Embree's primitive id is the constrained-face
 //! index), default build quality and scene flags, as an application would
 //! use it. Two methods:
-//! * `embree`: one `rtcIntersect1` per ray (single rays, incoherent context);
+//! * `embree`: one `rtcIntersect1` per ray (single rays; a batch of rays
+//!   from one start, a camera tile, in a coherent context, other rays in an
+//!   incoherent one);
 //! * `embree8`: `rtcIntersect8` on packets of eight consecutive rays of a
 //!   batch (the renderer's batches are 16×16 tiles, so packets are coherent).
 //!
@@ -127,13 +129,13 @@ impl<'m> EmbreeTracer<'m> {
         }
     }
 
-    /// A single ray that must not report face `skip` (u32::MAX: none).
-    fn trace_one(&self, ray: &Ray, skip: u32) -> TraceOutcome {
-        let mut ctx = IntersectContext::incoherent();
+    /// A single ray that must not report face `skip` (u32::MAX: none),
+    /// traced in `ctx` (coherent for the rays of a camera tile).
+    fn trace_one(&self, ctx: &mut IntersectContext, ray: &Ray, skip: u32) -> TraceOutcome {
         let mut t_near = ray.t_min.max(0.0);
         for _ in 0..=SKIP_RETRIES {
             let mut rh = ERayHit::from(Self::embree_ray(ray, t_near));
-            self.scene.intersect(&mut ctx, &mut rh);
+            self.scene.intersect(ctx, &mut rh);
             let (geom, prim, t) = (rh.hit.geomID, rh.hit.primID, rh.ray.tfar);
             if geom == INVALID_ID {
                 return self.outcome(ray, INVALID_ID, 0.0);
@@ -172,7 +174,7 @@ impl Tracer for EmbreeTracer<'_> {
                 tets_visited: 0,
             };
         }
-        self.trace_one(ray, skip)
+        self.trace_one(&mut IntersectContext::incoherent(), ray, skip)
     }
 
     /// Packets also for rays from a viewpoint outside the tet mesh (their
@@ -194,9 +196,22 @@ impl Tracer for EmbreeTracer<'_> {
         }
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
-        if !self.packets || matches!(start, Start::Face { .. }) {
+        if matches!(start, Start::Face { .. }) {
             for (r, o) in rays.iter().zip(out.iter_mut()) {
                 *o = self.trace(r, start);
+            }
+            return;
+        }
+        if !self.packets {
+            // A batch from one start is a tile of camera rays: coherent,
+            // which is how an application would tell Embree so.
+            let mut ctx = IntersectContext::coherent();
+            for (r, o) in rays.iter().zip(out.iter_mut()) {
+                *o = if r.is_valid() {
+                    self.trace_one(&mut ctx, r, u32::MAX)
+                } else {
+                    self.trace(r, start)
+                };
             }
             return;
         }

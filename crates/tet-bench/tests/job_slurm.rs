@@ -107,8 +107,14 @@ impl Drop for Cluster {
 #[ignore]
 fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
     let start = Instant::now();
-    let running = run("sinfo", &["-h", "-o", "%T"]);
-    let started = !(running.status.success() && text(&running).starts_with("idle"));
+    // No `sinfo` at all (Slurm not installed yet) is a cluster to start:
+    // single-node.sh installs it.
+    let idle = Command::new("sinfo")
+        .args(["-h", "-o", "%T"])
+        .env("SLURM_CONF", slurm_conf())
+        .output()
+        .is_ok_and(|out| out.status.success() && text(&out).starts_with("idle"));
+    let started = !idle;
     let _cluster = Cluster { started };
     if started {
         let status = Command::new(scripts().join("single-node.sh"))

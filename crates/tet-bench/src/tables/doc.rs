@@ -72,6 +72,10 @@ pub struct SceneResult {
     /// Full mode: the scene built with slivers bounded
     /// (`--min-dihedral 2`) and tet20 on it.
     pub min_dihedral2: Option<QualityTrade>,
+    /// Full mode: slivers bounded with at most 1 % of the scene's vertices
+    /// as refinement points and no mesh optimisation
+    /// (`--min-dihedral 2 --optimize 0/0 --max-steiner N`).
+    pub min_dihedral2_capped: Option<QualityTrade>,
     /// Out-of-core builds under ½ and ⅓ of the in-core peak (full mode,
     /// first scene of each geometry only).
     pub out_of_core: Vec<OutOfCoreRow>,

@@ -107,9 +107,13 @@ fn measure_scene(
     let unsorted_tet20 = Some(sorting::measure(planned, cache, opts, frames, pool)?);
     let wide_box_tet20 = Some(entry::measure(planned, cache, opts, frames, pool)?);
     let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames);
-    let (quality5, min_dihedral2) = if args.quick {
-        (None, None)
+    let (quality5, min_dihedral2, min_dihedral2_capped) = if args.quick {
+        (None, None, None)
     } else {
+        let vertices = loaded
+            .scene
+            .as_ref()
+            .map_or(loaded.mesh.points.len(), |s| s.vertices.len());
         let mut trade =
             |flags, label| quality::measure(planned, cache, opts, frames, pool, flags, label);
         (
@@ -117,6 +121,10 @@ fn measure_scene(
             Some(trade(
                 &quality::MIN_DIHEDRAL2,
                 "slivers-bounded (--min-dihedral 2)",
+            )?),
+            Some(trade(
+                &quality::capped_flags(vertices),
+                "slivers-bounded, capped (--max-steiner 1 %)",
             )?),
         )
     };
@@ -133,6 +141,7 @@ fn measure_scene(
         ray_strips,
         quality5,
         min_dihedral2,
+        min_dihedral2_capped,
         out_of_core,
         shares_mesh_with: planned.shares_with.clone(),
         mesh_reused,
@@ -206,6 +215,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
                     gpu_note: None,
                     quality5: None,
                     min_dihedral2: None,
+                    min_dihedral2_capped: None,
                     out_of_core: Vec::new(),
                     shares_mesh_with: planned.shares_with.clone(),
                     mesh_reused: false,

@@ -12,10 +12,24 @@ use super::lanes::Lanes;
 #[derive(Clone, Copy)]
 pub(crate) struct Avx2(());
 
+/// True when the CPU has every feature the AVX2 walks are compiled for
+/// (their `#[target_feature]` lists): AVX2 and the scalar extensions that
+/// come with it (FMA, BMI1/2, LZCNT, POPCNT). Compiling the walks for
+/// these too, not AVX2 alone, gives the code a `-C target-cpu=native`
+/// build gets.
+pub(crate) fn has_avx2_set() -> bool {
+    std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
+        && std::arch::is_x86_feature_detected!("bmi1")
+        && std::arch::is_x86_feature_detected!("bmi2")
+        && std::arch::is_x86_feature_detected!("lzcnt")
+        && std::arch::is_x86_feature_detected!("popcnt")
+}
+
 impl Avx2 {
-    /// The token, when the CPU has AVX2 (detected at run time).
+    /// The token, when the CPU has [`has_avx2_set`] (detected at run time).
     pub(crate) fn detect() -> Option<Avx2> {
-        std::arch::is_x86_feature_detected!("avx2").then_some(Avx2(()))
+        has_avx2_set().then_some(Avx2(()))
     }
 }
 
@@ -35,7 +49,7 @@ fn lane_mask(_: Avx2, l: usize) -> __m256i {
 /// `f` out of line with AVX2 code generation.
 #[cold]
 #[inline(never)]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
 fn cold_avx2<R>(f: impl FnOnce() -> R) -> R {
     f()
 }

@@ -12,17 +12,29 @@ use super::lanes::Lanes;
 #[derive(Clone, Copy)]
 pub(crate) struct Avx512(());
 
+/// True when the CPU has every feature the AVX-512 walks are compiled for
+/// (their `#[target_feature]` lists): AVX-512 F, VL, BW and DQ (mask and
+/// 256-bit forms every AVX-512 CPU since Skylake-SP has) and the AVX2 set
+/// ([`super::avx2::has_avx2_set`]).
+pub(crate) fn has_avx512_set() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+        && std::arch::is_x86_feature_detected!("avx512bw")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+        && super::avx2::has_avx2_set()
+}
+
 impl Avx512 {
-    /// The token, when the CPU has AVX-512F (detected at run time).
+    /// The token, when the CPU has [`has_avx512_set`] (detected at run time).
     pub(crate) fn detect() -> Option<Avx512> {
-        std::arch::is_x86_feature_detected!("avx512f").then_some(Avx512(()))
+        has_avx512_set().then_some(Avx512(()))
     }
 }
 
 /// `f` out of line with AVX-512F code generation.
 #[cold]
 #[inline(never)]
-#[target_feature(enable = "avx512f")]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
 fn cold_avx512<R>(f: impl FnOnce() -> R) -> R {
     f()
 }

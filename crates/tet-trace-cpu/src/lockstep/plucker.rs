@@ -509,7 +509,7 @@ where
 
 /// The walk with 8 AVX2 lanes, two packs in flight, compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
 fn walk_avx2<W, B>(t: Avx2, w: &W, words: &[u32], rays: &[Ray], begin: B, out: &mut [TraceOutcome])
 where
     W: PluckerWalk,
@@ -521,7 +521,7 @@ where
 /// The walk with 16 AVX-512 lanes, two packs in flight, compiled for
 /// AVX-512F.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
 fn walk_avx512<W, B>(
     t: Avx512,
     w: &W,
