@@ -43,10 +43,13 @@ const SKIP_RETRIES: usize = 8;
 
 /// An Embree scene over the constrained faces of a mesh.
 pub struct EmbreeTracer<'m> {
+    /// The mesh whose constrained faces Embree holds.
     mesh: &'m TetMesh,
+    /// Embree's committed scene (one triangle geometry).
     scene: Scene<'static>,
+    /// `rtcIntersect8` packets (`embree8`) rather than single rays.
     packets: bool,
-    // The device must outlive the scene; Scene holds its own handle to it.
+    /// The device, which must outlive the scene (Scene holds its own handle).
     _device: Device,
 }
 
@@ -61,6 +64,7 @@ pub enum EmbreeError {
     TooLarge(usize),
 }
 
+/// An Embree failure, naming what was being created.
 fn embree_err(what: &str, e: impl std::fmt::Debug) -> EmbreeError {
     EmbreeError::Embree(format!("{what}: {e:?}"))
 }
@@ -111,6 +115,7 @@ impl<'m> EmbreeTracer<'m> {
         })
     }
 
+    /// The ray as Embree's, from `t_near` to the ray's `t_max`.
     fn embree_ray(ray: &Ray, t_near: f32) -> ERay {
         ERay::segment(
             ray.origin.to_array(),
