@@ -84,6 +84,10 @@ pub struct SceneResult {
     pub shares_mesh_with: Vec<String>,
     /// True when this scene's mesh came from that shared build.
     pub mesh_reused: bool,
+    /// Measurements on meshes of their own (unsorted, wide box, refined
+    /// builds) that failed, each `"what: why"`; their fields are null and
+    /// the rest of the scene is measured.
+    pub partial_errors: Vec<String>,
     /// Why the scene failed, if it did.
     pub error: Option<String>,
 }

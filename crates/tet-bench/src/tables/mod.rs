@@ -75,6 +75,20 @@ use doc::{SceneResult, Setup, TABLE_FLAGS, TablesDoc};
 use plan::{MeshCache, Planned, plan, scene_specs};
 use report::{markdown, write_atomic, write_outputs};
 
+/// `r`'s value, or `None` with `"label: why"` added to `errors` (and
+/// printed) when the measurement failed.
+fn optional<T>(errors: &mut Vec<String>, spec: &str, label: &str, r: Result<T>) -> Option<T> {
+    match r {
+        Ok(v) => Some(v),
+        Err(e) => {
+            let why = format!("{label}: {}", error_chain(&e));
+            eprintln!("  {spec}: {why}");
+            errors.push(why);
+            None
+        }
+    }
+}
+
 /// Measures every table of one scene.
 fn measure_scene(
     planned: &Planned,
@@ -104,8 +118,22 @@ fn measure_scene(
         args.min_time_s(),
         streamed_rays,
     )?;
-    let unsorted_tet20 = Some(sorting::measure(planned, cache, opts, frames, pool)?);
-    let wide_box_tet20 = Some(entry::measure(planned, cache, opts, frames, pool)?);
+    // Measurements on meshes of their own (unsorted, wide box, refined
+    // builds): one that fails leaves its row empty and says why in
+    // `partial_errors`, not the whole scene.
+    let mut partial_errors = Vec::new();
+    let unsorted_tet20 = optional(
+        &mut partial_errors,
+        spec,
+        "unsorted mesh",
+        sorting::measure(planned, cache, opts, frames, pool),
+    );
+    let wide_box_tet20 = optional(
+        &mut partial_errors,
+        spec,
+        "wide-box mesh",
+        entry::measure(planned, cache, opts, frames, pool),
+    );
     let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames);
     let (quality5, min_dihedral2, min_dihedral2_capped) = if args.quick {
         (None, None, None)
@@ -114,18 +142,20 @@ fn measure_scene(
             .scene
             .as_ref()
             .map_or(loaded.mesh.points.len(), |s| s.vertices.len());
-        let mut trade =
-            |flags, label| quality::measure(planned, cache, opts, frames, pool, flags, label);
+        let mut trade = |flags, label: &str| {
+            let r = quality::measure(planned, cache, opts, frames, pool, flags, label);
+            optional(&mut partial_errors, spec, label, r)
+        };
         (
-            Some(trade(&quality::QUALITY5, "quality-refined (-q5)")?),
-            Some(trade(
+            trade(&quality::QUALITY5, "quality-refined (-q5)"),
+            trade(
                 &quality::MIN_DIHEDRAL2,
                 "slivers-bounded (--min-dihedral 2)",
-            )?),
-            Some(trade(
+            ),
+            trade(
                 &quality::capped_flags(vertices),
                 "slivers-bounded, capped (--max-steiner 1 %)",
-            )?),
+            ),
         )
     };
     #[cfg(feature = "tetgen")]
@@ -154,6 +184,7 @@ fn measure_scene(
         unsorted_tet20,
         wide_box_tet20,
         accuracy: Some(accuracy),
+        partial_errors,
         error: None,
     })
 }
@@ -219,6 +250,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
                     out_of_core: Vec::new(),
                     shares_mesh_with: planned.shares_with.clone(),
                     mesh_reused: false,
+                    partial_errors: Vec::new(),
                     error: Some(error_chain(&e)),
                 }
             }
@@ -285,4 +317,30 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A failed optional measurement leaves its row empty and names what
+    /// failed and why; a good one passes its value through untouched.
+    #[test]
+    fn a_failed_optional_measurement_is_recorded_not_raised() {
+        let mut errors = Vec::new();
+        let failed: Result<u32> =
+            Err(anyhow::anyhow!("2 tets flat").context("cannot build `Neptune`"));
+        assert_eq!(optional(&mut errors, "s", "wide-box mesh", failed), None);
+        assert_eq!(
+            optional(&mut errors, "s", "unsorted mesh", Ok(7u32)),
+            Some(7)
+        );
+        assert_eq!(errors.len(), 1);
+        assert!(errors[0].starts_with("wide-box mesh: "), "{}", errors[0]);
+        assert!(
+            errors[0].contains("cannot build `Neptune`") && errors[0].contains("2 tets flat"),
+            "{}",
+            errors[0]
+        );
+    }
 }

@@ -44,6 +44,11 @@ pub fn markdown(doc: &TablesDoc) -> String {
             sc.error.as_deref().unwrap_or("")
         );
     }
+    for sc in &doc.scenes {
+        for e in &sc.partial_errors {
+            let _ = writeln!(m, "* `{}`, {e} (row left out)", sc.spec);
+        }
+    }
 
     construction::markdown(&mut m, doc);
     render_speed::markdown(&mut m, doc);
