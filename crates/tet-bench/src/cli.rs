@@ -68,10 +68,10 @@ pub struct BuildFlags {
     pub min_dihedral: Option<f64>,
     /// Cap on the Steiner points of the quality refinement (`-S`; the
     /// points TetGen adds to recover the scene's edges and faces do not
-    /// count). With `--min-dihedral 2`, a few hundred already remove the
-    /// worst slivers.
-    #[arg(long)]
-    pub max_steiner: Option<u64>,
+    /// count): a number, or a percentage of the scene's vertices (`1%`).
+    /// With `--min-dihedral 2`, 1 % already removes the worst slivers.
+    #[arg(long, value_name = "N|P%", value_parser = parse_max_steiner)]
+    pub max_steiner: Option<MaxSteiner>,
     /// TetGen's mesh optimisation `LEVEL/SCHEME` (`-O`): up to 2^LEVEL − 1
     /// passes (LEVEL 0 to 9) of flips (SCHEME bit 1), smoothing (2) and
     /// vertex insertion/deletion (4). Default: TetGen's 2/7.
@@ -627,6 +627,22 @@ mod tests {
     use super::*;
 
     #[test]
+    fn steiner_caps_parse_as_counts_or_shares_of_the_vertices() {
+        assert_eq!(parse_max_steiner("500"), Ok(MaxSteiner::Count(500)));
+        assert_eq!(parse_max_steiner("1%"), Ok(MaxSteiner::Percent(1.0)));
+        assert_eq!(parse_max_steiner("0.5 %"), Ok(MaxSteiner::Percent(0.5)));
+        for bad in [
+            "", "%", "-1", "0%", "-2%", "1e9999%", "nan%", "x", "5 points",
+        ] {
+            assert!(parse_max_steiner(bad).is_err(), "{bad}");
+        }
+        // 1 % of 38,888 vertices is 388.88: rounded up.
+        assert_eq!(MaxSteiner::Percent(1.0).resolve(38_888), 389);
+        assert_eq!(MaxSteiner::Percent(1.0).resolve(0), 0);
+        assert_eq!(MaxSteiner::Count(7).resolve(1_000_000), 7);
+    }
+
+    #[test]
     fn memory_sizes_parse_with_binary_units() {
         assert_eq!(parse_memory_limit("2097152"), Ok(2_097_152));
         assert_eq!(parse_memory_limit("512M"), Ok(512 << 20));
@@ -862,17 +878,60 @@ impl BuildFlags {
     /// The TetGen options these flags ask for: every TetGen flag given
     /// replaces its default, the rest keep [`tet_build::tetgen_options::TetgenOptions::default`]. The
     /// one mapping for in-core, out-of-core and job builds.
+    /// `--max-steiner P%` is resolved against the scene's
+    /// `scene_vertices` (rounded up; the out-of-core parts each get the
+    /// resulting cap).
     #[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
-    pub fn tetgen_options(&self) -> tet_build::tetgen_options::TetgenOptions {
+    pub fn tetgen_options(
+        &self,
+        scene_vertices: usize,
+    ) -> tet_build::tetgen_options::TetgenOptions {
         let d = tet_build::tetgen_options::TetgenOptions::default();
         tet_build::tetgen_options::TetgenOptions {
             quality: self.quality,
-            max_steiner: self.max_steiner,
+            max_steiner: self.max_steiner.map(|m| m.resolve(scene_vertices)),
             min_dihedral: self.min_dihedral.or(d.min_dihedral),
             optimization: self.optimize.or(d.optimization),
             max_dihedral: self.max_dihedral.or(d.max_dihedral),
             ..d
         }
+    }
+}
+
+/// `--max-steiner`: a number of Steiner points, or a share of the scene's
+/// vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaxSteiner {
+    /// At most this many.
+    Count(u64),
+    /// At most this percentage of the scene's vertices (rounded up).
+    Percent(f64),
+}
+
+impl MaxSteiner {
+    /// The cap for a scene of `vertices` vertices.
+    pub fn resolve(self, vertices: usize) -> u64 {
+        match self {
+            MaxSteiner::Count(n) => n,
+            MaxSteiner::Percent(p) => (vertices as f64 * p / 100.0).ceil() as u64,
+        }
+    }
+}
+
+/// Parses `--max-steiner N` or `--max-steiner P%` (P in (0, 1000]).
+fn parse_max_steiner(s: &str) -> Result<MaxSteiner, String> {
+    match s.strip_suffix('%') {
+        Some(p) => p
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|p| *p > 0.0 && *p <= 1000.0)
+            .map(MaxSteiner::Percent)
+            .ok_or_else(|| format!("`{s}` is not a percentage above 0 and at most 1000")),
+        None => s
+            .parse::<u64>()
+            .map(MaxSteiner::Count)
+            .map_err(|_| format!("`{s}` is neither a count of points nor a percentage (`1%`)")),
     }
 }
 

@@ -236,7 +236,7 @@ pub fn build_scene_in(
     if flags.no_resolve {
         options.resolve = None;
     }
-    options.tetgen = flags.tetgen_options();
+    options.tetgen = flags.tetgen_options(scene.vertices.len());
     if !flags.no_sort {
         // Hilbert order inside the pipeline: parallel, one gather per array.
         options.reorder = tet_build::pipeline::Reorder::Hilbert;

@@ -277,7 +277,7 @@ impl Limited<'_> {
         let (split, parallel) = self.choose(&cleaned, (b.min, b.max), scene.triangles.len())?;
         let options = SeamOptions {
             enclosing_box: box_spec,
-            tetgen: flags.tetgen_options(),
+            tetgen: flags.tetgen_options(scene.vertices.len()),
             isolation: crate::load::worker_isolation(flags.time_limit)?,
             parallel_parts: parallel,
             tree_limit_bytes: Some(limit_bytes),

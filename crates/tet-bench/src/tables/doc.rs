@@ -74,7 +74,7 @@ pub struct SceneResult {
     pub min_dihedral2: Option<QualityTrade>,
     /// Full mode: slivers bounded with at most 1 % of the scene's vertices
     /// as refinement points and no mesh optimisation
-    /// (`--min-dihedral 2 --optimize 0/0 --max-steiner N`).
+    /// (`--min-dihedral 2 --optimize 0/0 --max-steiner 1%`).
     pub min_dihedral2_capped: Option<QualityTrade>,
     /// Out-of-core builds under ½ and ⅓ of the in-core peak (full mode,
     /// first scene of each geometry only).

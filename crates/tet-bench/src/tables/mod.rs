@@ -138,10 +138,6 @@ fn measure_scene(
     let (quality5, min_dihedral2, min_dihedral2_capped) = if args.quick {
         (None, None, None)
     } else {
-        let vertices = loaded
-            .scene
-            .as_ref()
-            .map_or(loaded.mesh.points.len(), |s| s.vertices.len());
         let mut trade = |flags, label: &str| {
             let r = quality::measure(planned, cache, opts, frames, pool, flags, label);
             optional(&mut partial_errors, spec, label, r)
@@ -153,8 +149,8 @@ fn measure_scene(
                 "slivers-bounded (--min-dihedral 2)",
             ),
             trade(
-                &quality::capped_flags(vertices),
-                "slivers-bounded, capped (--max-steiner 1 %)",
+                &quality::CAPPED,
+                "slivers-bounded, capped (--max-steiner 1%)",
             ),
         )
     };

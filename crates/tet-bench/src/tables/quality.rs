@@ -13,14 +13,14 @@ use tet_trace_cpu::render::RenderOptions;
 
 use super::doc::{QualityTrade, TABLE_FLAGS, TablesDoc};
 use super::plan::{MeshCache, Planned};
-use crate::cli::{BuildFlags, Method};
+use crate::cli::{BuildFlags, MaxSteiner, Method};
 use crate::load::BuildSummary;
 use crate::timing::time_method;
 
 /// The papers' setting: `-q5`, at most 2 M Steiner points.
 pub const QUALITY5: BuildFlags = BuildFlags {
     quality: Some(5.0),
-    max_steiner: Some(2_000_000),
+    max_steiner: Some(MaxSteiner::Count(2_000_000)),
     ..TABLE_FLAGS
 };
 
@@ -28,22 +28,20 @@ pub const QUALITY5: BuildFlags = BuildFlags {
 /// Steiner points.
 pub const MIN_DIHEDRAL2: BuildFlags = BuildFlags {
     min_dihedral: Some(2.0),
-    max_steiner: Some(2_000_000),
+    max_steiner: Some(MaxSteiner::Count(2_000_000)),
     ..TABLE_FLAGS
 };
 
 /// Slivers bounded cheaply: `--min-dihedral 2 --optimize 0/0
-/// --max-steiner N` with N 1 % of the scene's `vertices` (at least 100).
-pub fn capped_flags(vertices: usize) -> BuildFlags {
-    BuildFlags {
-        optimize: Some(tet_build::tetgen_options::Optimization {
-            level: 0,
-            scheme: 0,
-        }),
-        max_steiner: Some((vertices as u64 / 100).max(100)),
-        ..MIN_DIHEDRAL2
-    }
-}
+/// --max-steiner 1%` (1 % of the scene's vertices).
+pub const CAPPED: BuildFlags = BuildFlags {
+    optimize: Some(tet_build::tetgen_options::Optimization {
+        level: 0,
+        scheme: 0,
+    }),
+    max_steiner: Some(MaxSteiner::Percent(1.0)),
+    ..MIN_DIHEDRAL2
+};
 
 /// The scene built with `flags` (`label` names it in the progress line)
 /// and tet20 on it.
@@ -101,7 +99,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
         }
         for (label, t) in [
             (
-                "--min-dihedral 2 --optimize 0/0 --max-steiner 1 %",
+                "--min-dihedral 2 --optimize 0/0 --max-steiner 1%",
                 sc.min_dihedral2_capped.as_ref(),
             ),
             ("--min-dihedral 2", sc.min_dihedral2.as_ref()),

@@ -51,7 +51,7 @@ pub fn plan(args: &BuildArgs, dir: &Path, json: bool) -> Result<()> {
     let options = PlanOptions {
         seam: SeamOptions {
             enclosing_box: crate::load::enclosing_box(&scene, &[], flags.wide_box),
-            tetgen: flags.tetgen_options(),
+            tetgen: flags.tetgen_options(scene.vertices.len()),
             resolve: (!flags.no_resolve).then(Default::default),
             ..SeamOptions::default()
         },
