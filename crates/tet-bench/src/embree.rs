@@ -134,6 +134,18 @@ impl<'m> EmbreeTracer<'m> {
         }
     }
 
+    /// A single ray from `start` traced in `ctx`: a ray that is not valid
+    /// is a failure, and one from a face must not report that face.
+    fn trace_in(&self, ctx: &mut IntersectContext, ray: &Ray, start: Start) -> TraceOutcome {
+        if !ray.is_valid() {
+            return TraceOutcome::Failed {
+                failure: Failure::InvalidRay,
+                tets_visited: 0,
+            };
+        }
+        self.trace_one(ctx, ray, start.on_face().unwrap_or(u32::MAX))
+    }
+
     /// A single ray that must not report face `skip` (u32::MAX: none),
     /// traced in `ctx` (coherent for the rays of a camera tile).
     fn trace_one(&self, ctx: &mut IntersectContext, ray: &Ray, skip: u32) -> TraceOutcome {
@@ -172,14 +184,7 @@ impl Tracer for EmbreeTracer<'_> {
     }
 
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
-        let skip = start.on_face().unwrap_or(u32::MAX);
-        if !ray.is_valid() {
-            return TraceOutcome::Failed {
-                failure: Failure::InvalidRay,
-                tets_visited: 0,
-            };
-        }
-        self.trace_one(&mut IntersectContext::incoherent(), ray, skip)
+        self.trace_in(&mut IntersectContext::incoherent(), ray, start)
     }
 
     /// Packets also for rays from a viewpoint outside the tet mesh (their
@@ -201,22 +206,17 @@ impl Tracer for EmbreeTracer<'_> {
         }
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
-        if matches!(start, Start::Face { .. }) {
+        let from_face = matches!(start, Start::Face { .. });
+        if !self.packets || from_face {
+            // A batch from one start that is not a face is a tile of camera
+            // rays: coherent, which is how an application would tell Embree.
+            let mut ctx = if from_face {
+                IntersectContext::incoherent()
+            } else {
+                IntersectContext::coherent()
+            };
             for (r, o) in rays.iter().zip(out.iter_mut()) {
-                *o = self.trace(r, start);
-            }
-            return;
-        }
-        if !self.packets {
-            // A batch from one start is a tile of camera rays: coherent,
-            // which is how an application would tell Embree so.
-            let mut ctx = IntersectContext::coherent();
-            for (r, o) in rays.iter().zip(out.iter_mut()) {
-                *o = if r.is_valid() {
-                    self.trace_one(&mut ctx, r, u32::MAX)
-                } else {
-                    self.trace(r, start)
-                };
+                *o = self.trace_in(&mut ctx, r, start);
             }
             return;
         }

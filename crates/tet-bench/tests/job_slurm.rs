@@ -50,14 +50,19 @@ fn slurm_conf() -> PathBuf {
     Path::new(&dir).join("slurm.conf")
 }
 
-fn run(program: &str, args: &[&str]) -> Output {
+/// `program` with this test's Slurm configuration and no inherited task
+/// index; an error when it cannot be started (e.g. not installed).
+fn try_run(program: &str, args: &[&str]) -> std::io::Result<Output> {
     Command::new(program)
         .args(args)
         .env("SLURM_CONF", slurm_conf())
         .env_remove("SLURM_ARRAY_TASK_ID")
         .env_remove("JOB_COMPLETION_INDEX")
         .output()
-        .unwrap_or_else(|e| panic!("cannot run {program}: {e}"))
+}
+
+fn run(program: &str, args: &[&str]) -> Output {
+    try_run(program, args).unwrap_or_else(|e| panic!("cannot run {program}: {e}"))
 }
 
 fn text(out: &Output) -> String {
@@ -109,10 +114,7 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
     let start = Instant::now();
     // No `sinfo` at all (Slurm not installed yet) is a cluster to start:
     // single-node.sh installs it.
-    let idle = Command::new("sinfo")
-        .args(["-h", "-o", "%T"])
-        .env("SLURM_CONF", slurm_conf())
-        .output()
+    let idle = try_run("sinfo", &["-h", "-o", "%T"])
         .is_ok_and(|out| out.status.success() && text(&out).starts_with("idle"));
     let started = !idle;
     let _cluster = Cluster { started };
