@@ -4,8 +4,8 @@
 use glam::Vec3;
 
 use crate::layout::{
-    BlockLayout, PERMUTATION_BITS, PERMUTATIONS, SWAP_WORD, StripData, is_leaf, leaf_blocks,
-    split_counts, strip_words,
+    BlockLayout, LeafGrid, PERMUTATION_BITS, PERMUTATIONS, SWAP_WORD, StripData, is_leaf,
+    leaf_blocks, split_counts,
 };
 
 /// One node of a strip hierarchy, decoded.
@@ -31,6 +31,9 @@ pub struct StripView {
     /// Box of the BVH leaf holding the strip (shared by the strips of a
     /// leaf when `strips_per_leaf > 1`).
     pub bounds: (Vec3, Vec3),
+    /// The strip's own box as traversal decodes it from the header (within
+    /// `bounds`, around `vertices`).
+    pub strip_bounds: (Vec3, Vec3),
     /// The `n + 2` strip vertex positions.
     pub vertices: Vec<Vec3>,
     /// Input triangle index of each strip triangle, in strip order (`None`
@@ -55,7 +58,7 @@ pub(crate) fn strips(data: &StripData) -> Vec<StripView> {
             let (first, count) = leaf_blocks(leaf);
             (0..count).scan(first, move |offset, _| {
                 let start = *offset;
-                *offset += strip_words(data.words[start] as usize);
+                *offset += data.block_words(data.words[start]);
                 Some((leaf, start))
             })
         })
@@ -66,11 +69,14 @@ pub(crate) fn strips(data: &StripData) -> Vec<StripView> {
                 .iter()
                 .map(|&v| Vec3::from(data.vertices[v as usize]))
                 .collect();
-            let words = &data.words[layout.triangles..layout.triangles + n];
+            let words: Vec<u32> = (0..n).map(|j| data.triangle_word(&layout, j)).collect();
             let mut nodes = Vec::new();
             collect(data, &layout, 0, 0, layout.n, &mut nodes);
+            let (lo, hi) = (Vec3::from(leaf.min()), Vec3::from(leaf.max()));
+            let (slo, shi) = LeafGrid::new(leaf).strip_box(data.words[start]);
             StripView {
-                bounds: (Vec3::from(leaf.min()), Vec3::from(leaf.max())),
+                bounds: (lo, hi),
+                strip_bounds: (slo.into(), shi.into()),
                 vertices,
                 triangles: words
                     .iter()
@@ -84,7 +90,7 @@ pub(crate) fn strips(data: &StripData) -> Vec<StripView> {
                     })
                     .collect(),
                 nodes,
-                block_bytes: 4 * (layout.triangles + n - start),
+                block_bytes: 4 * data.block_words(data.words[start]),
             }
         })
         .collect()

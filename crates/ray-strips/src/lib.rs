@@ -40,20 +40,21 @@
 //!
 //! Geometry: the global vertex list (12 bytes per vertex, `f32`), one
 //! 4-byte vertex index per strip vertex (`n + 2` per strip of `n`
-//! triangles) and one 4-byte word per triangle (input triangle index and
+//! triangles) and one packed word per triangle (input triangle index and
 //! vertex permutation, needed to report [`Hit::triangle`] and input-order
-//! barycentrics). For a closed mesh (about half as many vertices as
+//! barycentrics; 3 bits plus the bits of the largest index, 20 bits for
+//! the bunny). For a closed mesh (about half as many vertices as
 //! triangles) and strips of mean length `s` that is about
-//! `6 + 4 (1 + 2/s) + 4` bytes per triangle. Hierarchy: a 4-byte header
-//! per strip and about 9 bytes per two triangles
-//! ([`layout::strip_words`] gives the exact size of a strip from `n`).
-//! Top level: 32 bytes per BVH node, two per leaf (a binary tree over
-//! the leaves); a leaf holds up to [`BuildOptions::strips_per_leaf`]
-//! strips of one chunk, by default all of them, so about two nodes per
-//! chunk. Bunny (69,451 triangles) at the defaults: 11,855 strips of
-//! 5.86 triangles on average and 5,483 top-level nodes; geometry 15.38,
-//! hierarchy 3.66 and top level 2.53 bytes per triangle, 21.57 in all
-//! (1.498 MB, within the paper's 1.5 MB).
+//! `6 + 4 (1 + 2/s) + 2.5` bytes per triangle. Hierarchy: a 4-byte header
+//! per strip (its length and its quantized box) and about 9 bytes per two
+//! triangles ([`layout::strip_words`] gives the exact size of a strip from
+//! `n` and the word width). Top level: 32 bytes per BVH node, two per leaf
+//! (a binary tree over the leaves); a leaf holds up to
+//! [`BuildOptions::strips_per_leaf`] strips of one chunk, by default all
+//! of them, so about two nodes per chunk. Bunny (69,451 triangles) at the
+//! defaults: 12,997 strips of 5.34 triangles on average and 7,147
+//! top-level nodes; geometry 14.31, hierarchy 3.62 and top level 3.29
+//! bytes per triangle, 21.22 in all (1.474 MB, within the paper's 1.5 MB).
 //! [`RayStrips::bytes`] reports the exact totals.
 //!
 //! # Deviations from the paper
@@ -63,18 +64,28 @@
 //!   (bunny: 8.1 triangles per strip at chunks of 128, against Stripe's
 //!   19.3 in Table 5), so one strip per leaf as in the paper takes 26.8
 //!   bytes per triangle (1.86 MB) instead of the paper's 1.5 MB. The
-//!   defaults instead cut the mesh into small chunks (36 triangles: short,
-//!   compact strips, 5.9 triangles on average) and put all strips of a
+//!   defaults instead cut the mesh into small chunks (28 triangles: short,
+//!   compact strips, 5.3 triangles on average) and put all strips of a
 //!   chunk into one leaf (a deviation: the paper gives each strip its own
-//!   leaf), which fits the budget (21.6 bytes per triangle, 1.498 MB) with
-//!   fewer instructions per ray than larger chunks with several strips per
-//!   leaf (see [`BuildOptions::default`]). Swaps are implemented but off
+//!   leaf), which fits the budget (21.2 bytes per triangle, 1.474 MB) with
+//!   fewer instructions per ray than larger chunks
+//!   (see [`BuildOptions::default`]). Swaps are implemented but off
 //!   by default (see the stripifier's docs for why).
+//! * Strip boxes: each strip's header carries its box, quantized to 4 bits
+//!   per face within its leaf's box; a ray enters only the strips whose box
+//!   it hits, and starts Algorithm 1 from that box's interval (the paper
+//!   starts every strip of a leaf from the leaf's box). The header word
+//!   that holds `n` has room for it, so it costs no memory.
+//! * Frame: a scene whose largest coordinate lies outside `[2⁻¹⁶, 2¹⁷)` is
+//!   stored scaled by a power of two, and rays are scaled to match, so the
+//!   test's products neither overflow nor underflow `f32` (scenes at 10³⁰
+//!   and 10⁻³⁰ trace like unit ones); this changes no rounding.
 //! * Triangle test: Woop et al.'s watertight test with the paper's edge
 //!   sharing along the strip, instead of Plücker edge tests.
-//! * Layout: 32-bit header and per-triangle word (input id and vertex
-//!   permutation instead of a 16-bit material); node flag bytes after the
-//!   node floats (see [`layout`]).
+//! * Layout: 32-bit header (length and strip box) and a packed
+//!   per-triangle word (input id and vertex permutation instead of a
+//!   16-bit material); node flag bytes after the node floats (see
+//!   [`layout`]). A strip has at most [`layout::MAX_STRIP`] triangles.
 //! * Algorithm 1: leaves hold 2 or 3 triangles (the odd one goes to the
 //!   first leaf), the far child's entry distance is tightened, and every
 //!   distance gets a small relative slack so culling is conservative.
@@ -98,6 +109,7 @@
 
 mod build;
 mod error;
+mod frame;
 pub mod inspect;
 pub mod layout;
 mod options;
@@ -112,10 +124,10 @@ pub use options::BuildOptions;
 pub use ray::{Hit, Ray};
 pub use stats::{Bytes, Stats};
 
-use layout::{PERMUTATION_BITS, StripData, strip_hierarchy_words};
+use layout::{PERMUTATION_BITS, StripData, header_n, strip_hierarchy_words};
 use traverse::packet::{LANES, PacketStacks, coherent, trace_packet};
 use traverse::prepared::{Best, Prepared};
-use traverse::single::{Stacks, trace_from};
+use traverse::single::trace;
 
 /// A built Ray-Strips structure over one triangle mesh; immutable and
 /// shareable between threads.
@@ -124,6 +136,8 @@ pub struct RayStrips {
     data: StripData,
     stats: Stats,
     bytes: Bytes,
+    /// The power of two the vertices were scaled by (see `frame`).
+    scale: f32,
 }
 
 impl RayStrips {
@@ -138,29 +152,64 @@ impl RayStrips {
         triangles: &[[u32; 3]],
         options: &BuildOptions,
     ) -> Result<RayStrips, BuildError> {
-        let (data, stats) = build::build(positions, triangles, options)?;
+        let scale = frame::unit_scale(positions);
+        let (data, stats) = if scale == 1.0 {
+            build::build(positions, triangles, options)?
+        } else {
+            let scaled: Vec<Vec3> = positions.iter().map(|&p| p * scale).collect();
+            build::build(&scaled, triangles, options)?
+        };
         let bytes = measure(&data);
-        Ok(Self { data, stats, bytes })
+        Ok(Self {
+            data,
+            stats,
+            bytes,
+            scale,
+        })
+    }
+
+    /// `ray` in the structure's frame: origin and range scaled, the same
+    /// direction (see `frame`).
+    #[inline(always)]
+    fn framed(&self, ray: &Ray) -> Ray {
+        if self.scale == 1.0 {
+            return *ray;
+        }
+        Ray {
+            origin: ray.origin * self.scale,
+            direction: ray.direction,
+            t_min: ray.t_min * self.scale,
+            t_max: ray.t_max * self.scale,
+        }
+    }
+
+    /// The hit recorded in `best`, its distance back in the caller's frame.
+    fn hit(&self, best: &Best) -> Option<Hit> {
+        (best.word != u32::MAX).then_some(Hit {
+            triangle: best.word >> PERMUTATION_BITS,
+            t: best.t / self.scale,
+            u: best.u,
+            v: best.v,
+        })
     }
 
     /// The closest hit with `t` in `[t_min, t_max]`, if any.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        let pre = Prepared::new(ray)?;
+        let ray = self.framed(ray);
+        let pre = Prepared::new(&ray)?;
         let mut best = Best::new(ray.t_max);
-        if !self.data.nodes.is_empty() {
-            trace_from(&self.data, 0, &pre, &mut best, false, &mut Stacks::new());
-        }
-        hit(&best)
+        trace(&self.data, &pre, &mut best, false);
+        self.hit(&best)
     }
 
     /// Whether anything is hit with `t` in `[t_min, t_max]`.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let Some(pre) = Prepared::new(ray) else {
+        let ray = self.framed(ray);
+        let Some(pre) = Prepared::new(&ray) else {
             return false;
         };
         let mut best = Best::new(ray.t_max);
-        !self.data.nodes.is_empty()
-            && trace_from(&self.data, 0, &pre, &mut best, true, &mut Stacks::new())
+        trace(&self.data, &pre, &mut best, true)
     }
 
     /// Closest hits of many rays: `out[i]` is exactly `self.intersect(&rays[i])`.
@@ -177,12 +226,11 @@ impl RayStrips {
             "intersect_packet needs one output slot per ray"
         );
         let mut stacks = PacketStacks::new();
-        let mut singles = Stacks::new();
         for (rays, out) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
             let mut pre = [None; LANES];
             let mut mask = 0u8;
             for (l, r) in rays.iter().enumerate() {
-                pre[l] = Prepared::new(r);
+                pre[l] = Prepared::new(&self.framed(r));
                 if pre[l].is_some() {
                     mask |= 1 << l;
                 }
@@ -193,18 +241,19 @@ impl RayStrips {
                 continue;
             };
             let pre = pre.map(|p| p.unwrap_or(fill));
-            let mut best: [Best; LANES] =
-                std::array::from_fn(|l| Best::new(rays.get(l).map_or(0.0, |r| r.t_max)));
+            let mut best: [Best; LANES] = std::array::from_fn(|l| {
+                Best::new(rays.get(l).map_or(0.0, |r| self.framed(r).t_max))
+            });
             if coherent(&pre, mask) {
                 trace_packet(&self.data, &pre, mask, &mut best, &mut stacks);
             } else {
                 for l in (0..LANES).filter(|l| mask & (1 << l) != 0) {
-                    trace_from(&self.data, 0, &pre[l], &mut best[l], false, &mut singles);
+                    trace(&self.data, &pre[l], &mut best[l], false);
                 }
             }
             for (l, o) in out.iter_mut().enumerate() {
                 *o = if mask & (1 << l) != 0 {
-                    hit(&best[l])
+                    self.hit(&best[l])
                 } else {
                     None
                 };
@@ -229,23 +278,14 @@ impl RayStrips {
     }
 }
 
-fn hit(best: &Best) -> Option<Hit> {
-    (best.word != u32::MAX).then_some(Hit {
-        triangle: best.word >> PERMUTATION_BITS,
-        t: best.t,
-        u: best.u,
-        v: best.v,
-    })
-}
-
 /// Splits the heap bytes by walking the BVH leaves' strip headers.
 fn measure(data: &StripData) -> Bytes {
     let mut hierarchy_words = 0;
     let mut offset = 0;
     while offset < data.words.len() {
-        let n = data.words[offset] as usize;
-        hierarchy_words += strip_hierarchy_words(n);
-        offset += layout::strip_words(n);
+        let header = data.words[offset];
+        hierarchy_words += strip_hierarchy_words(header_n(header) as usize);
+        offset += data.block_words(header);
     }
     let hierarchy = 4 * hierarchy_words;
     let geometry = std::mem::size_of_val(data.vertices.as_slice())

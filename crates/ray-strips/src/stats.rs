@@ -6,7 +6,8 @@
 pub struct Bytes {
     /// Global vertex list (12 bytes per referenced vertex), strip vertex
     /// indices (4 bytes each) and per-triangle words (input triangle id and
-    /// vertex permutation, 4 bytes per triangle).
+    /// vertex permutation, [`Stats::triangle_word_bits`] bits per triangle,
+    /// packed into whole words per strip).
     pub geometry: usize,
     /// Strip hierarchies: one header word per strip plus its
     /// `⌊n/2⌋ − 1` nodes (two `f32` split coordinates and one flag byte each,
@@ -44,4 +45,7 @@ pub struct Stats {
     pub top_level_nodes: usize,
     /// Strip-hierarchy nodes over all strips.
     pub hierarchy_nodes: usize,
+    /// Width of a per-triangle word ([`crate::layout::triangle_word_bits`]
+    /// of the input triangle count).
+    pub triangle_word_bits: u32,
 }

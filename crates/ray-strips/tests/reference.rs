@@ -194,3 +194,53 @@ fn a_camera_over_a_sphere_agrees_with_the_reference() {
     assert!(hits > rays.len() / 8, "the sphere fills part of the view");
     check_packets(&rs, &rays);
 }
+
+#[test]
+fn scaled_and_displaced_meshes_agree_with_the_reference() {
+    // Scales whose products overflow or underflow f32 unless the
+    // structure works in its own frame, and a scene far from the origin;
+    // chunks of several strips per leaf, so that the quantized strip boxes
+    // decide which strips a ray enters.
+    for (scale, offset) in [
+        (1e-15f32, Vec3::ZERO),
+        (1e15, Vec3::ZERO),
+        (1e-30, Vec3::ZERO),
+        (1e30, Vec3::ZERO),
+        (1e37, Vec3::ZERO),
+        (1.0, Vec3::new(1e4, -2e4, 5e3)),
+    ] {
+        let (unit, triangles) = common::torus(32, 12, 1.0, 0.35, Vec3::ZERO);
+        let positions: Vec<Vec3> = unit.iter().map(|&p| p * scale + offset).collect();
+        for strips_per_leaf in [1, 16] {
+            let options = BuildOptions {
+                strips_per_leaf,
+                ..BuildOptions::default()
+            };
+            let rs = RayStrips::build(&positions, &triangles, &options).unwrap();
+            let mut hits = 0;
+            for ray in camera_rays(Vec3::new(0.4, 2.2, 1.3) * 1.4, 12) {
+                let ray = Ray::new(ray.origin * scale + offset, ray.direction);
+                check_against_reference(&positions, &triangles, &rs, &ray);
+                if let Some(h) = rs.intersect(&ray) {
+                    hits += 1;
+                    // The distance in the caller's frame, to f32 precision.
+                    let p = common::point(
+                        &positions,
+                        triangles[h.triangle as usize],
+                        f64::from(h.u),
+                        f64::from(h.v),
+                    );
+                    let along = ray.origin.as_dvec3() + f64::from(h.t) * ray.direction.as_dvec3();
+                    assert!(
+                        (p - along).length() <= 1e-4 * (p.length() + f64::from(scale)),
+                        "scale {scale}: hit point {p} vs {along}"
+                    );
+                }
+            }
+            assert!(
+                hits > 50,
+                "scale {scale}: the torus is in view ({hits} hits)"
+            );
+        }
+    }
+}

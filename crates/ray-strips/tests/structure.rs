@@ -36,8 +36,10 @@ fn node_count_and_block_size_follow_the_formulas() {
         assert_eq!(layout::hierarchy_nodes(n), k);
         // Header, 2 floats per node, flag bytes in words, n + 2 indices,
         // n per-triangle words.
-        let words = 1 + 2 * k + k.div_ceil(4) + (n + 2) + n;
-        assert_eq!(layout::strip_words(n), words, "n = {n}");
+        for bits in [4, 20, 21, 32] {
+            let words = 1 + 2 * k + k.div_ceil(4) + (n + 2) + (n * bits).div_ceil(32);
+            assert_eq!(layout::strip_words(n, bits as u32), words, "n = {n}");
+        }
     }
 }
 
@@ -125,6 +127,17 @@ fn hierarchy_planes_bound_their_children_and_the_leaf_box_bounds_the_strip() {
                     .iter()
                     .map(move |p| p[axis])
             };
+            let (slo, shi) = s.strip_bounds;
+            assert!(
+                slo.cmpge(lo).all() && shi.cmple(hi).all(),
+                "strip box within the leaf"
+            );
+            for p in &s.vertices {
+                assert!(
+                    p.cmpge(slo).all() && p.cmple(shi).all(),
+                    "strip box holds the strip"
+                );
+            }
             assert_eq!(s.nodes.len(), layout::hierarchy_nodes(s.triangles.len()));
             for node in &s.nodes {
                 let (lower, upper) = if node.reverse {
@@ -164,7 +177,7 @@ fn bytes_add_up_from_the_block_formula() {
             let stats = rs.stats();
             let blocks: usize = strips
                 .iter()
-                .map(|s| 4 * layout::strip_words(s.triangles.len()))
+                .map(|s| 4 * layout::strip_words(s.triangles.len(), stats.triangle_word_bits))
                 .sum();
             assert_eq!(strips.iter().map(|s| s.block_bytes).sum::<usize>(), blocks);
             let hierarchy: usize = strips
@@ -188,5 +201,124 @@ fn bytes_add_up_from_the_block_formula() {
             }
             assert_eq!(stats.vertices, positions.len());
         }
+    }
+}
+
+/// The meshes moved and scaled to the extremes, plus a flat one (zero
+/// extent on an axis).
+fn extreme_meshes() -> Vec<(Vec<Vec3>, Vec<[u32; 3]>)> {
+    let mut out = Vec::new();
+    for (positions, triangles) in meshes() {
+        for (scale, offset) in [
+            (1e-30f32, Vec3::ZERO),
+            (1e30, Vec3::ZERO),
+            (1e37, Vec3::ZERO),
+            (1.0, Vec3::new(1e7, -3e6, 2e5)),
+            (1e-3, Vec3::splat(1e4)),
+        ] {
+            let moved = positions.iter().map(|&p| p * scale + offset).collect();
+            out.push((moved, triangles.clone()));
+        }
+    }
+    let flat = vec![0.5f32; 13 * 9];
+    out.push(common::grid(12, 8, &flat));
+    out
+}
+
+#[test]
+fn strip_boxes_hold_their_strips_at_any_scale_and_offset() {
+    for (positions, triangles) in extreme_meshes() {
+        for strips_per_leaf in [1, 4, 16] {
+            let options = BuildOptions {
+                strips_per_leaf,
+                ..BuildOptions::default()
+            };
+            let rs = RayStrips::build(&positions, &triangles, &options).unwrap();
+            let mut tighter = 0;
+            for s in rs.strips() {
+                let ((lo, hi), (slo, shi)) = (s.bounds, s.strip_bounds);
+                assert!(slo.cmpge(lo).all() && shi.cmple(hi).all());
+                for p in &s.vertices {
+                    assert!(
+                        p.cmpge(slo).all() && p.cmple(shi).all(),
+                        "{p} outside the strip box {slo}..{shi}"
+                    );
+                }
+                if strips_per_leaf == 1 {
+                    assert_eq!((slo, shi), (lo, hi), "a leaf of one strip is its box");
+                }
+                tighter += usize::from((slo, shi) != (lo, hi));
+            }
+            if strips_per_leaf > 1 && rs.stats().strips > rs.stats().chunks {
+                assert!(tighter > 0, "no strip box is tighter than its leaf");
+            }
+        }
+    }
+}
+
+#[test]
+fn strips_longer_than_a_header_can_name_are_cut() {
+    // A 600 × 1 ribbon stripifies into one strip of 1200 triangles when
+    // the chunk holds it all.
+    let heights: Vec<f32> = (0..601 * 2).map(|i| (i % 7) as f32 * 0.01).collect();
+    let (positions, triangles) = common::grid(600, 1, &heights);
+    let rs = RayStrips::build(
+        &positions,
+        &triangles,
+        &BuildOptions {
+            chunk_triangles: 100_000,
+            strips_per_leaf: 1,
+            strip_swaps: false,
+        },
+    )
+    .unwrap();
+    let strips = rs.strips();
+    assert!(
+        strips
+            .iter()
+            .all(|s| s.triangles.len() <= layout::MAX_STRIP)
+    );
+    assert_eq!(rs.stats().max_strip_triangles, layout::MAX_STRIP);
+    let mut seen = vec![0u32; triangles.len()];
+    for s in &strips {
+        for t in s.triangles.iter().flatten() {
+            seen[*t as usize] += 1;
+        }
+    }
+    assert!(seen.iter().all(|&c| c == 1));
+    // Every cell is hit from above, in its own triangle.
+    for x in 0..600 {
+        let origin = Vec3::new(x as f32 + 0.7, 0.2, 5.0);
+        let hit = rs
+            .intersect(&ray_strips::Ray::new(origin, Vec3::NEG_Z))
+            .unwrap();
+        assert_eq!(hit.triangle, 2 * x, "cell {x}");
+    }
+}
+
+#[test]
+fn triangle_words_are_as_wide_as_the_largest_index_needs() {
+    for (triangles, bits) in [
+        (1, 4),
+        (2, 4),
+        (3, 5),
+        (4, 5),
+        (5, 6),
+        (69_451, 20),
+        (1 << 20, 23),
+        ((1 << 20) + 1, 24),
+    ] {
+        assert_eq!(
+            layout::triangle_word_bits(triangles),
+            bits,
+            "{triangles} triangles"
+        );
+    }
+    for (positions, triangles) in meshes() {
+        let rs = RayStrips::build(&positions, &triangles, &BuildOptions::default()).unwrap();
+        assert_eq!(
+            rs.stats().triangle_word_bits,
+            layout::triangle_word_bits(triangles.len())
+        );
     }
 }

@@ -11,10 +11,7 @@
 //! into a 2×2-style packet when their directions share signs (the
 //! renderer's tile rows give runs of four neighbouring pixels).
 
-use std::borrow::Cow;
 use std::time::Instant;
-
-use glam::Vec3;
 
 use ray_strips::{BuildOptions, RayStrips};
 use tet_core::TetMesh;
@@ -22,7 +19,7 @@ use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Ray, TraceOutcome};
 use tet_trace_cpu::walk::{Start, Starts};
 
-use crate::bvh::{face_hit, unit_scale};
+use crate::bvh::face_hit;
 
 /// Ray-Strips over the constrained faces of a mesh.
 pub struct StripsTracer<'m> {
@@ -34,8 +31,6 @@ pub struct StripsTracer<'m> {
     packets: bool,
     /// Build time in seconds.
     build_s: f64,
-    /// The power of two the structure's points were scaled by.
-    scale: f32,
 }
 
 impl<'m> StripsTracer<'m> {
@@ -44,21 +39,14 @@ impl<'m> StripsTracer<'m> {
     pub fn new(mesh: &'m TetMesh, packets: bool) -> anyhow::Result<Self> {
         let triangles: Vec<[u32; 3]> = mesh.constrained.iter().map(|c| c.vertices).collect();
         let t = Instant::now();
-        // Built on the scene scaled by a power of two, like the BVH
-        // ([`unit_scale`]): surface areas of a scene at 1e30 overflow f32.
-        let scale = unit_scale(mesh);
-        let points: Cow<'_, [Vec3]> = if scale == 1.0 {
-            Cow::Borrowed(&mesh.points)
-        } else {
-            Cow::Owned(mesh.points.iter().map(|&p| p * scale).collect())
-        };
-        let strips = RayStrips::build(&points, &triangles, &BuildOptions::default())?;
+        // Scenes at 1e30 or 1e-30 need no scaling here: the crate works in
+        // a frame of its own.
+        let strips = RayStrips::build(&mesh.points, &triangles, &BuildOptions::default())?;
         Ok(StripsTracer {
             mesh,
             strips,
             packets,
             build_s: t.elapsed().as_secs_f64(),
-            scale,
         })
     }
 
@@ -83,7 +71,7 @@ impl<'m> StripsTracer<'m> {
     /// Closest hit skipping constrained face `skip` (a secondary ray
     /// leaving it): the ray is re-cast just past each hit on that face.
     fn closest(&self, ray: &Ray, skip: Option<u32>) -> Option<ray_strips::Hit> {
-        let mut r = to_strips(ray, self.scale);
+        let mut r = to_strips(ray);
         for _ in 0..8 {
             let h = self.strips.intersect(&r)?;
             if Some(h.triangle) != skip {
@@ -95,13 +83,12 @@ impl<'m> StripsTracer<'m> {
     }
 }
 
-/// The same ray for the `ray-strips` crate in the structure's frame scaled
-/// by `scale` (the same `t`; negative `t_min` clamped to 0, as the BVH
-/// baseline does).
-fn to_strips(ray: &Ray, scale: f32) -> ray_strips::Ray {
+/// The same ray for the `ray-strips` crate (negative `t_min` clamped to 0,
+/// as the BVH baseline does).
+fn to_strips(ray: &Ray) -> ray_strips::Ray {
     ray_strips::Ray {
-        origin: ray.origin * scale,
-        direction: ray.direction * scale,
+        origin: ray.origin,
+        direction: ray.direction,
         t_min: ray.t_min.max(0.0),
         t_max: ray.t_max,
     }
@@ -151,8 +138,7 @@ impl Tracer for StripsTracer<'_> {
             return;
         }
         let n = rays.len().min(out.len());
-        let converted: Vec<ray_strips::Ray> =
-            rays[..n].iter().map(|r| to_strips(r, self.scale)).collect();
+        let converted: Vec<ray_strips::Ray> = rays[..n].iter().map(to_strips).collect();
         let mut hits = vec![None; n];
         self.strips.intersect_packet(&converted, &mut hits);
         for ((r, h), o) in rays.iter().zip(hits).zip(out.iter_mut()) {

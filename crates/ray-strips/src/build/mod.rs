@@ -16,8 +16,8 @@ use glam::Vec3;
 
 use crate::error::BuildError;
 use crate::layout::{
-    BvhNode, LEAF, MAX_TRIANGLES, PERMUTATION_BITS, PERMUTATIONS, SWAP_WORD, StripData,
-    hierarchy_nodes,
+    BvhNode, LEAF, MAX_STRIP, MAX_TRIANGLES, PERMUTATION_BITS, PERMUTATIONS, SWAP_WORD, StripData,
+    hierarchy_nodes, triangle_word_bits,
 };
 use crate::options::BuildOptions;
 use crate::stats::Stats;
@@ -77,7 +77,10 @@ pub(crate) fn build(
         triangles,
         options: *options,
         remap: vec![u32::MAX; positions.len()],
-        data: StripData::default(),
+        data: StripData {
+            triangle_bits: triangle_word_bits(triangles.len()),
+            ..StripData::default()
+        },
         stats: Stats {
             triangles: items.len(),
             skipped_triangles: triangles.len() - items.len(),
@@ -93,6 +96,7 @@ pub(crate) fn build(
     data.words.shrink_to_fit();
     data.nodes.shrink_to_fit();
     stats.vertices = data.vertices.len();
+    stats.triangle_word_bits = data.triangle_bits;
     stats.top_level_nodes = data.nodes.len();
     stats.mean_strip_triangles = if stats.strips == 0 {
         0.0
@@ -100,6 +104,27 @@ pub(crate) fn build(
         stats.triangles as f64 / stats.strips as f64
     };
     Ok((data, stats))
+}
+
+/// Cuts strips longer than [`MAX_STRIP`] triangles into consecutive
+/// pieces (a piece of triangles `[a, b)` keeps strip vertices `[a, b + 2)`,
+/// so every triangle keeps its three vertices).
+fn cut_long(strips: Vec<Strip>) -> Vec<Strip> {
+    let mut out = Vec::with_capacity(strips.len());
+    for s in strips {
+        if s.triangles.len() <= MAX_STRIP {
+            out.push(s);
+            continue;
+        }
+        for a in (0..s.triangles.len()).step_by(MAX_STRIP) {
+            let b = (a + MAX_STRIP).min(s.triangles.len());
+            out.push(Strip {
+                vertices: s.vertices[a..b + 2].to_vec(),
+                triangles: s.triangles[a..b].to_vec(),
+            });
+        }
+    }
+    out
 }
 
 struct Builder<'a> {
@@ -151,7 +176,7 @@ impl Builder<'_> {
             .iter()
             .map(|it| self.triangles[it.id as usize])
             .collect();
-        let strips = stripify(&local, self.options.strip_swaps);
+        let strips = cut_long(stripify(&local, self.options.strip_swaps));
         let mut strip_items: Vec<Item> = strips
             .iter()
             .enumerate()
@@ -178,11 +203,10 @@ impl Builder<'_> {
     fn strip_node(&mut self, items: &mut [Item], strips: &[Strip], ids: &[u32], depth: usize) {
         if items.len() <= self.options.strips_per_leaf {
             let offset = self.data.words.len() as u32;
-            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+            let (lo, hi) = bounds(items);
             for it in items.iter() {
-                let (a, b) = self.block(&strips[it.id as usize], ids);
-                lo = lo.min(a);
-                hi = hi.max(b);
+                let b = self.block(&strips[it.id as usize], ids, (lo, hi));
+                debug_assert!(b.0.cmpge(lo).all() && b.1.cmple(hi).all());
             }
             self.data
                 .nodes
@@ -194,8 +218,9 @@ impl Builder<'_> {
         });
     }
 
-    /// Writes one strip's block and returns its box.
-    fn block(&mut self, strip: &Strip, ids: &[u32]) -> (Vec3, Vec3) {
+    /// Writes one strip's block into a leaf with box `leaf` and returns
+    /// the strip's box.
+    fn block(&mut self, strip: &Strip, ids: &[u32], leaf: (Vec3, Vec3)) -> (Vec3, Vec3) {
         let n = strip.triangles.len();
         let words: Vec<u32> = strip
             .triangles
@@ -222,6 +247,8 @@ impl Builder<'_> {
             &self.data.vertices,
             &vertices,
             &words,
+            self.data.triangle_bits,
+            leaf,
             &mut self.data.words,
         );
         self.stats.strips += 1;

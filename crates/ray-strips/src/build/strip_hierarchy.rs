@@ -7,31 +7,58 @@
 
 use glam::Vec3;
 
-use crate::layout::{BlockLayout, REVERSE, split_counts, strip_words};
+use crate::layout::{
+    BOX_STEPS, BlockLayout, MAX_STRIP, REVERSE, StripBox, box_lower, box_step, box_upper,
+    pack_words, split_counts, strip_words,
+};
 
 /// Appends the block of one strip to `out` and returns its box.
 /// `strip_vertices` has `n + 2` global vertex indices and `triangle_words`
-/// the `n` per-triangle words.
+/// the `n` per-triangle words (packed to `bits` bits each); `leaf` is the box of the BVH leaf that will
+/// hold the strip (it must contain the strip).
 pub(crate) fn write_block(
     positions: &[[f32; 3]],
     strip_vertices: &[u32],
     triangle_words: &[u32],
+    bits: u32,
+    leaf: (Vec3, Vec3),
     out: &mut Vec<u32>,
 ) -> (Vec3, Vec3) {
     let n = triangle_words.len();
+    debug_assert!(n <= MAX_STRIP);
     debug_assert_eq!(strip_vertices.len(), n + 2);
     let start = out.len();
-    out.resize(start + strip_words(n), 0);
+    out.resize(start + strip_words(n, bits), 0);
     let layout = BlockLayout::new(start, n as u32);
-    out[start] = n as u32;
     out[layout.indices..layout.indices + n + 2].copy_from_slice(strip_vertices);
-    out[layout.triangles..layout.triangles + n].copy_from_slice(triangle_words);
+    pack_words(triangle_words, bits, &mut out[layout.triangles..]);
     let writer = Writer {
         positions,
         strip_vertices,
         layout,
     };
-    writer.node(out, 0, 0, n as u32)
+    let bounds = writer.node(out, 0, 0, n as u32);
+    out[start] = quantize(leaf, bounds).header(n as u32);
+    bounds
+}
+
+/// The codes of the smallest grid box around `strip` within `leaf`: on
+/// each axis the largest lower code and the smallest upper code whose
+/// faces, computed as traversal computes them, still enclose the strip.
+fn quantize(leaf: (Vec3, Vec3), strip: (Vec3, Vec3)) -> StripBox {
+    let mut q = StripBox::LEAF;
+    for a in 0..3 {
+        let (lo, hi) = (leaf.0[a], leaf.1[a]);
+        let step = box_step(lo, hi);
+        q.lower[a] = (0..=BOX_STEPS)
+            .rev()
+            .find(|&c| box_lower(lo, step, c) <= strip.0[a])
+            .unwrap_or(0);
+        q.upper[a] = (0..=BOX_STEPS)
+            .find(|&c| box_upper(hi, step, c) >= strip.1[a])
+            .unwrap_or(BOX_STEPS);
+    }
+    q
 }
 
 struct Writer<'a> {

@@ -5,11 +5,13 @@
 //!
 //! The packet requires its rays to share the sign of their direction on
 //! every axis (the caller checks), so every node orders its children the
-//! same way for all four rays. Each ray then sees exactly the node and
-//! triangle sequence of single-ray traversal, with the same per-ray
-//! arithmetic, and its result is bit for bit the single-ray result.
+//! same way for all four rays (by the split axis of the high-level BVH,
+//! where single rays order by entry distance). Every triangle test is the
+//! single-ray test with the same per-ray arithmetic, and culling is
+//! conservative, so the closest hit (ties to the smaller input index) is
+//! bit for bit the single-ray result whatever the visiting order.
 
-use crate::layout::{BlockLayout, StripData, is_leaf, leaf_blocks, strip_words};
+use crate::layout::{BlockLayout, LeafGrid, StripData, is_leaf, leaf_blocks};
 use crate::traverse::prepared::{Best, Prepared, fmin};
 use crate::traverse::single::{
     BVH_STACK, Part, STRIP_STACK, Stacks, child_intervals, node_children, strip_from, trace_from,
@@ -98,24 +100,41 @@ pub(crate) fn trace_packet(
         }
         if active.count_ones() <= SINGLE_BELOW {
             for l in lanes(active) {
-                trace_from(data, i, &rays[l], &mut best[l], false, singles);
+                let interval = (dmin[l], dmax[l]);
+                trace_from(data, i, interval, &rays[l], &mut best[l], false, singles);
             }
             continue;
         }
         if is_leaf(node) {
             let (mut offset, count) = leaf_blocks(node);
+            let grid = LeafGrid::new(node);
             for _ in 0..count {
-                let layout = BlockLayout::new(offset, data.words[offset]);
+                let header = data.words[offset];
+                let layout = BlockLayout::new(offset, header);
+                offset += data.block_words(header);
+                // Each ray's interval of the strip's own box.
+                let (slo, shi) = grid.strip_box(header);
+                let (mut entered, mut smin, mut smax) = (0u8, dmin, dmax);
+                for l in lanes(active) {
+                    let t_max = fmin(dmax[l], best[l].t);
+                    if let Some((tn, tf)) = rays[l].interval(slo, shi, t_max) {
+                        entered |= 1 << l;
+                        smin[l] = tn;
+                        smax[l] = tf;
+                    }
+                }
+                if entered == 0 {
+                    continue;
+                }
                 strip_packet(
                     data,
                     &layout,
-                    (active, dmin, dmax),
+                    (entered, smin, smax),
                     rays,
                     best,
                     &forward,
                     (strip_stack, singles),
                 );
-                offset += strip_words(layout.n as usize);
             }
         } else {
             let (first, second) = (i + 1, node.a());

@@ -82,18 +82,24 @@ impl Prepared {
         if dir[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
+        // One vector division for all reciprocals; Woop's shear constants
+        // `d_kx / d_kz` and `d_ky / d_kz` as products with `1 / d_kz` (any
+        // per-ray constants give a watertight test, as long as every
+        // vertex is transformed with the same ones).
+        let inv = glam::Vec3::ONE / glam::Vec3::from(dir);
+        let inv_kz = inv[kz];
         Some(Self {
             org: ray.origin.to_array(),
             dir,
-            inv: dir.map(|d| 1.0 / d),
+            inv: inv.to_array(),
             // The `w` lanes meet the node's words (small integers, i.e.
             // subnormal floats): 1 keeps that lane's results normal, which
             // some processors compute much faster.
             org_a: Vec3A::from_vec4(ray.origin.extend(1.0)),
-            inv_a: Vec3A::from_vec4(glam::Vec3::from(dir.map(|d| 1.0 / d)).extend(1.0)),
+            inv_a: Vec3A::from_vec4(inv.extend(1.0)),
             t_min: ray.t_min,
             k: [kx, ky, kz],
-            shear: [dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]],
+            shear: [dir[kx] * inv_kz, dir[ky] * inv_kz, inv_kz],
             parallel: dir.contains(&0.0),
         })
     }
@@ -109,7 +115,13 @@ impl Prepared {
     /// `None` when empty.
     #[inline(always)]
     pub fn box_interval(&self, node: &BvhNode, t_max: f32) -> Option<(f32, f32)> {
-        let (min, max) = (node.min(), node.max());
+        self.interval(node.min(), node.max(), t_max)
+    }
+
+    /// Conservative `[t_near, t_far]` of the box `[min, max]` (`xyz`
+    /// lanes) within `[t_min, t_max]`, `None` when empty.
+    #[inline(always)]
+    pub fn interval(&self, min: Vec3A, max: Vec3A, t_max: f32) -> Option<(f32, f32)> {
         if !self.parallel {
             // No direction component is zero: every slab distance is a
             // number (the same IEEE operations per lane as a scalar loop),

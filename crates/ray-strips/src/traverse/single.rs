@@ -1,6 +1,8 @@
-//! Single-ray traversal: the high-level BVH (depth first, nearer child
-//! first) and, in each leaf, Algorithm 1 of the paper over the strip
-//! hierarchy (paper §5.1).
+//! Single-ray traversal: the high-level BVH (depth first; both children's
+//! boxes tested together, the one entered first visited first) and, in
+//! each leaf, for every strip whose quantized box the ray enters
+//! ([`crate::layout::LeafGrid`]), Algorithm 1 of the paper over the strip
+//! hierarchy from that box's interval (paper §5.1).
 //!
 //! | paper (Alg. 1) | here |
 //! |---|---|
@@ -18,20 +20,25 @@
 //! ([`crate::traverse::prepared::SLACK`]) so that rounding never culls a
 //! ray aimed at a vertex or edge on a splitting plane.
 
-use crate::layout::{BlockLayout, StripData, is_leaf, leaf_blocks, split_counts, strip_words};
+use crate::layout::{
+    BlockLayout, LeafGrid, MAX_STRIP, StripData, is_leaf, leaf_blocks, split_counts,
+};
 use crate::traverse::prepared::{Best, Prepared, down, fmax, fmin, up};
 use crate::traverse::triangle::intersect_leaf;
 
 /// Traversal stack depth of the high-level BVH (the builder caps the tree's
 /// depth below this).
 pub(crate) const BVH_STACK: usize = 64;
-/// Traversal stack depth of a strip hierarchy (`log2` of the largest strip).
-pub(crate) const STRIP_STACK: usize = 32;
+/// Traversal stack depth of a strip hierarchy: at least its depth, which
+/// is below `log2` of the longest strip ([`MAX_STRIP`]); small, because
+/// every ray sets its stacks up.
+pub(crate) const STRIP_STACK: usize = 12;
+const _: () = assert!(MAX_STRIP < 1 << STRIP_STACK);
 
 /// The stacks of one single-ray traversal, allocated once per ray (or
 /// once per packet for its single-ray fallbacks).
 pub(crate) struct Stacks {
-    bvh: [u32; BVH_STACK],
+    bvh: [(u32, f32, f32); BVH_STACK],
     pub(crate) strip: [(Part, f32, f32); STRIP_STACK],
 }
 
@@ -44,7 +51,7 @@ impl Stacks {
             m: 0,
         };
         Self {
-            bvh: [0; BVH_STACK],
+            bvh: [(0, 0.0, 0.0); BVH_STACK],
             strip: [(part, 0.0, 0.0); STRIP_STACK],
         }
     }
@@ -122,30 +129,52 @@ pub(crate) fn child_intervals(
     ]
 }
 
+/// Closest (or, with `any`, some) hit of `ray` in the whole structure,
+/// updating `best`; see [`trace_from`]. The root box is tested before the
+/// stacks are set up, so a ray that misses the scene costs one box test.
+pub(crate) fn trace(data: &StripData, ray: &Prepared, best: &mut Best, any: bool) -> bool {
+    let Some(root) = data.nodes.first() else {
+        return false;
+    };
+    let Some(interval) = ray.box_interval(root, best.t) else {
+        return false;
+    };
+    trace_from(data, 0, interval, ray, best, any, &mut Stacks::new())
+}
+
 /// Closest (or, with `any`, some) hit of `ray` in the subtree of BVH node
-/// `root`, updating `best`. Returns `true` when `any` and a hit was found.
+/// `root`, whose box the ray crosses over `interval`, updating `best`.
+/// Returns `true` when `any` and a hit was found.
+///
+/// Both children of an inner node are box-tested together; the one the
+/// ray enters first is visited next and the other, if hit, is pushed with
+/// its entry distance, so that it is skipped on its pop once a closer hit
+/// is known.
 pub(crate) fn trace_from(
     data: &StripData,
     root: u32,
+    mut interval: (f32, f32),
     ray: &Prepared,
     best: &mut Best,
     any: bool,
     stacks: &mut Stacks,
 ) -> bool {
     let Stacks { bvh: stack, strip } = stacks;
-    stack[0] = root;
-    let mut sp = 1;
-    while sp > 0 {
-        sp -= 1;
-        let i = stack[sp] as usize;
+    let mut i = root as usize;
+    let mut sp = 0;
+    loop {
         let node = &data.nodes[i];
-        let Some((tn, tf)) = ray.box_interval(node, best.t) else {
-            continue;
-        };
         if is_leaf(node) {
             let (mut offset, count) = leaf_blocks(node);
+            let grid = LeafGrid::new(node);
             for _ in 0..count {
-                let layout = BlockLayout::new(offset, data.words[offset]);
+                let header = data.words[offset];
+                let layout = BlockLayout::new(offset, header);
+                offset += data.block_words(header);
+                let (slo, shi) = grid.strip_box(header);
+                let Some((tn, tf)) = ray.interval(slo, shi, fmin(interval.1, best.t)) else {
+                    continue;
+                };
                 let root = Part {
                     node: 0,
                     t0: 0,
@@ -154,21 +183,46 @@ pub(crate) fn trace_from(
                 if strip_from(data, &layout, root, tn, tf, ray, best, any, strip) && any {
                     return true;
                 }
-                offset += strip_words(layout.n as usize);
             }
         } else {
-            let (first, second) = (i as u32 + 1, node.a());
-            let (near, far) = if ray.forward(node.b() as usize) {
-                (first, second)
-            } else {
-                (second, first)
-            };
-            stack[sp] = far;
-            stack[sp + 1] = near;
-            sp += 2;
+            let (a, b) = (i + 1, node.a() as usize);
+            let hit_a = ray.box_interval(&data.nodes[a], best.t);
+            let hit_b = ray.box_interval(&data.nodes[b], best.t);
+            match (hit_a, hit_b) {
+                (Some(ia), Some(ib)) => {
+                    let ((near, near_i), (far, far_i)) = if ia.0 <= ib.0 {
+                        ((a, ia), (b, ib))
+                    } else {
+                        ((b, ib), (a, ia))
+                    };
+                    stack[sp] = (far as u32, far_i.0, far_i.1);
+                    sp += 1;
+                    (i, interval) = (near, near_i);
+                    continue;
+                }
+                (Some(ia), None) => {
+                    (i, interval) = (a, ia);
+                    continue;
+                }
+                (None, Some(ib)) => {
+                    (i, interval) = (b, ib);
+                    continue;
+                }
+                (None, None) => {}
+            }
+        }
+        loop {
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            let (j, tn, tf) = stack[sp];
+            if tn <= best.t {
+                (i, interval) = (j as usize, (tn, fmin(tf, best.t)));
+                break;
+            }
         }
     }
-    false
 }
 
 /// Algorithm 1 from `part` with interval `[dmin, dmax]`; returns whether a

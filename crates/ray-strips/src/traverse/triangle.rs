@@ -107,7 +107,7 @@ fn leaf<const M: usize>(
         if !(t >= ray.t_min && t <= best.t) {
             continue;
         }
-        let word = data.words[layout.triangles + t0 as usize + j];
+        let word = data.triangle_word(layout, t0 as usize + j);
         if word == SWAP_WORD || (t == best.t && word >= best.word) {
             continue;
         }
