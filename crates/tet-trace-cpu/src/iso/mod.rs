@@ -58,7 +58,7 @@ use glam::{Mat3, Vec3};
 use thiserror::Error;
 
 pub use ibvh::{BuildKind, Ibvh};
-pub use walk::{IsoOutcome, IsoWalk, WalkLayout};
+pub use walk::{IsoOutcome, IsoWalk, TileWalk, WalkLayout};
 
 /// Most isovalues one query may hold (the paper's SIMD width, §7).
 pub const MAX_ISOVALUES: usize = 4;

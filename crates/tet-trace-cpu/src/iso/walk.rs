@@ -33,6 +33,14 @@
 //!
 //! Volume meshes rarely have constrained faces; any the mesh has are
 //! walked through (the walk runs on a copy without them).
+//!
+//! Tiles of rays from outside the volume ([`IsoWalk::trace_tile`]) walk
+//! the stretch before the first tet that straddles an isovalue in the SIMD
+//! lockstep walk of the surface kernels and hand each ray to the scalar
+//! walk there (`lockstep`): the same steps, twice as fast (see the
+//! README's isosurface figures).
+
+mod lockstep;
 
 use std::borrow::Cow;
 
@@ -84,6 +92,18 @@ enum Topo {
     Tet32(Tet32Mesh),
     Tet20(Tet20Mesh),
     Tet16(Tet16Mesh),
+}
+
+/// How [`IsoWalk::trace_tile_as`] walks a tile.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TileWalk {
+    /// [`LANES`] scalar walks interleaved on the thread.
+    Interleaved,
+    /// From a viewpoint outside the volume: the stretch of every walk up to
+    /// the first tet that straddles an isovalue in SIMD lockstep (the
+    /// widest lanes the CPU runs, portable lanes without AVX2), the rest
+    /// scalar; from inside, as `Interleaved`.
+    Lockstep,
 }
 
 /// Result of one iso walk.
@@ -354,6 +374,34 @@ impl<'m> IsoWalk<'m> {
         out: &mut [IsoOutcome],
         stats: &mut IsoStats,
     ) {
+        let how = if lockstep_tiles() {
+            TileWalk::Lockstep
+        } else {
+            TileWalk::Interleaved
+        };
+        self.trace_tile_as(how, vp, rays, query, out, stats);
+    }
+
+    /// [`IsoWalk::trace_tile`] with the tile walk chosen by the caller
+    /// (tests and comparisons; `trace_tile` picks [`TileWalk::Lockstep`]
+    /// where the CPU has AVX2). The outcomes are the same either way.
+    pub fn trace_tile_as(
+        &self,
+        how: TileWalk,
+        vp: &Viewpoint,
+        rays: &[Ray],
+        query: &IsoQuery,
+        out: &mut [IsoOutcome],
+        stats: &mut IsoStats,
+    ) {
+        if matches!(vp, Viewpoint::Outside(_)) && how == TileWalk::Lockstep {
+            match &self.topo {
+                Topo::Tet32(t) => self.tile_lockstep(t, rays, query, out, stats),
+                Topo::Tet20(t) => self.tile_lockstep(t, rays, query, out, stats),
+                Topo::Tet16(t) => self.tile_lockstep(t, rays, query, out, stats),
+            }
+            return;
+        }
         match &self.topo {
             Topo::Tet32(t) => self.tile(t, vp, rays, query, out, stats),
             Topo::Tet20(t) => self.tile(t, vp, rays, query, out, stats),
@@ -589,6 +637,19 @@ impl<'m> IsoWalk<'m> {
             tets_visited: visited,
         })
     }
+}
+
+/// Whether tiles from outside the volume walk their empty stretch in SIMD
+/// lockstep ([`lockstep`]): where the CPU has AVX2 (where it was measured;
+/// without AVX2 the interleaved walk stays the default), unless
+/// `TET_LOCKSTEP=scalar` asks for the interleaved walk (read once; for
+/// same-machine comparisons).
+fn lockstep_tiles() -> bool {
+    static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *ON.get_or_init(|| {
+        crate::lockstep::Width::Avx2.available()
+            && std::env::var("TET_LOCKSTEP").map_or(true, |v| v != "scalar")
+    })
 }
 
 /// One walk in flight: the tet walk's lane, the entry face's values, the

@@ -21,6 +21,13 @@
 //! same ending, crossing and refill for every width); a finished lane is
 //! refilled at once from the batch, so lanes idle only at the batch's tail.
 //!
+//! A *gated* walk (`walk::Gate`, `trace_lockstep_gated`) also stops a lane
+//! short before it enters a tet the gate names, handing its state to the
+//! caller, which walks on with the scalar walk: the iso walk gates on the
+//! range test, so the tets on no isovalue's side are walked in lockstep
+//! ([`crate::iso::IsoWalk::trace_tile`]). The plain walk's gate compiles
+//! away.
+//!
 //! # Dispatch
 //!
 //! * x86-64 with AVX-512F (detected at run time) and a layout that exposes
@@ -132,6 +139,9 @@ pub(crate) mod sctp;
 mod side;
 mod walk;
 
+use walk::NoGate;
+pub(crate) use walk::{Gate, Handover};
+
 use tet_core::TetMesh;
 
 use crate::ray::{Ray, TraceOutcome};
@@ -213,11 +223,28 @@ pub fn trace_lockstep<T: Topology>(
     cap: u32,
     out: &mut [TraceOutcome],
 ) {
+    trace_lockstep_gated(mesh, topo, rays, start, cap, out, &mut NoGate);
+}
+
+/// [`trace_lockstep`] stopped short by `gate`: a walk about to enter a tet
+/// the gate names is handed to it instead (its `out` left unwritten), so
+/// that a caller walks on with the scalar walk from there (the iso walk
+/// does, from the first tet whose values straddle an isovalue).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn trace_lockstep_gated<T: Topology, GT: Gate>(
+    mesh: &TetMesh,
+    topo: &T,
+    rays: &[Ray],
+    start: Starts<'_>,
+    cap: u32,
+    out: &mut [TraceOutcome],
+    gate: &mut GT,
+) {
     #[cfg(target_arch = "x86_64")]
     let wide = !avx2_only();
     #[cfg(not(target_arch = "x86_64"))]
     let wide = false;
-    dispatch(mesh, topo, rays, start, cap, out, wide);
+    dispatch(mesh, topo, rays, start, cap, out, wide, gate);
 }
 
 /// [`trace_lockstep`] without the AVX-512 walk (the AVX2 walk where the CPU
@@ -231,7 +258,7 @@ pub fn trace_lockstep_avx2<T: Topology>(
     cap: u32,
     out: &mut [TraceOutcome],
 ) {
-    dispatch(mesh, topo, rays, start, cap, out, false);
+    dispatch(mesh, topo, rays, start, cap, out, false, &mut NoGate);
 }
 
 /// [`trace_lockstep`] with `W` lanes compiled for the baseline target (no
@@ -246,7 +273,15 @@ pub fn trace_lockstep_portable<T: Topology, const W: usize>(
     out: &mut [TraceOutcome],
 ) {
     const { assert!(W > 0 && W <= 32, "1 to 32 portable lanes") };
-    walk::run::<Portable<W>, Planar, _, 1>(Portable, &PerLane(topo), mesh, rays, start, cap, out);
+    walk::run_plain::<Portable<W>, Planar, _, 1>(
+        Portable,
+        &PerLane(topo),
+        mesh,
+        rays,
+        start,
+        cap,
+        out,
+    );
 }
 
 /// [`trace_lockstep`] at `width` exactly: the portable widths read the
@@ -272,9 +307,11 @@ pub fn trace_lockstep_at<T: Topology>(
             };
             match (width, Avx2::detect(), Avx512::detect()) {
                 (Width::Avx512, _, Some(t)) => {
-                    gathered_avx512(t, rule, g, mesh, rays, start, cap, out)
+                    gathered_avx512(t, rule, g, mesh, rays, start, cap, out, &mut NoGate)
                 }
-                (Width::Avx2, Some(t), _) => gathered_avx2(t, rule, g, mesh, rays, start, cap, out),
+                (Width::Avx2, Some(t), _) => {
+                    gathered_avx2(t, rule, g, mesh, rays, start, cap, out, &mut NoGate)
+                }
                 _ => return false,
             }
         }
@@ -304,22 +341,26 @@ pub fn trace_lockstep_sctp<T: Topology>(
     };
     let x = &Gathered::<IDS>(g);
     match width {
-        Width::Portable4 => {
-            walk::run::<Portable<NARROW>, Triple, _, 1>(Portable, x, mesh, rays, start, cap, out)
-        }
-        Width::Portable8 => {
-            walk::run::<Portable<WIDE>, Triple, _, 1>(Portable, x, mesh, rays, start, cap, out)
-        }
+        Width::Portable4 => walk::run_plain::<Portable<NARROW>, Triple, _, 1>(
+            Portable, x, mesh, rays, start, cap, out,
+        ),
+        Width::Portable8 => walk::run_plain::<Portable<WIDE>, Triple, _, 1>(
+            Portable, x, mesh, rays, start, cap, out,
+        ),
         #[cfg(target_arch = "x86_64")]
         Width::Avx2 => match Avx2::detect() {
             // SAFETY: the token proves the CPU has AVX2.
-            Some(t) => unsafe { walk_avx2::<Triple, _>(t, x, mesh, rays, start, cap, out) },
+            Some(t) => unsafe {
+                walk_avx2::<Triple, _, _>(t, x, mesh, rays, start, cap, out, &mut NoGate)
+            },
             None => return false,
         },
         #[cfg(target_arch = "x86_64")]
         Width::Avx512 => match Avx512::detect() {
             // SAFETY: the token proves the CPU has AVX-512F.
-            Some(t) => unsafe { walk_avx512::<Triple, _>(t, x, mesh, rays, start, cap, out) },
+            Some(t) => unsafe {
+                walk_avx512::<Triple, _, _>(t, x, mesh, rays, start, cap, out, &mut NoGate)
+            },
             None => return false,
         },
         #[cfg(not(target_arch = "x86_64"))]
@@ -346,8 +387,10 @@ fn baseline_records<'a, T: Topology>(mesh: &TetMesh, topo: &'a T) -> Option<Geo<
     Geo::new(mesh, &rw)
 }
 
-/// The widest walk the CPU supports (AVX-512 only when `wide`).
-fn dispatch<T: Topology>(
+/// The widest walk the CPU supports (AVX-512 only when `wide`), stopped
+/// short by `gate`.
+#[allow(clippy::too_many_arguments)]
+fn dispatch<T: Topology, GT: Gate>(
     mesh: &TetMesh,
     topo: &T,
     rays: &[Ray],
@@ -355,6 +398,7 @@ fn dispatch<T: Topology>(
     cap: u32,
     out: &mut [TraceOutcome],
     wide: bool,
+    gate: &mut GT,
 ) {
     #[cfg(not(target_arch = "x86_64"))]
     let _ = wide;
@@ -365,19 +409,19 @@ fn dispatch<T: Topology>(
             && let Some(t) = Avx512::detect()
             && let Some((rule, g)) = records
         {
-            gathered_avx512(t, rule, g, mesh, rays, start, cap, out);
+            gathered_avx512(t, rule, g, mesh, rays, start, cap, out, gate);
             return;
         }
         if let Some(t) = Avx2::detect() {
             match records {
-                Some((rule, g)) => gathered_avx2(t, rule, g, mesh, rays, start, cap, out),
+                Some((rule, g)) => gathered_avx2(t, rule, g, mesh, rays, start, cap, out, gate),
                 // SAFETY: the token proves the CPU has AVX2.
-                None => unsafe { portable_avx2(t, topo, mesh, rays, start, cap, out) },
+                None => unsafe { portable_avx2(t, topo, mesh, rays, start, cap, out, gate) },
             }
             return;
         }
     }
-    trace_lockstep_portable::<T, NARROW>(mesh, topo, rays, start, cap, out);
+    portable_gated::<T, GT, NARROW>(topo, mesh, rays, start, cap, out, gate);
 }
 
 /// True when `TET_LOCKSTEP=avx2` asks the lockstep walk to keep to 8-lane
@@ -396,13 +440,13 @@ macro_rules! by_rule {
         // entry point's instruction set.
         match $rule {
             ExitRule::Rank { .. } => unsafe {
-                $walk::<Planar, _>($t, &Gathered::<RANK>($g), $($arg),*)
+                $walk::<Planar, _, _>($t, &Gathered::<RANK>($g), $($arg),*)
             },
             ExitRule::RankXor { .. } => unsafe {
-                $walk::<Planar, _>($t, &Gathered::<RANK_XOR>($g), $($arg),*)
+                $walk::<Planar, _, _>($t, &Gathered::<RANK_XOR>($g), $($arg),*)
             },
             ExitRule::Slot { .. } | ExitRule::Ids { .. } => unsafe {
-                $walk::<Planar, _>($t, &Gathered::<SLOT>($g), $($arg),*)
+                $walk::<Planar, _, _>($t, &Gathered::<SLOT>($g), $($arg),*)
             },
         }
     };
@@ -411,7 +455,7 @@ macro_rules! by_rule {
 /// The projected walk with AVX-512 lanes and gathered records of `rule`.
 #[cfg(target_arch = "x86_64")]
 #[allow(clippy::too_many_arguments)]
-fn gathered_avx512(
+fn gathered_avx512<GT: Gate>(
     t: Avx512,
     rule: ExitRule,
     g: Geo<'_>,
@@ -420,14 +464,15 @@ fn gathered_avx512(
     start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
+    gate: &mut GT,
 ) {
-    by_rule!(walk_avx512, t, rule, g, mesh, rays, start, cap, out)
+    by_rule!(walk_avx512, t, rule, g, mesh, rays, start, cap, out, gate)
 }
 
 /// The projected walk with AVX2 lanes and gathered records of `rule`.
 #[cfg(target_arch = "x86_64")]
 #[allow(clippy::too_many_arguments)]
-fn gathered_avx2(
+fn gathered_avx2<GT: Gate>(
     t: Avx2,
     rule: ExitRule,
     g: Geo<'_>,
@@ -436,15 +481,17 @@ fn gathered_avx2(
     start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
+    gate: &mut GT,
 ) {
-    by_rule!(walk_avx2, t, rule, g, mesh, rays, start, cap, out)
+    by_rule!(walk_avx2, t, rule, g, mesh, rays, start, cap, out, gate)
 }
 
 /// The walk with 16 AVX-512 lanes, two packs in flight, compiled for
 /// AVX-512F (everything inlines into it).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
-fn walk_avx512<G: Geometry<Avx512>, X: Records<Avx512>>(
+#[allow(clippy::too_many_arguments)]
+fn walk_avx512<G: Geometry<Avx512>, X: Records<Avx512>, GT: Gate>(
     t: Avx512,
     x: &X,
     mesh: &TetMesh,
@@ -452,14 +499,16 @@ fn walk_avx512<G: Geometry<Avx512>, X: Records<Avx512>>(
     start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
+    gate: &mut GT,
 ) {
-    walk::run::<Avx512, G, X, 2>(t, x, mesh, rays, start, cap, out);
+    walk::run::<Avx512, G, X, GT, 2>(t, x, mesh, rays, start, cap, out, gate);
 }
 
 /// The walk with 8 AVX2 lanes, two packs in flight, compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
-fn walk_avx2<G: Geometry<Avx2>, X: Records<Avx2>>(
+#[allow(clippy::too_many_arguments)]
+fn walk_avx2<G: Geometry<Avx2>, X: Records<Avx2>, GT: Gate>(
     t: Avx2,
     x: &X,
     mesh: &TetMesh,
@@ -467,15 +516,17 @@ fn walk_avx2<G: Geometry<Avx2>, X: Records<Avx2>>(
     start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
+    gate: &mut GT,
 ) {
-    walk::run::<Avx2, G, X, 2>(t, x, mesh, rays, start, cap, out);
+    walk::run::<Avx2, G, X, GT, 2>(t, x, mesh, rays, start, cap, out, gate);
 }
 
 /// The portable lanes, 8 wide, compiled for AVX2, reading the records
 /// through [`Topology`] (layouts without gatherable records).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
-fn portable_avx2<T: Topology>(
+#[allow(clippy::too_many_arguments)]
+fn portable_avx2<T: Topology, GT: Gate>(
     _: Avx2,
     topo: &T,
     mesh: &TetMesh,
@@ -483,14 +534,23 @@ fn portable_avx2<T: Topology>(
     start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
+    gate: &mut GT,
 ) {
-    walk::run::<Portable<WIDE>, Planar, _, 1>(
-        Portable,
-        &PerLane(topo),
-        mesh,
-        rays,
-        start,
-        cap,
-        out,
-    );
+    portable_gated::<T, GT, WIDE>(topo, mesh, rays, start, cap, out, gate);
+}
+
+/// The projected walk with `W` portable lanes reading the records through
+/// [`Topology`], stopped short by `gate`.
+#[inline(always)]
+fn portable_gated<T: Topology, GT: Gate, const W: usize>(
+    topo: &T,
+    mesh: &TetMesh,
+    rays: &[Ray],
+    start: Starts<'_>,
+    cap: u32,
+    out: &mut [TraceOutcome],
+    gate: &mut GT,
+) {
+    let records = &PerLane(topo);
+    walk::run::<Portable<W>, Planar, _, _, 1>(Portable, records, mesh, rays, start, cap, out, gate);
 }

@@ -17,6 +17,44 @@ use crate::walk::start::Lane;
 use crate::walk::stop::{Advance, Stopped};
 use crate::walk::stopped::{AfterStop, after_stop};
 
+/// A walk's state between two tets, as the scalar walk keeps it (its
+/// `Lane` less the projection, which is a function of the ray and start):
+/// about to enter `next` through the face `ids`, from tet `entry_raw`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Handover {
+    pub(crate) ids: [u32; 3],
+    pub(crate) next: u32,
+    pub(crate) entry_raw: u32,
+    pub(crate) visited: u32,
+}
+
+/// Where a gated lockstep walk stops short: before every round, a lane
+/// about to enter a tet the gate names leaves the walk (its state goes to
+/// [`Gate::hand_over`], its outcome is not written) and the lane is
+/// refilled. The plain walk's gate ([`NoGate`]) names none and compiles
+/// away.
+pub(crate) trait Gate {
+    /// False for [`NoGate`]: no check at all.
+    const ON: bool;
+    /// Whether a walk stops before entering `tet`.
+    fn stops_before(&self, tet: u32) -> bool;
+    /// Receives ray `ray`'s walk, stopped before entering `h.next`.
+    fn hand_over(&mut self, ray: usize, h: Handover);
+}
+
+/// The plain walk: never stops short.
+pub(crate) struct NoGate;
+
+impl Gate for NoGate {
+    const ON: bool = false;
+    #[inline(always)]
+    fn stops_before(&self, _: u32) -> bool {
+        false
+    }
+    #[inline(always)]
+    fn hand_over(&mut self, _: usize, _: Handover) {}
+}
+
 /// `L::WIDTH` walks in registers, and per lane its cold part.
 struct Pack<L: Lanes, G: Geometry<L>> {
     ray: G::Ray,
@@ -69,6 +107,16 @@ impl<L: Lanes, G: Geometry<L>> Pack<L, G> {
         self.visited = l.set_i(self.visited, k, lane.st.visited);
         self.live = l.or_m(self.live, l.mask_of_bits(1 << k));
         self.ray_index.as_mut()[k] = ray;
+    }
+
+    /// The entry face's vertex ids of lane `k`.
+    #[inline(always)]
+    fn ids_of(&self, l: L, k: usize) -> [u32; 3] {
+        [
+            l.get_i(self.ids[0], k),
+            l.get_i(self.ids[1], k),
+            l.get_i(self.ids[2], k),
+        ]
     }
 
     /// Parks lane `k` (on tet 0).
@@ -220,11 +268,7 @@ fn events<L: Lanes, G: Geometry<L>>(
         let link = r.raw.as_ref()[k];
         let stopped = Stopped {
             adv: Advance::stopped(bit(r.capped), bit(r.lost)),
-            ids: [
-                l.get_i(pk.ids[0], k),
-                l.get_i(pk.ids[1], k),
-                l.get_i(pk.ids[2], k),
-            ],
+            ids: pk.ids_of(l, k),
             tet: l.get_i(pk.next, k),
             visited: l.get_i(pk.visited, k),
             link,
@@ -244,12 +288,61 @@ fn events<L: Lanes, G: Geometry<L>>(
     parked
 }
 
+/// Hands over the lanes of `stop` (their next tet is the gate's) and
+/// refills them, handing over at once the new walks whose first tet is the
+/// gate's too. Returns the number of lanes parked.
+#[inline(always)]
+fn gate_lanes<L: Lanes, G: Geometry<L>, GT: Gate>(
+    l: L,
+    feed: &mut Feed<'_>,
+    pk: &mut Pack<L, G>,
+    gate: &mut GT,
+    stop: u32,
+) -> usize {
+    let mut parked = 0;
+    for k in (0..L::WIDTH).filter(|k| stop >> k & 1 != 0) {
+        let h = Handover {
+            ids: pk.ids_of(l, k),
+            next: l.get_i(pk.next, k),
+            entry_raw: l.get_i(pk.entry, k),
+            visited: l.get_i(pk.visited, k),
+        };
+        gate.hand_over(pk.ray_index.as_ref()[k], h);
+        loop {
+            match feed.next_lane::<G::Proj>() {
+                Some((j, lane)) if gate.stops_before(lane.next) => {
+                    let h = Handover {
+                        ids: lane.st.ids,
+                        next: lane.next,
+                        entry_raw: lane.entry_raw,
+                        visited: lane.st.visited,
+                    };
+                    gate.hand_over(j, h);
+                }
+                Some((j, lane)) => {
+                    pk.put(l, k, j, &lane);
+                    break;
+                }
+                None => {
+                    pk.park(l, k);
+                    parked += 1;
+                    break;
+                }
+            }
+        }
+    }
+    parked
+}
+
 /// Traces `rays` from `start` (at most `cap` tets each) with `PACKS` packs
 /// of `L::WIDTH` lanes stepped in turn (the out-of-order core overlaps
 /// their dependent load chains); `out[i]` is exactly the scalar walk of
-/// `rays[i]` with `G::Proj`. The points must number at most `i32::MAX / 3`.
+/// `rays[i]` with `G::Proj`, except for the walks `gate` stops short
+/// (their `out` is left as it was). The points must number at most
+/// `i32::MAX / 3`.
 #[inline(always)]
-pub(crate) fn run<L: Lanes, G: Geometry<L>, X: Records<L>, const PACKS: usize>(
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn run<L: Lanes, G: Geometry<L>, X: Records<L>, GT: Gate, const PACKS: usize>(
     l: L,
     records: &X,
     mesh: &TetMesh,
@@ -257,6 +350,7 @@ pub(crate) fn run<L: Lanes, G: Geometry<L>, X: Records<L>, const PACKS: usize>(
     start: Starts<'_>,
     cap: u32,
     out: &mut [TraceOutcome],
+    gate: &mut GT,
 ) {
     // The gathers' indices `3·i` of the points fit in an `i32` (checked
     // by `RecordWords::gatherable` for every gathered layout already).
@@ -278,6 +372,22 @@ pub(crate) fn run<L: Lanes, G: Geometry<L>, X: Records<L>, const PACKS: usize>(
             if *live == 0 {
                 continue;
             }
+            if GT::ON {
+                let next = L::i_lanes(pk.next);
+                let live_bits = l.bits(pk.live);
+                let mut stop = 0u32;
+                for k in (0..L::WIDTH).filter(|k| live_bits >> k & 1 != 0) {
+                    if gate.stops_before(next.as_ref()[k]) {
+                        stop |= 1 << k;
+                    }
+                }
+                if stop != 0 {
+                    *live -= l.cold(|| gate_lanes(l, &mut feed, pk, gate, stop));
+                    if *live == 0 {
+                        continue;
+                    }
+                }
+            }
             any = true;
             if let Some(r) = step(l, pk, records, points, cap) {
                 *live -= l.cold(|| events(l, &mut feed, pk, &r));
@@ -287,4 +397,18 @@ pub(crate) fn run<L: Lanes, G: Geometry<L>, X: Records<L>, const PACKS: usize>(
             break;
         }
     }
+}
+
+/// [`run`] without a gate: every walk to its end.
+#[inline(always)]
+pub(crate) fn run_plain<L: Lanes, G: Geometry<L>, X: Records<L>, const PACKS: usize>(
+    l: L,
+    records: &X,
+    mesh: &TetMesh,
+    rays: &[Ray],
+    start: Starts<'_>,
+    cap: u32,
+    out: &mut [TraceOutcome],
+) {
+    run::<L, G, X, NoGate, PACKS>(l, records, mesh, rays, start, cap, out, &mut NoGate);
 }
