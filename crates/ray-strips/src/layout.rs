@@ -151,26 +151,6 @@ impl StripBox {
     }
 }
 
-/// Grid step of the strip boxes over a leaf's extent `[lo, hi]` on one
-/// axis. Each end is divided separately, so the step is finite for any
-/// finite box.
-#[inline(always)]
-pub(crate) fn box_step(lo: f32, hi: f32) -> f32 {
-    hi / BOX_STEPS as f32 - lo / BOX_STEPS as f32
-}
-
-/// Lower face of code `q` on one axis (`q = 0`: exactly `lo`).
-#[inline(always)]
-pub(crate) fn box_lower(lo: f32, step: f32, q: u32) -> f32 {
-    lo + q as f32 * step
-}
-
-/// Upper face of code `q` on one axis (`q = BOX_STEPS`: exactly `hi`).
-#[inline(always)]
-pub(crate) fn box_upper(hi: f32, step: f32, q: u32) -> f32 {
-    hi - (BOX_STEPS - q) as f32 * step
-}
-
 /// The strip-box grid of one leaf: its box and the step per axis.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LeafGrid {
@@ -184,8 +164,15 @@ impl LeafGrid {
     /// are left out: as floats they are subnormal and slow in arithmetic).
     #[inline(always)]
     pub fn new(leaf: &BvhNode) -> Self {
-        let lo = Vec3A::from(leaf.lo.truncate());
-        let hi = Vec3A::from(leaf.hi.truncate());
+        Self::over(leaf.lo.truncate(), leaf.hi.truncate())
+    }
+
+    /// The grid over the box `[lo, hi]` (the builder's, before the leaf's
+    /// node exists). Each end is divided separately, so the step is finite
+    /// for any finite box.
+    #[inline(always)]
+    pub fn over(lo: Vec3, hi: Vec3) -> Self {
+        let (lo, hi) = (Vec3A::from(lo), Vec3A::from(hi));
         let steps = Vec3A::splat(BOX_STEPS as f32);
         Self {
             lo,
@@ -194,9 +181,11 @@ impl LeafGrid {
         }
     }
 
-    /// The decoded box of the strip with header word `header`, by the same
-    /// operations as [`box_step`], [`box_lower`] and [`box_upper`] lane by
-    /// lane.
+    /// The decoded box of the strip with header word `header`: code `q`
+    /// gives the lower face `lo + q·step` (exactly `lo` for 0) and the
+    /// upper face `hi − (BOX_STEPS − q)·step` (exactly `hi` for
+    /// `BOX_STEPS`). The builder quantizes with this same function, so
+    /// the decoded box always contains the strip.
     #[inline(always)]
     pub fn strip_box(&self, header: u32) -> (Vec3A, Vec3A) {
         let q = StripBox::from_header(header);

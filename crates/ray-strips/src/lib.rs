@@ -227,10 +227,12 @@ impl RayStrips {
         );
         let mut stacks = PacketStacks::new();
         for (rays, out) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
+            let framed: [Option<Ray>; LANES] =
+                std::array::from_fn(|l| rays.get(l).map(|r| self.framed(r)));
             let mut pre = [None; LANES];
             let mut mask = 0u8;
-            for (l, r) in rays.iter().enumerate() {
-                pre[l] = Prepared::new(&self.framed(r));
+            for (l, r) in framed.iter().enumerate() {
+                pre[l] = r.as_ref().and_then(Prepared::new);
                 if pre[l].is_some() {
                     mask |= 1 << l;
                 }
@@ -241,9 +243,8 @@ impl RayStrips {
                 continue;
             };
             let pre = pre.map(|p| p.unwrap_or(fill));
-            let mut best: [Best; LANES] = std::array::from_fn(|l| {
-                Best::new(rays.get(l).map_or(0.0, |r| self.framed(r).t_max))
-            });
+            let mut best: [Best; LANES] =
+                std::array::from_fn(|l| Best::new(framed[l].map_or(0.0, |r| r.t_max)));
             if coherent(&pre, mask) {
                 trace_packet(&self.data, &pre, mask, &mut best, &mut stacks);
             } else {

@@ -8,8 +8,8 @@
 use glam::Vec3;
 
 use crate::layout::{
-    BOX_STEPS, BlockLayout, MAX_STRIP, REVERSE, StripBox, box_lower, box_step, box_upper,
-    pack_words, split_counts, strip_words,
+    BOX_STEPS, BlockLayout, LeafGrid, MAX_STRIP, REVERSE, StripBox, pack_words, split_counts,
+    strip_words,
 };
 
 /// Appends the block of one strip to `out` and returns its box.
@@ -44,18 +44,27 @@ pub(crate) fn write_block(
 
 /// The codes of the smallest grid box around `strip` within `leaf`: on
 /// each axis the largest lower code and the smallest upper code whose
-/// faces, computed as traversal computes them, still enclose the strip.
+/// faces, decoded by traversal's own [`LeafGrid::strip_box`], still
+/// enclose the strip.
 fn quantize(leaf: (Vec3, Vec3), strip: (Vec3, Vec3)) -> StripBox {
+    let grid = LeafGrid::over(leaf.0, leaf.1);
+    // The lower and upper faces of code `c`, on every axis at once.
+    let faces: [_; BOX_STEPS as usize + 1] = std::array::from_fn(|c| {
+        let c = c as u32;
+        let codes = StripBox {
+            lower: [c; 3],
+            upper: [c; 3],
+        };
+        grid.strip_box(codes.header(0))
+    });
     let mut q = StripBox::LEAF;
     for a in 0..3 {
-        let (lo, hi) = (leaf.0[a], leaf.1[a]);
-        let step = box_step(lo, hi);
         q.lower[a] = (0..=BOX_STEPS)
             .rev()
-            .find(|&c| box_lower(lo, step, c) <= strip.0[a])
+            .find(|&c| faces[c as usize].0[a] <= strip.0[a])
             .unwrap_or(0);
         q.upper[a] = (0..=BOX_STEPS)
-            .find(|&c| box_upper(hi, step, c) >= strip.1[a])
+            .find(|&c| faces[c as usize].1[a] >= strip.1[a])
             .unwrap_or(BOX_STEPS);
     }
     q

@@ -100,8 +100,7 @@ pub(crate) fn trace_packet(
         }
         if active.count_ones() <= SINGLE_BELOW {
             for l in lanes(active) {
-                let interval = (dmin[l], dmax[l]);
-                trace_from(data, i, interval, &rays[l], &mut best[l], false, singles);
+                trace_from(data, i, dmax[l], &rays[l], &mut best[l], false, singles);
             }
             continue;
         }

@@ -136,14 +136,14 @@ pub(crate) fn trace(data: &StripData, ray: &Prepared, best: &mut Best, any: bool
     let Some(root) = data.nodes.first() else {
         return false;
     };
-    let Some(interval) = ray.box_interval(root, best.t) else {
+    let Some((_, exit)) = ray.box_interval(root, best.t) else {
         return false;
     };
-    trace_from(data, 0, interval, ray, best, any, &mut Stacks::new())
+    trace_from(data, 0, exit, ray, best, any, &mut Stacks::new())
 }
 
 /// Closest (or, with `any`, some) hit of `ray` in the subtree of BVH node
-/// `root`, whose box the ray crosses over `interval`, updating `best`.
+/// `root`, whose box the ray leaves at `exit`, updating `best`.
 /// Returns `true` when `any` and a hit was found.
 ///
 /// Both children of an inner node are box-tested together; the one the
@@ -153,7 +153,7 @@ pub(crate) fn trace(data: &StripData, ray: &Prepared, best: &mut Best, any: bool
 pub(crate) fn trace_from(
     data: &StripData,
     root: u32,
-    mut interval: (f32, f32),
+    mut exit: f32,
     ray: &Prepared,
     best: &mut Best,
     any: bool,
@@ -172,7 +172,7 @@ pub(crate) fn trace_from(
                 let layout = BlockLayout::new(offset, header);
                 offset += data.block_words(header);
                 let (slo, shi) = grid.strip_box(header);
-                let Some((tn, tf)) = ray.interval(slo, shi, fmin(interval.1, best.t)) else {
+                let Some((tn, tf)) = ray.interval(slo, shi, fmin(exit, best.t)) else {
                     continue;
                 };
                 let root = Part {
@@ -197,15 +197,15 @@ pub(crate) fn trace_from(
                     };
                     stack[sp] = (far as u32, far_i.0, far_i.1);
                     sp += 1;
-                    (i, interval) = (near, near_i);
+                    (i, exit) = (near, near_i.1);
                     continue;
                 }
                 (Some(ia), None) => {
-                    (i, interval) = (a, ia);
+                    (i, exit) = (a, ia.1);
                     continue;
                 }
                 (None, Some(ib)) => {
-                    (i, interval) = (b, ib);
+                    (i, exit) = (b, ib.1);
                     continue;
                 }
                 (None, None) => {}
@@ -218,7 +218,7 @@ pub(crate) fn trace_from(
             sp -= 1;
             let (j, tn, tf) = stack[sp];
             if tn <= best.t {
-                (i, interval) = (j as usize, (tn, fmin(tf, best.t)));
+                (i, exit) = (j as usize, fmin(tf, best.t));
                 break;
             }
         }
