@@ -13,6 +13,7 @@ use super::geometry::Geometry;
 use super::lanes::Lanes;
 use crate::ray::{Ray, TraceOutcome};
 use crate::walk::lanes::{Feed, Starts};
+use crate::walk::projection::Projection;
 use crate::walk::start::Lane;
 use crate::walk::stop::{Advance, Stopped};
 use crate::walk::stopped::{AfterStop, after_stop};
@@ -26,6 +27,33 @@ pub(crate) struct Handover {
     pub(crate) next: u32,
     pub(crate) entry_raw: u32,
     pub(crate) visited: u32,
+}
+
+impl Handover {
+    /// The state of a scalar lane between two tets.
+    #[inline(always)]
+    fn of<P: Projection>(lane: &Lane<P>) -> Self {
+        Handover {
+            ids: lane.st.ids,
+            next: lane.next,
+            entry_raw: lane.entry_raw,
+            visited: lane.st.visited,
+        }
+    }
+
+    /// Puts this state into `lane`, a lane of the same ray and start (so
+    /// the same projection). The entry face's points are projected anew: a
+    /// pure function of the point, so the same bits the lockstep lane held.
+    pub(crate) fn resume<P: Projection>(self, lane: &mut Lane<P>, points: &[Vec3]) {
+        for (slot, &i) in self.ids.iter().enumerate() {
+            let p = points.get(i as usize).copied().unwrap_or(Vec3::NAN);
+            P::set_point(&mut lane.st.p, slot, lane.proj.project(p));
+        }
+        lane.st.ids = self.ids;
+        lane.st.visited = self.visited;
+        lane.next = self.next;
+        lane.entry_raw = self.entry_raw;
+    }
 }
 
 /// Where a gated lockstep walk stops short: before every round, a lane
@@ -311,13 +339,7 @@ fn gate_lanes<L: Lanes, G: Geometry<L>, GT: Gate>(
         loop {
             match feed.next_lane::<G::Proj>() {
                 Some((j, lane)) if gate.stops_before(lane.next) => {
-                    let h = Handover {
-                        ids: lane.st.ids,
-                        next: lane.next,
-                        entry_raw: lane.entry_raw,
-                        visited: lane.st.visited,
-                    };
-                    gate.hand_over(j, h);
+                    gate.hand_over(j, Handover::of(&lane));
                 }
                 Some((j, lane)) => {
                     pk.put(l, k, j, &lane);

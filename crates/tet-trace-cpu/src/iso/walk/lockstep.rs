@@ -13,7 +13,6 @@
 //! bit for bit; rays that leave the volume inside the lockstep walk miss
 //! there.
 
-use glam::Vec3;
 use tet_core::TetMesh;
 
 use super::super::walk_ray::Ctx;
@@ -22,7 +21,7 @@ use super::{IsoOutcome, IsoWalk, WalkState, converted};
 use crate::lockstep::{Gate, Handover, trace_lockstep_gated};
 use crate::ray::{Failure, Ray, TraceOutcome};
 use crate::walk::start::begin;
-use crate::walk::{DuffF32, EntryHint, Face2, Projection, Start, Starts, Topology};
+use crate::walk::{DuffF32, EntryHint, Start, Starts, Topology};
 
 /// The range test as a gate: walks stop short of the first tet whose
 /// values straddle an isovalue.
@@ -137,12 +136,7 @@ impl IsoWalk<'_> {
             Err(o) => return converted(o),
         };
         let opened = lane.st.visited;
-        let point = |i: u32| mesh.points.get(i as usize).copied().unwrap_or(Vec3::NAN);
-        lane.st.p = Face2::new(h.ids.map(|i| lane.proj.project(point(i))));
-        lane.st.ids = h.ids;
-        lane.st.visited = h.visited;
-        lane.next = h.next;
-        lane.entry_raw = h.entry_raw;
+        h.resume(&mut lane, &mesh.points);
         let mut w = WalkState {
             lane,
             cached: None,
