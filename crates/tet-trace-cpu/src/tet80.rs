@@ -108,7 +108,7 @@ use tet_core::predicates::orient3d;
 use tet_core::{FACE_VERTICES, NO_TET, TetMesh};
 
 use crate::kernel::Tracer;
-use crate::lockstep::plucker::width as lockstep_width;
+use crate::lockstep::batch_width as lockstep_width;
 use crate::lockstep::plucker::{Begun, PluckerWalk};
 use crate::lockstep::{self, Width};
 use crate::ray::{Failure, Hit, Ray, TraceOutcome};

@@ -374,7 +374,9 @@ impl<'m> IsoWalk<'m> {
         out: &mut [IsoOutcome],
         stats: &mut IsoStats,
     ) {
-        let how = if lockstep_tiles() {
+        // Lockstep where the CPU has AVX2 (measured there) unless
+        // `TET_LOCKSTEP=scalar` asks for the interleaved walk.
+        let how = if crate::lockstep::batch_width().is_some() {
             TileWalk::Lockstep
         } else {
             TileWalk::Interleaved
@@ -637,19 +639,6 @@ impl<'m> IsoWalk<'m> {
             tets_visited: visited,
         })
     }
-}
-
-/// Whether tiles from outside the volume walk their empty stretch in SIMD
-/// lockstep ([`lockstep`]): where the CPU has AVX2 (where it was measured;
-/// without AVX2 the interleaved walk stays the default), unless
-/// `TET_LOCKSTEP=scalar` asks for the interleaved walk (read once; for
-/// same-machine comparisons).
-fn lockstep_tiles() -> bool {
-    static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    *ON.get_or_init(|| {
-        crate::lockstep::Width::Avx2.available()
-            && std::env::var("TET_LOCKSTEP").map_or(true, |v| v != "scalar")
-    })
 }
 
 /// One walk in flight: the tet walk's lane, the entry face's values, the

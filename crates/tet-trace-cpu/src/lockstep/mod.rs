@@ -424,6 +424,26 @@ fn dispatch<T: Topology, GT: Gate>(
     portable_gated::<T, GT, NARROW>(topo, mesh, rays, start, cap, out, gate);
 }
 
+/// The width the batch paths that choose between a lockstep walk and a
+/// scalar one (the Tet80 tracers, the iso walk's tiles) walk in lockstep
+/// on this CPU: AVX-512F (16 lanes) unless `TET_LOCKSTEP=avx2`, else AVX2
+/// (8 lanes); `None` (the scalar walk) without either, or with
+/// `TET_LOCKSTEP=scalar` in the environment (read once; for same-machine
+/// comparisons).
+pub(crate) fn batch_width() -> Option<Width> {
+    static WIDTH: std::sync::OnceLock<Option<Width>> = std::sync::OnceLock::new();
+    *WIDTH.get_or_init(|| {
+        let env = std::env::var("TET_LOCKSTEP").unwrap_or_default();
+        if env == "scalar" {
+            return None;
+        }
+        [Width::Avx512, Width::Avx2]
+            .into_iter()
+            .filter(|w| *w != Width::Avx512 || env != "avx2")
+            .find(|w| w.available())
+    })
+}
+
 /// True when `TET_LOCKSTEP=avx2` asks the lockstep walk to keep to 8-lane
 /// AVX2 on a CPU with AVX-512 (read once; for same-machine comparisons).
 #[cfg(target_arch = "x86_64")]

@@ -448,24 +448,6 @@ fn run_side<L, W, B, const PACKS: usize>(
     }
 }
 
-/// The width the Tet80 tracers' batch paths walk in lockstep on this CPU:
-/// AVX-512F (16 lanes) unless `TET_LOCKSTEP=avx2`, else AVX2 (8 lanes);
-/// `None` (the scalar walk) without either, or with `TET_LOCKSTEP=scalar`
-/// in the environment (read once; for same-machine comparisons).
-pub(crate) fn width() -> Option<Width> {
-    static WIDTH: std::sync::OnceLock<Option<Width>> = std::sync::OnceLock::new();
-    *WIDTH.get_or_init(|| {
-        let env = std::env::var("TET_LOCKSTEP").unwrap_or_default();
-        if env == "scalar" {
-            return None;
-        }
-        [Width::Avx512, Width::Avx2]
-            .into_iter()
-            .filter(|w| *w != Width::Avx512 || env != "avx2")
-            .find(|w| w.available())
-    })
-}
-
 /// Traces `rays` with `w`'s Plücker walk in lockstep at `width` (ray `i`
 /// started by `begin(i)`, which also stores the outcome of a walk that
 /// ends before it starts); `out[i]` is exactly the scalar walk's outcome.
