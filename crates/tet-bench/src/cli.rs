@@ -520,6 +520,12 @@ pub struct TablesArgs {
     /// Default: 1m,10m,30m, or none with `--quick`.
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_size)]
     pub large_models: Option<Vec<u64>>,
+    /// Sizes of the large out-of-core table (`fan-sphere:N` built in parts
+    /// under its builder's share plus a sixteenth of its predicted in-core
+    /// peak; `k`/`m` suffixes; `none` for no table). Default: 1m, or none
+    /// with `--quick`.
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_size)]
+    pub large_out_of_core: Option<Vec<u64>>,
     /// Rays of the robustness table on the first scene, in batches (camera
     /// image, random and adversarial rays; `k`/`m` suffixes; `none` for the
     /// plain 1024² + 100 k rays). Default: 100m, or none with `--quick`.
@@ -555,6 +561,15 @@ impl TablesArgs {
             Some(sizes) => sizes.iter().copied().filter(|&n| n > 0).collect(),
             None if self.quick => Vec::new(),
             None => vec![1_000_000, 10_000_000, 30_000_000],
+        }
+    }
+
+    /// Sizes of the large out-of-core table (see `--large-out-of-core`).
+    pub fn large_out_of_core_sizes(&self) -> Vec<u64> {
+        match &self.large_out_of_core {
+            Some(sizes) => sizes.iter().copied().filter(|&n| n > 0).collect(),
+            None if self.quick => Vec::new(),
+            None => vec![1_000_000],
         }
     }
 

@@ -292,19 +292,21 @@ struct Entry {
 pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> IntersectionReport {
     let mut report = IntersectionReport::default();
     let n = triangles.len();
-    let mut tris: Vec<[DVec3; 3]> = Vec::with_capacity(n);
+    // Per triangle one byte and one index: the f64 corners and boxes are
+    // made again where they are needed (f32 to f64 is exact), so that a
+    // scene of millions of triangles is checked in little more memory
+    // than the grid's entries.
     let mut axes: Vec<u8> = Vec::with_capacity(n);
     let mut live: Vec<u32> = Vec::with_capacity(n);
     for (t, tri) in triangles.iter().enumerate() {
         let ok = tri
             .iter()
             .all(|&v| (v as usize) < vertices.len() && vertices[v as usize].is_finite());
-        let pts = if ok {
-            tri.map(|v| vertices[v as usize].as_dvec3())
+        let axis = if ok {
+            projection_axis(&tri.map(|v| vertices[v as usize].as_dvec3()))
         } else {
-            [DVec3::ZERO; 3]
+            None
         };
-        let axis = if ok { projection_axis(&pts) } else { None };
         match axis {
             Some(ax) => {
                 axes.push(ax as u8);
@@ -315,13 +317,14 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
                 report.degenerate.push(t as u32);
             }
         }
-        tris.push(pts);
     }
     if live.len() < 2 {
         return report;
     }
+    // Only for live triangles (their indices are in range).
+    let corners = |t: usize| triangles[t].map(|v| vertices[v as usize].as_dvec3());
     let bb = |t: usize| {
-        let [a, b, c] = tris[t];
+        let [a, b, c] = corners(t);
         (a.min(b).min(c), a.max(b).max(c))
     };
     let (mut lo, mut hi) = bb(live[0] as usize);
@@ -374,8 +377,7 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
     // Each entry carries its triangle's box (exact: the corners are f32)
     // and lowest cell, so that a cell's pairs are tested from contiguous
     // memory.
-    let mut ranges = Vec::with_capacity(live.len());
-    for &t in &live {
+    let entry_of = |t: u32| {
         let (l, h) = bb(t as usize);
         let (cl, ch) = (cell_of(l), cell_of(h));
         let entry = Entry {
@@ -384,7 +386,10 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
             hi: h.as_vec3().to_array(),
             cell: cl.map(|i| i as u32),
         };
-        ranges.push((entry, ch));
+        (entry, cl, ch)
+    };
+    for &t in &live {
+        let (_, cl, ch) = entry_of(t);
         for z in cl[2]..=ch[2] {
             for y in cl[1]..=ch[1] {
                 for x in cl[0]..=ch[0] {
@@ -407,8 +412,8 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
         };
         total
     ];
-    for &(entry, ch) in &ranges {
-        let cl = entry.cell.map(|i| i as usize);
+    for &t in &live {
+        let (entry, cl, ch) = entry_of(t);
         for z in cl[2]..=ch[2] {
             for y in cl[1]..=ch[1] {
                 for x in cl[0]..=ch[0] {
@@ -419,6 +424,7 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
             }
         }
     }
+    drop(fill);
     // Every cell's pairs, in parallel (cells are independent).
     let (candidates, pairs) = (0..ncells)
         .into_par_iter()
@@ -442,7 +448,7 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
                         let (s, t) = (s.triangle, t.triangle);
                         let (a, b) = (s.min(t) as usize, s.max(t) as usize);
                         if let Some(kind) =
-                            classify(&tris[a], axes[a] as usize, &tris[b], axes[b] as usize)
+                            classify(&corners(a), axes[a] as usize, &corners(b), axes[b] as usize)
                         {
                             pairs.push(IntersectingPair {
                                 first: a as u32,

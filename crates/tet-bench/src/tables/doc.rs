@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 
-use crate::accuracy::CaseAccuracy;
+use crate::accuracy::{CaseAccuracy, MethodAccuracy};
 use crate::cli::BuildFlags;
 use crate::exitface::ExitFaceTable;
 use crate::layouts::Info;
@@ -174,6 +174,11 @@ pub struct TablesDoc {
     pub large_models: Vec<LargeModelRow>,
     /// Why there is no large-model table, if there is none.
     pub large_models_note: Option<String>,
+    /// Out-of-core builds of large closed meshes (`fan-sphere:N`) under a
+    /// small fraction of their in-core peak, one row per size.
+    pub large_out_of_core: Vec<LargeOutOfCoreRow>,
+    /// Why there is no large out-of-core table, if there is none.
+    pub large_out_of_core_note: Option<String>,
     /// SVG figures written (paths).
     pub figures: Vec<String>,
     /// Wall time of the whole run, s.
@@ -275,6 +280,31 @@ pub struct LargeModelRow {
     /// Why a structure is missing (e.g. TetGen's predicted peak).
     pub note: Option<String>,
     /// Why the whole size failed or was skipped.
+    pub error: Option<String>,
+}
+
+/// One size of the large out-of-core table (JSON `large_out_of_core[]`).
+#[derive(Clone, Debug, Serialize)]
+pub struct LargeOutOfCoreRow {
+    /// Scene spec (`fan-sphere:N`).
+    pub scene: String,
+    /// Scene triangles.
+    pub triangles: usize,
+    /// The memory model's prediction of an in-core TetGen run's peak, bytes.
+    pub predicted_in_core_bytes: u64,
+    /// The limit on the whole process tree: the builder's own share plus
+    /// a sixteenth of `predicted_in_core_bytes`, bytes.
+    pub limit_bytes: u64,
+    /// The build's memory report (parts, peaks, time).
+    pub memory: Option<MemoryReport>,
+    /// Tets of the merged mesh.
+    pub tets: usize,
+    /// tet20 on the merged mesh.
+    pub tet20: Option<RenderDoc>,
+    /// tet20 (f32) against the f64 reference on the merged mesh: its
+    /// camera image (256²) and 20,000 random rays.
+    pub accuracy: Option<MethodAccuracy>,
+    /// Why the size failed, if it did.
     pub error: Option<String>,
 }
 

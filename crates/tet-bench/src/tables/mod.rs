@@ -30,7 +30,8 @@
 //!   full mode ([`large_models`]);
 //! * Erkoç et al. (seed 003) Tables 2–3 — out of core: build time, parts
 //!   and peaks under limits of ½ and ⅓ of the in-core TetGen peak, full
-//!   mode ([`out_of_core`]).
+//!   mode ([`out_of_core`]); and a 1 M-triangle closed mesh built under a
+//!   sixteenth of its in-core peak, full mode ([`out_of_core_large`]).
 //!
 //! This module is the driver: it plans the scenes ([`plan`](mod@plan)), measures
 //! each table into a [`doc::TablesDoc`], and hands it to the report
@@ -50,6 +51,7 @@ mod isosurfaces;
 mod large_models;
 mod memory;
 mod out_of_core;
+mod out_of_core_large;
 mod paper;
 mod plan;
 mod quality;
@@ -272,6 +274,8 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
     let iso_scaling = isosurfaces::measure_scaling(args.quick, &pool);
     let large_sizes = args.large_model_sizes();
     let large_models = large_models::measure_all(&large_sizes, &opts, frames, &pool);
+    let large_ooc_sizes = args.large_out_of_core_sizes();
+    let large_out_of_core = out_of_core_large::measure_all(&large_ooc_sizes, &opts, frames, &pool);
     let mut doc = TablesDoc {
         setup,
         scenes,
@@ -287,6 +291,10 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
         large_models_note: large_sizes.is_empty().then(|| {
             "skipped: no sizes (`--large-models 1m,10m,30m`; the default without --quick)".to_string()
         }),
+        large_out_of_core_note: large_ooc_sizes.is_empty().then(|| {
+            "skipped: no sizes (`--large-out-of-core 1m`; the default without --quick)".to_string()
+        }),
+        large_out_of_core,
         figures: Vec::new(),
         total_s: 0.0,
     };

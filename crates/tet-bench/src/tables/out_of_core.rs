@@ -16,7 +16,7 @@ use super::doc::{Quality, TablesDoc};
 use crate::cli::Method;
 
 #[cfg(feature = "tetgen")]
-pub use measuring::measure;
+pub use measuring::{build_in_own_process, measure};
 
 /// The measurement: limited builds in processes of their own (they run
 /// TetGen, so only with the `tetgen` feature).
@@ -123,7 +123,7 @@ mod measuring {
     /// `tet-bench build SPEC -o FILE --memory-limit LIMIT --threads THREADS
     /// --json`, with `build`'s default flags (the tables' own): the merged
     /// mesh, read back, and the build's memory report.
-    fn build_in_own_process(
+    pub fn build_in_own_process(
         spec: &str,
         limit: u64,
         threads: usize,

@@ -10,8 +10,9 @@ use anyhow::{Context, Result};
 
 use super::doc::TablesDoc;
 use super::{
-    construction, entry, exit_face, gpu, isosurfaces, large_models, memory, out_of_core, quality,
-    render_speed, robustness, sorting, speed_accuracy, strips_vs_bvh, zoom,
+    construction, entry, exit_face, gpu, isosurfaces, large_models, memory, out_of_core,
+    out_of_core_large, quality, render_speed, robustness, sorting, speed_accuracy, strips_vs_bvh,
+    zoom,
 };
 
 /// The Markdown report (`tables.md`, and stdout without `--json`).
@@ -69,6 +70,7 @@ pub fn markdown(doc: &TablesDoc) -> String {
     isosurfaces::markdown(&mut m, doc);
     large_models::markdown(&mut m, doc);
     out_of_core::markdown(&mut m, doc);
+    out_of_core_large::markdown(&mut m, doc);
     if !doc.figures.is_empty() {
         let _ = writeln!(m, "\n## Figures\n");
         for f in &doc.figures {

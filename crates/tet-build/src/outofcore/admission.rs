@@ -1,8 +1,8 @@
 //! Starting TetGen workers only while the whole process tree fits a
 //! memory limit: the planner keeps every part's *prediction* under its
 //! share of the limit, but what this process holds while the parts run
-//! (the scene, every part's facets, the results being taken in) is only
-//! known then. Before a worker starts, this process's resident memory
+//! (the scene, the facets of the parts running, the results being taken
+//! in) is only known then. Before a worker starts, this process's resident memory
 //! *now*, the commitments of the parts still running and the new part's
 //! commitment must fit the limit; otherwise the part waits for one to
 //! finish. A part with nothing else running always starts (it was planned
@@ -35,11 +35,14 @@ pub const PARENT_SHARE_DIVISOR: u64 = 4;
 /// planning Torus Knots in a Box and Armadillo in a Box).
 pub const BUILDER_BASE_BYTES: u64 = 24 << 20;
 
-/// A local builder's own memory per scene triangle: the cleaned and
-/// resolved scene, every part's clipped facets and seam sections (measured
-/// on Torus Knots in a Box: 25 MiB from planning to the first worker for
-/// 77,784 triangles, about 340 bytes each; more for a margin).
-pub const BUILDER_BYTES_PER_TRIANGLE: u64 = 600;
+/// A local builder's own memory per scene triangle: the scene as loaded,
+/// its cleaned copy and self-intersection check, the triangles the planes
+/// cut and the walls (every other triangle joins its part's facets only
+/// while that part is built). Measured as the planner's peak resident
+/// memory: about 200 bytes per triangle on a 1 M-triangle closed mesh,
+/// 270 on Mix in a Box (548 k triangles, crossings resolved); more for a
+/// margin.
+pub const BUILDER_BYTES_PER_TRIANGLE: u64 = 320;
 
 /// What a local build of a scene of `triangles` triangles sets aside for
 /// itself from a limit on its whole process tree, before the workers'

@@ -9,16 +9,13 @@ use glam::Vec3;
 use tet_core::{TetMesh, face_key};
 
 use super::error::SeamError;
-use super::parts::{FacetKind, PartMesh, PartStats, SeamOptions, SeamReport, run_parts};
+use super::parts::{PartFacets, PartMesh, PartStats, SeamOptions, SeamReport, run_parts};
 use super::plane::{SplitPlane, key};
 
 /// The parts of a split, ready for TetGen.
 pub(super) struct PartInputs {
-    /// Each part's PLC facets (scene pieces and wall triangles).
-    pub(super) parts: Vec<Vec<([Vec3; 3], FacetKind)>>,
-    /// Each part's box faces (unmarked facets; empty for a tree, whose
-    /// walls are among the facets).
-    pub(super) faces: Vec<Vec<[Vec3; 3]>>,
+    /// Each part's PLC facets, made when the part is taken up.
+    pub(super) parts: Box<dyn PartFacets>,
     /// Input scene triangle of each cleaned one.
     pub(super) triangle_source: Vec<u32>,
     /// Input scene triangles.
@@ -74,7 +71,7 @@ pub(super) fn finish_parts<M: Merge>(
         triangle_count: inputs.triangle_count,
         seams: &report.seams,
     };
-    let parts = run_parts(&inputs.parts, &inputs.faces, options, &|k, mesh| {
+    let parts = run_parts(inputs.parts.as_ref(), options, &|k, mesh| {
         merge.part(k, mesh, &ctx)
     })?;
     let stats: Vec<PartStats> = parts.iter().map(M::stats).collect();

@@ -38,6 +38,10 @@
 //!   limit ([`seam::SeamOptions::tree_limit_bytes`]).
 //! * `parts`: each part's TetGen run (parts run concurrently in worker
 //!   processes with `parallel_parts`) and the [`seam::SeamReport`].
+//! * `split_parts`: a part's facets made when it is taken up: the cut
+//!   clips ahead only the triangles the planes cut, and a triangle inside
+//!   one part is read from the scene when that part is written or built,
+//!   so no planner holds every part's facets at once.
 //! * `merge`: what becomes of finished parts. In memory: exact point
 //!   deduplication + [`tet_core::TetMesh::assemble`] (no repair step, no
 //!   hashing of centroids; the caller holds the whole mesh).
@@ -79,8 +83,9 @@
 //! ## Limits
 //! * The limit is honoured by every TetGen worker's *predicted* peak (and
 //!   measured: see the tests); the caller's own memory is the planner's
-//!   inputs (the cleaned scene, every part's facets) plus, while parts
-//!   run, one finished part (TetGen's output, then its assembled and
+//!   inputs (the cleaned scene, the pieces of the triangles the planes cut
+//!   and the walls; a part's own triangles join its facets only while it
+//!   is built) plus, while parts run, one finished part (TetGen's output, then its assembled and
 //!   sorted [`tet_core::TetMesh`]) per worker thread; the streamed merge
 //!   then holds one part plus the seam maps. The in-memory merge (and
 //!   the whole-mesh Hilbert sort after it) holds the whole mesh. A caller
@@ -90,9 +95,9 @@
 //!   while they fit beside it ([`admission`]).
 //! * The streamed mesh is Hilbert-sorted within each part only: the
 //!   whole-mesh order needs the whole mesh in memory.
-//! * A Steiner point whose f32 rounding flattens a tet is an error
-//!   ([`seam::SeamError::RoundingFlattens`]); the in-core pipeline's
-//!   snapping repair is not reused yet.
+//! * A Steiner point whose f32 rounding flattens a tet is first snapped,
+//!   then fed back to TetGen (the in-core pipeline's repair); where that
+//!   fails, [`seam::SeamError::RoundingFlattens`].
 //! * A plane closer than [`seam::NEAR_PLANE`] × the box extent to a vertex
 //!   (but not through it) is refused (TetGen would merge the crossing
 //!   points with the vertex); [`split::plan_slabs`] avoids such planes and
@@ -112,6 +117,7 @@ pub mod seam;
 pub mod seam_index;
 mod section;
 pub mod split;
+mod split_parts;
 pub mod stream;
 pub mod tree;
 pub mod tree_memory;

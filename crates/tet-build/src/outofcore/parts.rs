@@ -101,6 +101,26 @@ impl Default for SeamOptions {
     }
 }
 
+/// One part's PLC: its facets (scene pieces and wall triangles) and its
+/// box faces (unmarked facets; empty for a tree, whose walls are among
+/// the facets).
+pub(super) struct PartFacetList {
+    pub(super) facets: Vec<([Vec3; 3], FacetKind)>,
+    pub(super) box_faces: Vec<[Vec3; 3]>,
+}
+
+/// Where the parts' PLCs come from: made one part at a time, so that a
+/// planner or a local build holds every part's facets only while that
+/// part is written or built, never all of them at once.
+pub(super) trait PartFacets: Send + Sync {
+    /// How many parts.
+    fn len(&self) -> usize;
+    /// About how many facets part `k` has (for the order parts start in).
+    fn size(&self, k: usize) -> usize;
+    /// Part `k`'s PLC.
+    fn facets(&self, k: usize) -> Result<PartFacetList, SeamError>;
+}
+
 /// What one part's TetGen run took and gave (the per-part report fields).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct PartStats {
@@ -352,18 +372,18 @@ pub(super) fn self_intersection(
 /// run returns. Results are in part order; the first error (in part order)
 /// is returned.
 pub(super) fn run_parts<T: Send>(
-    parts: &[Vec<([Vec3; 3], FacetKind)>],
-    faces: &[Vec<[Vec3; 3]>],
+    parts: &dyn PartFacets,
     options: &SeamOptions,
     finish: &(dyn Fn(usize, PartMesh) -> Result<T, SeamError> + Sync),
 ) -> Result<Vec<T>, SeamError> {
     use std::sync::Mutex;
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-    let width = options.parallel_parts.max(1).min(parts.len().max(1));
-    let mut order: Vec<usize> = (0..parts.len()).collect();
-    order.sort_by_key(|&k| std::cmp::Reverse(parts[k].len() + faces[k].len()));
+    let count = parts.len();
+    let width = options.parallel_parts.max(1).min(count.max(1));
+    let mut order: Vec<usize> = (0..count).collect();
+    order.sort_by_key(|&k| std::cmp::Reverse(parts.size(k)));
     let results: Vec<Mutex<Option<Result<T, SeamError>>>> =
-        (0..parts.len()).map(|_| Mutex::new(None)).collect();
+        (0..count).map(|_| Mutex::new(None)).collect();
     let next = AtomicUsize::new(0);
     let failed = AtomicBool::new(false);
     let admission = Admission::new(options.tree_limit_bytes);
@@ -374,11 +394,13 @@ pub(super) fn run_parts<T: Send>(
                 break;
             }
             let k = order[i];
-            let plc = PartPlc::new(&parts[k], &faces[k]);
-            // Held until the part is handed on: this process's share of
-            // the result counts as long as the worker's.
-            let _ticket = admission.enter(plc.predicted_peak_bytes());
-            let r = run_plc(k, &parts[k], plc, options).and_then(|m| finish(k, m));
+            let r = parts.facets(k).and_then(|list| {
+                let plc = PartPlc::new(&list.facets, &list.box_faces);
+                // Held until the part is handed on: this process's share
+                // of the result counts as long as the worker's.
+                let _ticket = admission.enter(plc.predicted_peak_bytes());
+                run_plc(k, &list.facets, plc, options).and_then(|m| finish(k, m))
+            });
             if r.is_err() {
                 failed.store(true, Ordering::Relaxed);
             }
@@ -395,7 +417,7 @@ pub(super) fn run_parts<T: Send>(
             }
         });
     }
-    let mut out = Vec::with_capacity(parts.len());
+    let mut out = Vec::with_capacity(count);
     let mut first_error = None;
     for r in results {
         match r.into_inner().unwrap_or_else(|e| e.into_inner()) {

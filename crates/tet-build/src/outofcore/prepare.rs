@@ -6,7 +6,7 @@
 
 use super::error::SeamError;
 use super::parts::SeamOptions;
-use crate::clean::{CleanMesh, clean_scene};
+use crate::clean::clean_scene;
 use crate::pipeline::resolve_cleaned;
 use crate::resolve::ResolveReport;
 use crate::scene::Scene;
@@ -15,8 +15,10 @@ use crate::scene::Scene;
 pub(super) struct Prepared {
     /// Cleaned (and resolved) scene.
     pub scene: Scene,
-    /// Its map back to the input (pieces name their input triangle).
-    pub map: CleanMesh,
+    /// Input scene triangle of each cleaned one (pieces name their input
+    /// triangle); the rest of the cleaning's map, a second copy of the
+    /// scene, is not kept.
+    pub triangle_source: Vec<u32>,
     /// What the resolution did (`None` when off).
     pub resolve: Option<ResolveReport>,
 }
@@ -33,13 +35,13 @@ pub(super) fn prepare(scene: &Scene, options: &SeamOptions) -> Result<Prepared, 
             let (scene, map, report) = resolve_cleaned(cleaned, map, o)?;
             Prepared {
                 scene,
-                map,
+                triangle_source: map.triangle_source,
                 resolve: Some(report),
             }
         }
         None => Prepared {
             scene: cleaned,
-            map,
+            triangle_source: map.triangle_source,
             resolve: None,
         },
     })

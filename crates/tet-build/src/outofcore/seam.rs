@@ -45,6 +45,7 @@ use super::merge::{InMemory, Merge, PartInputs, finish_parts};
 use super::parts::FacetKind;
 use super::plane::{SplitPlane, fan};
 use super::prepare::{Prepared, prepare};
+use super::split_parts::{PartTriangles, SplitParts, WholeTriangle};
 use super::stream::{StreamOptions, StreamSummary, ToFile};
 use crate::bbox::EnclosingBox;
 use crate::clean::clean_scene;
@@ -120,7 +121,7 @@ pub(super) fn slab_part_inputs(
 ) -> Result<(PartInputs, SeamReport), SeamError> {
     let Prepared {
         scene: cleaned,
-        map: cm,
+        triangle_source,
         resolve,
     } = prepare(scene, options)?;
     let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
@@ -154,7 +155,11 @@ pub(super) fn slab_part_inputs(
         resolve,
         ..SeamReport::default()
     };
-    let mut parts: Vec<Vec<([Vec3; 3], FacetKind)>> = vec![Vec::new(); n + 1];
+    // Triangles inside one slab are listed, not copied: their facets are
+    // made when their slab is taken up.
+    let mut slab_of = vec![u32::MAX; cleaned.triangles.len()];
+    let mut clipped: Vec<Vec<(u32, Vec<[Vec3; 3]>)>> = vec![Vec::new(); n + 1];
+    let mut walls: Vec<Vec<([Vec3; 3], FacetKind)>> = vec![Vec::new(); n + 1];
     let mut segments: Vec<Vec<[Vec3; 2]>> = vec![Vec::new(); n];
     let mut seam_points: Vec<Vec<Vec3>> = vec![Vec::new(); n];
     let mut in_plane: Vec<Vec<([Vec3; 3], u32)>> = vec![Vec::new(); n];
@@ -180,7 +185,7 @@ pub(super) fn slab_part_inputs(
             if below && above {
                 cut = true;
                 let (lo, hi, seg) = clip_polygon(&poly, plane);
-                parts[j].extend(fan(&lo).into_iter().map(|p| (p, FacetKind::Scene(s))));
+                clipped[j].push((s, fan(&lo)));
                 segments[j].push(seg);
                 poly = hi;
                 continue;
@@ -198,8 +203,10 @@ pub(super) fn slab_part_inputs(
         report.triangles_cut += usize::from(cut);
         if slab == usize::MAX {
             report.triangles_in_plane += 1;
+        } else if cut {
+            clipped[slab].push((s, fan(&poly)));
         } else {
-            parts[slab].extend(fan(&poly).into_iter().map(|p| (p, FacetKind::Scene(s))));
+            slab_of[i] = slab as u32;
         }
     }
     let corners_of = |lo: Vec3, hi: Vec3| -> [Vec3; 8] {
@@ -234,8 +241,8 @@ pub(super) fn slab_part_inputs(
         report.seam_triangles.push(seam.triangles.len());
         for (t, src) in seam.triangles.iter().zip(&seam.source) {
             let k = src.map_or(FacetKind::Seam, FacetKind::Scene);
-            parts[j].push((*t, k));
-            parts[j + 1].push((*t, k));
+            walls[j].push((*t, k));
+            walls[j + 1].push((*t, k));
         }
     }
     // Box faces of each slab: BOX_TRIANGLES pairs are z-min, z-max, y-min,
@@ -262,14 +269,39 @@ pub(super) fn slab_part_inputs(
             .map(|(_, t)| t.map(|v| corners[v as usize]))
             .collect()
     };
-    let faces: Vec<Vec<[Vec3; 3]>> = (0..=n).map(slab_faces).collect();
+    let box_faces: Vec<Vec<[Vec3; 3]>> = (0..=n).map(slab_faces).collect();
+    let inside = PartTriangles::new(
+        n + 1,
+        |t| (slab_of[t] != u32::MAX).then_some(slab_of[t] as usize),
+        slab_of.len(),
+    );
+    drop(slab_of);
+    let parts = SplitParts {
+        whole: SlabWhole { scene: cleaned },
+        inside,
+        clipped,
+        walls,
+        box_faces,
+    };
     let inputs = PartInputs {
-        parts,
-        faces,
-        triangle_source: cm.triangle_source,
+        parts: Box::new(parts),
+        triangle_source,
         triangle_count: scene.triangles.len() as u32,
     };
     Ok((inputs, report))
+}
+
+/// A triangle inside one slab: itself (fanned as a cut piece would be).
+struct SlabWhole {
+    /// The cleaned (and resolved) scene.
+    scene: Scene,
+}
+
+impl WholeTriangle for SlabWhole {
+    fn facets(&self, t: u32) -> Result<Vec<[Vec3; 3]>, SeamError> {
+        let v = self.scene.triangles[t as usize].map(|i| self.scene.vertices[i as usize]);
+        Ok(fan(&v))
+    }
 }
 
 /// Builds `scene` so that every TetGen run's *predicted* peak fits

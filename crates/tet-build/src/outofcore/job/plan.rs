@@ -132,6 +132,9 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
     }
     let b = EnclosingBox::new(cleaned.bounds(), options.seam.enclosing_box)
         .map_err(|e| JobError::Plan(SeamError::from(e)))?;
+    // The cleaned copy is made again only if slabs are planned: it is not
+    // held while the tree's parts are made.
+    drop(cleaned);
     let limit = options.limit_bytes.unwrap_or(u64::MAX);
     let split = SplitOptions {
         limit_bytes: limit,
@@ -163,6 +166,8 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
     let (inputs, report, partition) = match tree {
         Some(t) => t,
         None => {
+            let (cleaned, _) =
+                clean_scene(scene).map_err(|e| JobError::Plan(SeamError::from(e)))?;
             let plan = slabs_for(
                 &cleaned.vertices,
                 &cleaned.triangles,
@@ -171,6 +176,7 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
                 options.parts,
             )
             .ok_or(JobError::LimitTooSmall { limit_bytes: limit })?;
+            drop(cleaned);
             let (inputs, report) =
                 slab_part_inputs(scene, plan.axis, &plan.values, seam).map_err(JobError::Plan)?;
             let partition = Partition::Slabs {
@@ -180,7 +186,6 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
             (inputs, report, partition)
         }
     };
-    drop(cleaned);
     std::fs::create_dir_all(dir).map_err(JobError::io(dir))?;
     let parts = write_inputs(&inputs, dir)?;
     let (camera, lights) = MergePlan::scene_records(&options.scene_info);
@@ -228,16 +233,20 @@ fn merge_plan(
     }
 }
 
-/// Writes every part's input file; the parts' plan records.
+/// Writes every part's input file, one part's facets at a time; the
+/// parts' plan records.
 fn write_inputs(inputs: &PartInputs, dir: &Path) -> Result<Vec<PartRecord>, JobError> {
     let mut records = Vec::with_capacity(inputs.parts.len());
-    for (k, (facets, box_faces)) in inputs.parts.iter().zip(&inputs.faces).enumerate() {
+    for k in 0..inputs.parts.len() {
+        let list = inputs.parts.facets(k).map_err(JobError::Plan)?;
+        let plc = PartPlc::new(&list.facets, &list.box_faces);
         // Facets carry the *input* scene triangle, so that a part needs no
         // map back from the cleaned scene.
         let input = PartInput {
             part: k as u32,
             triangle_count: inputs.triangle_count,
-            facets: facets
+            facets: list
+                .facets
                 .iter()
                 .map(|(t, kind)| {
                     let id = match kind {
@@ -247,9 +256,9 @@ fn write_inputs(inputs: &PartInputs, dir: &Path) -> Result<Vec<PartRecord>, JobE
                     (*t, id)
                 })
                 .collect(),
-            box_faces: box_faces.clone(),
+            box_faces: list.box_faces,
         };
-        let plc = PartPlc::new(facets, box_faces);
+        drop(list.facets);
         let (bytes, sum) = encode(&input);
         let name = format!("part-{k}.input");
         write_atomic(&dir.join(&name), &bytes)?;

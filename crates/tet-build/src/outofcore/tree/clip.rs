@@ -28,6 +28,35 @@ pub(super) struct Cut {
     pub(super) lines: Lines,
     pub(super) triangles_cut: HashSet<u32>,
     pub(super) triangles_in_plane: HashSet<u32>,
+    /// Per scene triangle: the leaf holding it whole, or [`CLIPPED`].
+    pub(super) leaf_of: Vec<u32>,
+}
+
+/// [`Cut::leaf_of`] of a triangle that is clipped (see [`interior_leaf`]).
+pub(super) const CLIPPED: u32 = u32::MAX;
+
+/// The leaf whose box holds triangle `t` strictly inside, clear of every
+/// plane on its way down by at least `tolerance`: such a triangle is one
+/// piece of that leaf, untouched by the clipping, so it need not go
+/// through it. `None` when a plane cuts it, touches it or passes within
+/// `tolerance` of a vertex (the clipping then sees it, and reports what
+/// it must).
+pub(super) fn interior_leaf(nodes: &[Node], t: [Vec3; 3], tolerance: f64) -> Option<usize> {
+    let mut id = 0;
+    loop {
+        let Some((plane, _, below, above)) = nodes[id].split else {
+            return Some(id);
+        };
+        let c = plane.axis;
+        let d = |x: &Vec3| x[c] as f64 - plane.value as f64;
+        if t.iter().all(|x| x[c] < plane.value && -d(x) >= tolerance) {
+            id = below;
+        } else if t.iter().all(|x| x[c] > plane.value && d(x) >= tolerance) {
+            id = above;
+        } else {
+            return None;
+        }
+    }
 }
 
 pub(super) fn flatten(
@@ -172,30 +201,25 @@ pub(super) fn run_clipping(
         }
     }
     let mut reg = Registry::default();
-    let mut lines = Lines::default();
+    let mut lines = Lines::with_scene(vertices, triangles);
     let mut pieces: Vec<Vec<Poly>> = (0..nodes.len()).map(|_| Vec::new()).collect();
     let mut triangles_cut = HashSet::new();
     let mut triangles_in_plane = HashSet::new();
-    // (node, polygons, ghosts)
-    let root_polys: Vec<Poly> = triangles
-        .iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let v = t.map(|k| vertices[k as usize]);
-            Poly {
-                v: v.to_vec(),
-                roots: (0..3).map(|k| Root::new(v[k], v[(k + 1) % 3])).collect(),
-                source: i as u32,
-            }
-        })
-        .collect();
+    // Triangles inside one leaf skip the clipping; the rest are clipped in
+    // scene order, as before, so the first error is the same one.
+    let mut leaf_of = vec![CLIPPED; triangles.len()];
+    let mut root_polys: Vec<Poly> = Vec::new();
+    for (i, t) in triangles.iter().enumerate() {
+        let v = t.map(|k| vertices[k as usize]);
+        match interior_leaf(&nodes, v, tolerance) {
+            Some(leaf) => leaf_of[i] = leaf as u32,
+            None => root_polys.push(Poly::triangle(v, i as u32)),
+        }
+    }
+    // (node, polygons, ghosts). Every point of a polygon is a scene vertex
+    // (in `lines` already) or a registered crossing (added below).
     let mut stack = vec![(0usize, root_polys, Vec::<Poly>::new())];
     while let Some((id, polys, ghosts)) = stack.pop() {
-        for p in polys.iter().chain(&ghosts) {
-            for &x in &p.v {
-                lines.insert(x);
-            }
-        }
         let Some((plane, w, below, above)) = nodes[id].split else {
             pieces[id] = polys;
             continue;
@@ -283,5 +307,103 @@ pub(super) fn run_clipping(
         lines,
         triangles_cut,
         triangles_in_plane,
+        leaf_of,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A tree over [0, 8]³: x = 4, then y = 2 below and z = 5 above, then
+    /// x = 6 in the upper z half.
+    fn tree() -> CutTree {
+        let split = |axis, value, below, above| CutTree::Split {
+            plane: SplitPlane { axis, value },
+            below: Box::new(below),
+            above: Box::new(above),
+        };
+        split(
+            0,
+            4.0,
+            split(1, 2.0, CutTree::Leaf, CutTree::Leaf),
+            split(
+                2,
+                5.0,
+                CutTree::Leaf,
+                split(0, 6.0, CutTree::Leaf, CutTree::Leaf),
+            ),
+        )
+    }
+
+    /// The leaf whose box holds `t` at least `tolerance` away from every
+    /// face that is a plane (the enclosing box's faces are not), by
+    /// looking at every leaf's box.
+    fn by_boxes(nodes: &[Node], t: [Vec3; 3], tolerance: f64, lo: Vec3, hi: Vec3) -> Option<usize> {
+        let clear = |x: f32, face: f32, outer: f32, above: bool| {
+            if face == outer {
+                return if above { x >= face } else { x <= face };
+            }
+            let d = x as f64 - face as f64;
+            if above {
+                d >= tolerance
+            } else {
+                -d >= tolerance
+            }
+        };
+        let mut found = None;
+        for (id, n) in nodes.iter().enumerate() {
+            if n.split.is_some() {
+                continue;
+            }
+            let inside = t.iter().all(|x| {
+                (0..3).all(|a| {
+                    clear(x[a], n.lo[a], lo[a], true) && clear(x[a], n.hi[a], hi[a], false)
+                })
+            });
+            if inside {
+                assert!(found.is_none(), "{t:?} clear inside two leaves");
+                found = Some(id);
+            }
+        }
+        found
+    }
+
+    /// A coordinate in the box: anywhere, on a plane, on the box, or
+    /// within 2e-3 of a plane.
+    fn coordinate() -> impl Strategy<Value = f32> {
+        let planes = || prop::sample::select(vec![2.0f32, 4.0, 5.0, 6.0]);
+        prop_oneof![
+            2 => 0.0f32..8.0,
+            1 => planes(),
+            1 => prop::sample::select(vec![0.0f32, 8.0]),
+            4 => (planes(), -2e-3f32..2e-3).prop_map(|(c, d)| c + d),
+        ]
+    }
+
+    fn point() -> impl Strategy<Value = Vec3> {
+        (coordinate(), coordinate(), coordinate()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+    }
+
+    proptest! {
+        /// The descent finds the leaf a look at every leaf's box finds,
+        /// and none where a plane cuts, touches or passes near the
+        /// triangle.
+        #[test]
+        fn interior_leaf_is_the_leaf_holding_the_triangle_clear_of_planes(
+            t in (point(), point(), point()),
+            tolerance in prop::sample::select(vec![0.0f64, 1e-3]),
+        ) {
+            let (lo, hi) = (Vec3::ZERO, Vec3::splat(8.0));
+            let (mut nodes, mut walls) = (Vec::new(), Vec::new());
+            flatten(&tree(), lo, hi, &mut nodes, &mut walls);
+            let t = [t.0, t.1, t.2];
+            let tolerance = tolerance.max(f64::MIN_POSITIVE);
+            prop_assert_eq!(
+                interior_leaf(&nodes, t, tolerance),
+                by_boxes(&nodes, t, tolerance, lo, hi)
+            );
+        }
+    }
 }

@@ -47,8 +47,8 @@
 use glam::Vec3;
 use tet_core::TetMesh;
 
-use self::clip::run_clipping;
-use self::geometry::{outline, triangulate_outline};
+use self::clip::{Cut, run_clipping};
+use self::leaf_parts::{TreeWhole, piece_facets};
 use self::walls::{prepare_walls, triangulate_wall};
 use super::error::SeamError;
 use super::merge::{InMemory, Merge, PartInputs, finish_parts};
@@ -56,6 +56,7 @@ use super::parts::{FacetKind, SeamOptions, SeamReport};
 use super::plane::key;
 use super::prepare::{Prepared, prepare};
 use super::split::SplitTree;
+use super::split_parts::{PartTriangles, SplitParts};
 use super::stream::{StreamOptions, StreamSummary, ToFile};
 use crate::bbox::EnclosingBox;
 use crate::clean::clean_scene;
@@ -66,6 +67,7 @@ pub use cut_tree::CutTree;
 mod clip;
 mod cut_tree;
 mod geometry;
+mod leaf_parts;
 mod walls;
 
 /// Builds the mesh of `scene` in its enclosing box split by `tree` (see
@@ -117,7 +119,7 @@ pub(in crate::outofcore) fn tree_part_inputs(
 ) -> Result<(PartInputs, SeamReport), SeamError> {
     let Prepared {
         scene: cleaned,
-        map: cm,
+        triangle_source,
         resolve,
     } = prepare(scene, options)?;
     let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
@@ -160,55 +162,78 @@ pub(in crate::outofcore) fn tree_part_inputs(
             }
         }
     }
-    let mut parts: Vec<Vec<([Vec3; 3], FacetKind)>> = Vec::with_capacity(leaves.len());
+    let mut clipped = Vec::with_capacity(leaves.len());
+    let mut walls = Vec::with_capacity(leaves.len());
     for &id in &leaves {
-        let node = &cut.nodes[id];
-        let mut facets = Vec::new();
+        let mut pieces = Vec::with_capacity(cut.pieces[id].len());
         for poly in &cut.pieces[id] {
-            let l = outline(&cut.registry, &cut.lines, poly)?;
-            let t = cleaned.triangles[poly.source as usize].map(|v| cleaned.vertices[v as usize]);
-            let normal = (t[1] - t[0]).as_dvec3().cross((t[2] - t[0]).as_dvec3());
-            for tri in triangulate_outline(&l, normal, poly.source)? {
-                facets.push((tri, FacetKind::Scene(poly.source)));
-            }
+            let facets = piece_facets(poly, &cleaned, &cut.registry, &cut.lines)?;
+            pieces.push((poly.source, facets));
         }
-        for axis in 0..3 {
-            for value in [node.lo[axis], node.hi[axis]] {
-                let (mut flo, mut fhi) = (node.lo, node.hi);
-                flo[axis] = value;
-                fhi[axis] = value;
-                let wall = cut
-                    .walls
-                    .iter()
-                    .find(|w| {
-                        w.plane.axis == axis
-                            && w.plane.value == value
-                            && (0..3).all(|a| w.lo[a] <= flo[a] && fhi[a] <= w.hi[a])
-                    })
-                    .expect("every leaf face lies on a seam or on the enclosing box");
-                for (t, s) in &wall.triangles {
-                    let inside = t
-                        .iter()
-                        .all(|p| (0..3).all(|a| p[a] >= flo[a] && p[a] <= fhi[a]));
-                    if inside {
-                        facets.push((*t, s.map_or(FacetKind::Seam, FacetKind::Scene)));
-                    }
-                }
-            }
-        }
-        parts.push(facets);
+        clipped.push(pieces);
+        walls.push(leaf_wall_facets(&cut, id));
     }
-    // The clipping (pieces, walls, registries) and the cleaned scene are
-    // not needed while the parts run: every part's PLC is in `parts`.
-    drop(cut);
-    drop(cleaned);
+    let mut part_of_node = vec![None; cut.nodes.len()];
+    for (k, &id) in leaves.iter().enumerate() {
+        part_of_node[id] = Some(k);
+    }
+    let inside = PartTriangles::new(
+        leaves.len(),
+        |t| part_of_node.get(cut.leaf_of[t] as usize).copied().flatten(),
+        cut.leaf_of.len(),
+    );
+    let Cut {
+        registry, lines, ..
+    } = cut;
+    let parts = SplitParts {
+        whole: TreeWhole {
+            scene: cleaned,
+            registry,
+            lines,
+        },
+        inside,
+        clipped,
+        box_faces: vec![Vec::new(); walls.len()],
+        walls,
+    };
     let inputs = PartInputs {
-        faces: vec![Vec::new(); parts.len()],
-        parts,
-        triangle_source: cm.triangle_source,
+        parts: Box::new(parts),
+        triangle_source,
         triangle_count: scene.triangles.len() as u32,
     };
     Ok((inputs, report))
+}
+
+/// The facets of leaf `id`'s six faces: the triangles of the walls they
+/// lie on that lie inside them.
+fn leaf_wall_facets(cut: &Cut, id: usize) -> Vec<([Vec3; 3], FacetKind)> {
+    let node = &cut.nodes[id];
+    let mut facets = Vec::new();
+    for axis in 0..3 {
+        for value in [node.lo[axis], node.hi[axis]] {
+            let (mut flo, mut fhi) = (node.lo, node.hi);
+            flo[axis] = value;
+            fhi[axis] = value;
+            let wall = cut
+                .walls
+                .iter()
+                .find(|w| {
+                    w.plane.axis == axis
+                        && w.plane.value == value
+                        && (0..3).all(|a| w.lo[a] <= flo[a] && fhi[a] <= w.hi[a])
+                })
+                .expect("every leaf face lies on a seam or on the enclosing box");
+            for (t, s) in &wall.triangles {
+                let inside = t
+                    .iter()
+                    .all(|p| (0..3).all(|a| p[a] >= flo[a] && p[a] <= fhi[a]));
+                if inside {
+                    facets.push((*t, s.map_or(FacetKind::Seam, FacetKind::Scene)));
+                }
+            }
+        }
+    }
+    facets
 }
 
 /// The plan [`build_tree_with_memory_limit`] built.
@@ -322,6 +347,7 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
 
 #[cfg(test)]
 mod tests {
+    use super::geometry::triangulate_outline;
     use super::*;
 
     /// A piece nearly parallel to a wall (z = 0) whose chain A–D–C on the
