@@ -101,6 +101,43 @@ pub struct BuildFlags {
     /// pairs instead of being resolved.
     #[arg(long)]
     pub no_resolve: bool,
+    /// Cut the enclosing box into parts with exact walls between them (the
+    /// out-of-core builder's recursive planes, to a uniform depth),
+    /// tetrahedralize the parts in parallel and merge them: the walls
+    /// break up the long sliver fans of the unrefined `-pY` mesh, which
+    /// every ray crosses. `N` parts (rounded up to a power of two) or
+    /// `auto` (one per about 2,000 scene triangles).
+    #[arg(long, value_name = "N|auto", value_parser = parse_walls)]
+    pub walls: Option<Walls>,
+}
+
+/// How finely `--walls` cuts the enclosing box.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Walls {
+    /// One part per about [`Walls::TRIANGLES_PER_PART`] scene triangles.
+    Auto,
+    /// This many parts (rounded up to a power of two).
+    Parts(u32),
+}
+
+#[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
+impl Walls {
+    /// `auto`'s scene triangles per part (Torus Knots: 32 parts,
+    /// Armadillo and Nefertiti: 64).
+    pub const TRIANGLES_PER_PART: usize = 2_000;
+
+    /// The depth of the cut tree (`2^depth` parts, at most 4096) for a
+    /// scene of `triangles` triangles.
+    pub fn depth(self, triangles: usize) -> usize {
+        let parts = match self {
+            Walls::Parts(n) => n as usize,
+            Walls::Auto => {
+                let x = triangles as f64 / Self::TRIANGLES_PER_PART as f64;
+                x.max(1.0).log2().round().exp2() as usize
+            }
+        };
+        parts.clamp(1, 4096).next_power_of_two().trailing_zeros() as usize
+    }
 }
 
 /// `build` arguments.
@@ -641,6 +678,26 @@ pub fn parse_memory_limit(s: &str) -> Result<u64, String> {
 mod tests {
     use super::*;
 
+    /// `--walls`: counts and `auto`, the tree depth they give, and what
+    /// is refused.
+    #[test]
+    fn walls_parse_as_part_counts_or_auto() {
+        assert_eq!(parse_walls("auto"), Ok(Walls::Auto));
+        assert_eq!(parse_walls(" 8 "), Ok(Walls::Parts(8)));
+        for bad in ["0", "4097", "-2", "x", ""] {
+            assert!(parse_walls(bad).is_err(), "{bad}");
+        }
+        // Rounded up to a power of two.
+        assert_eq!(Walls::Parts(1).depth(10), 0);
+        assert_eq!(Walls::Parts(5).depth(10), 3);
+        assert_eq!(Walls::Parts(4096).depth(10), 12);
+        // One part per about 2,000 triangles, to the nearest power of two.
+        assert_eq!(Walls::Auto.depth(500), 0);
+        assert_eq!(Walls::Auto.depth(77_760), 5);
+        assert_eq!(Walls::Auto.depth(100_000), 6);
+        assert_eq!(Walls::Auto.depth(u32::MAX as usize), 12);
+    }
+
     #[test]
     fn steiner_caps_parse_as_counts_or_shares_of_the_vertices() {
         assert_eq!(parse_max_steiner("500"), Ok(MaxSteiner::Count(500)));
@@ -931,6 +988,19 @@ impl MaxSteiner {
             MaxSteiner::Percent(p) => (vertices as f64 * p / 100.0).ceil() as u64,
         }
     }
+}
+
+/// Parses `--walls N` (1 to 4096 parts) or `--walls auto`.
+fn parse_walls(s: &str) -> Result<Walls, String> {
+    if s.trim().eq_ignore_ascii_case("auto") {
+        return Ok(Walls::Auto);
+    }
+    s.trim()
+        .parse::<u32>()
+        .ok()
+        .filter(|n| (1..=4096).contains(n))
+        .map(Walls::Parts)
+        .ok_or_else(|| format!("`{s}` is neither a count of parts from 1 to 4096 nor `auto`"))
 }
 
 /// Parses `--max-steiner N` or `--max-steiner P%` (P in (0, 1000]).

@@ -221,6 +221,9 @@ pub fn build_scene_in(
     use std::sync::Arc;
     use tet_build::pipeline::{BuildOptions, build};
 
+    if let Some(walls) = flags.walls {
+        return build_walled(scene, flags, walls, quiet, extra);
+    }
     let start = Instant::now();
     let spinner = spinner(quiet);
     let pb = spinner.clone();
@@ -265,6 +268,99 @@ pub fn build_scene_in(
             unused_vertices: report.clean.unused_vertices.len(),
         },
         resolve: report.resolve.clone(),
+    };
+    Ok((mesh, summary))
+}
+
+/// `--walls`: a scene built as parts with exact walls between them, in
+/// memory, even when it would fit one TetGen run. The out-of-core
+/// builder's recursive planes (Erkoç et al., seed 003) cut the enclosing
+/// box into `2^depth` parts, each tetrahedralized by its own TetGen worker
+/// (as many at once as there are cores), and the parts merge exactly.
+/// Why: an unrefined `-pY` CDT fills empty space with long fans of slivers
+/// from the fine surface to the box's corners, which every ray must cross;
+/// the walls cut those fans short, and measured on Torus Knots, Armadillo
+/// and Nefertiti they bring tets per ray to within 10 % of TetGen's `-q5`
+/// mesh at no extra build time (the parts run in parallel).
+///
+/// The merged mesh is Hilbert-sorted as a whole unless `flags.no_sort`.
+#[cfg(feature = "tetgen")]
+fn build_walled(
+    scene: &Scene,
+    flags: &BuildFlags,
+    walls: crate::cli::Walls,
+    quiet: bool,
+    extra: &[Vec3],
+) -> Result<(TetMesh, BuildSummary)> {
+    if flags.no_box {
+        bail!(
+            "`{}`: --walls cuts the enclosing box into parts: drop --no-box",
+            scene.name
+        );
+    }
+    let start = Instant::now();
+    let spinner = spinner(quiet);
+    let depth = walls.depth(scene.triangles.len());
+    let parts = 1usize << depth;
+    spinner.set_message(format!("building {} in {parts} parts", scene.name));
+    let options = tet_build::outofcore::seam::SeamOptions {
+        enclosing_box: enclosing_box(scene, extra, flags.wide_box),
+        tetgen: flags.tetgen_options(scene.vertices.len()),
+        isolation: worker_isolation(flags.time_limit)?,
+        parallel_parts: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        tree_limit_bytes: None,
+        resolve: (!flags.no_resolve).then(Default::default),
+    };
+    // No memory limit: every part is split down to `depth` (the paper's
+    // planes, empty margins peeled off first). A split by memory instead
+    // leaves light parts whole and got fewer tets per ray on the boxed
+    // scenes, but cannot always reach a small target.
+    let split = tet_build::outofcore::split::SplitOptions {
+        limit_bytes: u64::MAX,
+        min_depth: depth,
+        ..tet_build::outofcore::split::SplitOptions::default()
+    };
+    let tetgen_start = Instant::now();
+    let (mut mesh, report, _) =
+        tet_build::outofcore::tree::build_tree_with_memory_limit(scene, &split, &options)
+            .with_context(|| {
+                format!("cannot build `{}` in {parts} parts with walls", scene.name)
+            })?;
+    let tetgen_s = tetgen_start.elapsed().as_secs_f64();
+    let reorder_start = Instant::now();
+    if !flags.no_sort {
+        tet_core::reorder::hilbert_reorder(&mut mesh)?;
+    }
+    let reorder_s = reorder_start.elapsed().as_secs_f64();
+    spinner.finish_and_clear();
+    let input_points: usize = report.part_points.iter().sum();
+    let summary = BuildSummary {
+        switches: format!(
+            "{} in {} parts",
+            options.tetgen.switches(),
+            report.part_tets.len()
+        ),
+        // The input triangles the mesh holds a face of (cleaning drops
+        // degenerate ones).
+        scene_triangles: {
+            let mut ids: Vec<u32> = mesh.constrained.iter().map(|f| f.triangle).collect();
+            ids.sort_unstable();
+            ids.dedup();
+            ids.len()
+        },
+        steiner_points: mesh
+            .points
+            .len()
+            .saturating_sub(input_points.min(mesh.points.len())),
+        clean_s: 0.0,
+        resolve_s: 0.0,
+        tetgen_s,
+        assemble_s: 0.0,
+        reorder_s,
+        total_s: start.elapsed().as_secs_f64(),
+        worker_peak_kib: report.part_peak_kib.iter().flatten().copied().max(),
+        cleaning: CleaningSummary::default(),
+        resolve: report.resolve.clone().unwrap_or_default(),
     };
     Ok((mesh, summary))
 }

@@ -1021,3 +1021,52 @@ fn convert_round_trips_through_vtk_and_tetgen() {
     let out = bench(&["convert", &p("missing.vtu"), &p("x.tmesh")]);
     assert!(!out.status.success());
 }
+
+/// `--walls N`: the scene cut into N parts with walls between them traces
+/// with no failure against the f64 reference, and hits what the in-core
+/// mesh hits (the walls are no scene faces).
+#[test]
+fn walls_build_parts_that_trace_like_the_in_core_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let walled = dir.path().join("walled.tmesh");
+    let walled = walled.to_str().unwrap();
+    let b = json(&["build", "torus-knot", "--walls", "8", "-o", walled]);
+    let switches = b["build"]["switches"].as_str().unwrap();
+    assert!(switches.ends_with("in 8 parts"), "{switches}");
+    let a = json(&[
+        "accuracy",
+        "--min-time",
+        "0",
+        walled,
+        "--methods",
+        "tet20,tet16,tet32",
+        "--rays",
+        "2000",
+        "--image",
+        "32",
+    ]);
+    for m in a["cases"][0]["methods"].as_array().unwrap() {
+        assert_eq!(m["failures"], 0, "{m}");
+        assert_eq!(m["rays"], 2000 + 32 * 32);
+    }
+    let image = ["--method", "tet20", "--width", "64", "--height", "48"];
+    let hits = |scene: &str| {
+        let mut args = vec!["render", scene];
+        args.extend(image);
+        args.extend(["--frames", "1"]);
+        json(&args)["hits"].as_u64().unwrap()
+    };
+    assert_eq!(hits(walled), hits("torus-knot"));
+    // Parts are chosen by memory or by --walls, not both.
+    let err = stderr_of(&[
+        "build",
+        "torus-knot",
+        "--walls",
+        "8",
+        "--memory-limit",
+        "1G",
+        "-o",
+        walled,
+    ]);
+    assert!(err.contains("--walls and --memory-limit"), "{err}");
+}

@@ -9,15 +9,11 @@ use std::process::{Command, Stdio};
 use serde_json::Value;
 use tet_build::outofcore::tree_memory::TreeSampler;
 
-/// Runs `build SCENE -o OUT --memory-limit LIMIT --json` while sampling
-/// its process tree: the document and the sampled peak (KiB).
-fn sampled_build(scene: &str, limit: &str, extra: &[&str]) -> (Value, u64) {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("m.tmesh");
+/// Runs `tet-bench ARGS` while sampling its process tree (it must
+/// succeed): its stdout and the sampled peak (KiB).
+fn sampled(args: &[&str]) -> (Vec<u8>, u64) {
     let child = Command::new(env!("CARGO_BIN_EXE_tet-bench"))
-        .args(["build", scene, "-o", out.to_str().unwrap()])
-        .args(["--memory-limit", limit, "--json"])
-        .args(extra)
+        .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -30,7 +26,19 @@ fn sampled_build(scene: &str, limit: &str, extra: &[&str]) -> (Value, u64) {
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
-    (serde_json::from_slice(&output.stdout).unwrap(), peak)
+    (output.stdout, peak)
+}
+
+/// Runs `build SCENE -o OUT --memory-limit LIMIT --json` while sampling
+/// its process tree: the document and the sampled peak (KiB).
+fn sampled_build(scene: &str, limit: &str, extra: &[&str]) -> (Value, u64) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m.tmesh");
+    let mut args = vec!["build", scene, "-o", out.to_str().unwrap()];
+    args.extend(["--memory-limit", limit, "--json"]);
+    args.extend(extra);
+    let (stdout, peak) = sampled(&args);
+    (serde_json::from_slice(&stdout).unwrap(), peak)
 }
 
 #[test]
@@ -103,21 +111,8 @@ fn a_job_planner_stays_under_the_builders_share() {
     };
     let dir = tempfile::tempdir().unwrap();
     let job = dir.path().join("job");
-    let child = Command::new(env!("CARGO_BIN_EXE_tet-bench"))
-        .args(["build", scene, "--plan", job.to_str().unwrap()])
-        .args(["--memory-limit", "100M"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("tet-bench runs");
-    let sampler = TreeSampler::start(child.id());
-    let output = child.wait_with_output().unwrap();
-    let peak = sampler.finish().expect("/proc is readable");
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let plan = ["build", scene, "--plan", job.to_str().unwrap()];
+    let (_, peak) = sampled(&[&plan[..], &["--memory-limit", "100M"]].concat());
     let inputs = std::fs::read_dir(&job)
         .unwrap()
         .filter(|e| {

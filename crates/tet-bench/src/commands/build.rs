@@ -91,6 +91,11 @@ pub fn run(args: &BuildArgs, json: bool) -> Result<()> {
             output.display()
         );
     }
+    if args.memory_limit.is_some() && args.build.walls.is_some() {
+        bail!(
+            "--walls and --memory-limit both cut the scene into parts: give one (--memory-limit chooses the parts by memory)"
+        );
+    }
     let doc = match args.memory_limit {
         None => {
             let loaded = load(&args.scene, &args.build, json)?;

@@ -76,6 +76,9 @@ pub struct SceneResult {
     /// as refinement points and no mesh optimisation
     /// (`--min-dihedral 2 --optimize 0/0 --max-steiner 1%`).
     pub min_dihedral2_capped: Option<QualityTrade>,
+    /// Full mode: the scene built in parts with walls between them
+    /// (`--walls auto`), `-pY` in each.
+    pub walls: Option<QualityTrade>,
     /// Out-of-core builds under ½ and ⅓ of the in-core peak (full mode,
     /// first scene of each geometry only).
     pub out_of_core: Vec<OutOfCoreRow>,
@@ -198,6 +201,7 @@ pub const TABLE_FLAGS: BuildFlags = BuildFlags {
     wide_box: false,
     no_sort: false,
     no_resolve: false,
+    walls: None,
 };
 
 /// Speed against accuracy (seed 001 Table 4 beside render speed): every CPU method in f32 and,

@@ -137,8 +137,8 @@ fn measure_scene(
         entry::measure(planned, cache, opts, frames, pool),
     );
     let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames);
-    let (quality5, min_dihedral2, min_dihedral2_capped) = if args.quick {
-        (None, None, None)
+    let (quality5, min_dihedral2, min_dihedral2_capped, walls) = if args.quick {
+        (None, None, None, None)
     } else {
         let mut trade = |flags, label: &str| {
             let r = quality::measure(planned, cache, opts, frames, pool, flags, label);
@@ -154,6 +154,7 @@ fn measure_scene(
                 &quality::CAPPED,
                 "slivers-bounded, capped (--max-steiner 1%)",
             ),
+            trade(&quality::WALLS, "walled (--walls auto)"),
         )
     };
     #[cfg(feature = "tetgen")]
@@ -170,6 +171,7 @@ fn measure_scene(
         quality5,
         min_dihedral2,
         min_dihedral2_capped,
+        walls,
         out_of_core,
         shares_mesh_with: planned.shares_with.clone(),
         mesh_reused,
@@ -245,6 +247,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
                     quality5: None,
                     min_dihedral2: None,
                     min_dihedral2_capped: None,
+                    walls: None,
                     out_of_core: Vec::new(),
                     shares_mesh_with: planned.shares_with.clone(),
                     mesh_reused: false,

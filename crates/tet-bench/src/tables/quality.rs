@@ -3,7 +3,8 @@
 //! (`--min-dihedral 2`: TetGen refines tets whose smallest dihedral angle
 //! is below 2°, no radius-edge bound), and against that bound capped at
 //! 1 % of the scene's vertices with no mesh optimisation (the worst
-//! slivers go first, so a few hundred points do most of the work): tets,
+//! slivers go first, so a few hundred points do most of the work), and
+//! against `-pY` in parts with walls between them (`--walls auto`): tets,
 //! build time, tets per ray and tet20 speed.
 
 use std::fmt::Write as _;
@@ -43,6 +44,12 @@ pub const CAPPED: BuildFlags = BuildFlags {
     ..MIN_DIHEDRAL2
 };
 
+/// The scene cut into parts with walls between them, `-pY` in each.
+pub const WALLS: BuildFlags = BuildFlags {
+    walls: Some(crate::cli::Walls::Auto),
+    ..TABLE_FLAGS
+};
+
 /// The scene built with `flags` (`label` names it in the progress line)
 /// and tet20 on it.
 pub fn measure(
@@ -70,7 +77,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     }
     let _ = writeln!(
         m,
-        "\n## Build trade: surface-preserving `-pY`, slivers bounded (`--min-dihedral 2`, also capped at 1 % of the vertices), quality `-pYq5`\n"
+        "\n## Build trade: surface-preserving `-pY`, slivers bounded (`--min-dihedral 2`, also capped at 1 % of the vertices), quality `-pYq5`, walls (`--walls auto`)\n"
     );
     let _ = writeln!(
         m,
@@ -104,6 +111,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
             ),
             ("--min-dihedral 2", sc.min_dihedral2.as_ref()),
             ("-q5", Some(q)),
+            ("--walls auto", sc.walls.as_ref()),
         ] {
             if let Some(t) = t {
                 let _ = writeln!(
