@@ -102,11 +102,12 @@ pub struct BuildFlags {
     #[arg(long)]
     pub no_resolve: bool,
     /// Cut the enclosing box into parts with exact walls between them (the
-    /// out-of-core builder's recursive planes, to a uniform depth),
-    /// tetrahedralize the parts in parallel and merge them: the walls
-    /// break up the long sliver fans of the unrefined `-pY` mesh, which
-    /// every ray crosses. `N` parts (rounded up to a power of two) or
-    /// `auto` (one per about 2,000 scene triangles).
+    /// out-of-core builder's recursive planes), tetrahedralize the parts
+    /// in parallel and merge them: the walls break up the long sliver fans
+    /// of the unrefined `-pY` mesh, which every ray crosses. `auto`: dense
+    /// regions cut until each part's predicted TetGen peak is about 28 MiB
+    /// (light parts and empty margins left whole); `N`: every part cut to
+    /// the same depth, N parts (rounded up to a power of two).
     #[arg(long, value_name = "N|auto", value_parser = parse_walls)]
     pub walls: Option<Walls>,
 }
@@ -114,7 +115,9 @@ pub struct BuildFlags {
 /// How finely `--walls` cuts the enclosing box.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Walls {
-    /// One part per about [`Walls::TRIANGLES_PER_PART`] scene triangles.
+    /// Parts of about [`Walls::PART_TARGET_BYTES`] predicted TetGen peak
+    /// (if that build fails: one part per about
+    /// [`Walls::TRIANGLES_PER_PART`] scene triangles, uniform depth).
     Auto,
     /// This many parts (rounded up to a power of two).
     Parts(u32),
@@ -122,8 +125,14 @@ pub enum Walls {
 
 #[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
 impl Walls {
-    /// `auto`'s scene triangles per part (Torus Knots: 32 parts,
-    /// Armadillo and Nefertiti: 64).
+    /// `auto`'s target for a part's predicted TetGen peak: tets per ray
+    /// within 10 % of `-q5`'s (or fewer) on Torus Knots and Armadillo,
+    /// alone and in a box, Nefertiti and `fan-sphere:200000` (20, 24, 28
+    /// and 32 MiB tried; 32 left Torus Knots 19 % above).
+    pub const PART_TARGET_BYTES: u64 = 28 << 20;
+
+    /// `auto`'s fallback: scene triangles per part at uniform depth (Torus
+    /// Knots: 32 parts, Armadillo and Nefertiti: 64).
     pub const TRIANGLES_PER_PART: usize = 2_000;
 
     /// The depth of the cut tree (`2^depth` parts, at most 4096) for a

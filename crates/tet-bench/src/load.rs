@@ -275,13 +275,12 @@ pub fn build_scene_in(
 /// `--walls`: a scene built as parts with exact walls between them, in
 /// memory, even when it would fit one TetGen run. The out-of-core
 /// builder's recursive planes (Erkoç et al., seed 003) cut the enclosing
-/// box into `2^depth` parts, each tetrahedralized by its own TetGen worker
-/// (as many at once as there are cores), and the parts merge exactly.
-/// Why: an unrefined `-pY` CDT fills empty space with long fans of slivers
-/// from the fine surface to the box's corners, which every ray must cross;
-/// the walls cut those fans short, and measured on Torus Knots, Armadillo
-/// and Nefertiti they bring tets per ray to within 10 % of TetGen's `-q5`
-/// mesh at no extra build time (the parts run in parallel).
+/// box ([`crate::cli::Walls`] says how finely), each part is tetrahedralized by its own
+/// TetGen worker (as many at once as there are cores), and the parts merge
+/// exactly. Why: an unrefined `-pY` CDT fills empty space with long fans
+/// of slivers from the fine surface to the box's corners, which every ray
+/// must cross; the walls cut those fans short (measured in the README's
+/// "Walls instead of points").
 ///
 /// The merged mesh is Hilbert-sorted as a whole unless `flags.no_sort`.
 #[cfg(feature = "tetgen")]
@@ -301,8 +300,7 @@ fn build_walled(
     let start = Instant::now();
     let spinner = spinner(quiet);
     let depth = walls.depth(scene.triangles.len());
-    let parts = 1usize << depth;
-    spinner.set_message(format!("building {} in {parts} parts", scene.name));
+    spinner.set_message(format!("building {} in parts with walls", scene.name));
     let options = tet_build::outofcore::seam::SeamOptions {
         enclosing_box: enclosing_box(scene, extra, flags.wide_box),
         tetgen: flags.tetgen_options(scene.vertices.len()),
@@ -311,21 +309,42 @@ fn build_walled(
         tree_limit_bytes: None,
         resolve: (!flags.no_resolve).then(Default::default),
     };
-    // No memory limit: every part is split down to `depth` (the paper's
-    // planes, empty margins peeled off first). A split by memory instead
-    // leaves light parts whole and got fewer tets per ray on the boxed
-    // scenes, but cannot always reach a small target.
-    let split = tet_build::outofcore::split::SplitOptions {
+    // `auto`: the parts as the memory planner cuts them for a small
+    // target (dense regions split, light ones and empty margins left
+    // whole), or, should that build fail, every part split to `depth`.
+    // `N`: every part split to `depth`.
+    use tet_build::outofcore::split::SplitOptions;
+    let uniform = SplitOptions {
         limit_bytes: u64::MAX,
         min_depth: depth,
-        ..tet_build::outofcore::split::SplitOptions::default()
+        ..SplitOptions::default()
+    };
+    use crate::cli::Walls;
+    let splits = match walls {
+        Walls::Auto => vec![
+            SplitOptions {
+                limit_bytes: Walls::PART_TARGET_BYTES,
+                best_effort: true,
+                ..SplitOptions::default()
+            },
+            uniform,
+        ],
+        Walls::Parts(_) => vec![uniform],
     };
     let tetgen_start = Instant::now();
-    let (mut mesh, report, _) =
-        tet_build::outofcore::tree::build_tree_with_memory_limit(scene, &split, &options)
-            .with_context(|| {
-                format!("cannot build `{}` in {parts} parts with walls", scene.name)
-            })?;
+    let mut built = None;
+    for split in &splits {
+        match tet_build::outofcore::tree::build_tree_with_memory_limit(scene, split, &options) {
+            Ok(b) => {
+                built = Some(Ok(b));
+                break;
+            }
+            Err(e) => built = Some(Err(e)),
+        }
+    }
+    let (mut mesh, report, _) = built
+        .expect("at least one split is tried")
+        .with_context(|| format!("cannot build `{}` in parts with walls", scene.name))?;
     let tetgen_s = tetgen_start.elapsed().as_secs_f64();
     let reorder_start = Instant::now();
     if !flags.no_sort {

@@ -153,6 +153,12 @@ pub struct SplitOptions {
     /// Force splitting down to this depth even if the part fits (for tests
     /// and for parallelism).
     pub min_depth: usize,
+    /// Build even when some part's prediction stays above `limit_bytes`
+    /// at `max_depth` or where no plane splits it: the limit is then a
+    /// target for the parts' size, not a bound on memory (the walls of a
+    /// mesh shaped for rays), and [`super::tree::build_tree_with_memory_limit`]
+    /// does not refuse with `LimitTooSmall`.
+    pub best_effort: bool,
 }
 
 impl Default for SplitOptions {
@@ -164,6 +170,7 @@ impl Default for SplitOptions {
             search_steps: 8,
             search_step: 1.0 / 32.0,
             min_depth: 0,
+            best_effort: false,
         }
     }
 }

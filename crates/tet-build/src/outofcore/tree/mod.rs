@@ -310,7 +310,7 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
     let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
     let plan =
         super::split::plan_split(&cleaned.vertices, &cleaned.triangles, (b.min, b.max), split);
-    if plan.max_predicted_bytes() > split.limit_bytes {
+    if plan.max_predicted_bytes() > split.limit_bytes && !split.best_effort {
         return Err(SeamError::LimitTooSmall {
             limit_bytes: split.limit_bytes,
         });
