@@ -106,8 +106,9 @@ pub struct BuildFlags {
     /// in parallel and merge them: the walls break up the long sliver fans
     /// of the unrefined `-pY` mesh, which every ray crosses. `auto`: dense
     /// regions cut until each part's predicted TetGen peak is about 28 MiB
-    /// (light parts and empty margins left whole); `N`: every part cut to
-    /// the same depth, N parts (rounded up to a power of two).
+    /// (light parts and empty margins left whole; where no walled build
+    /// succeeds, the scene in one piece); `N`: every part cut to the same
+    /// depth, N parts (rounded up to a power of two).
     #[arg(long, value_name = "N|auto", value_parser = parse_walls)]
     pub walls: Option<Walls>,
 }
@@ -117,7 +118,8 @@ pub struct BuildFlags {
 pub enum Walls {
     /// Parts of about [`Walls::PART_TARGET_BYTES`] predicted TetGen peak
     /// (if that build fails: one part per about
-    /// [`Walls::TRIANGLES_PER_PART`] scene triangles, uniform depth).
+    /// [`Walls::TRIANGLES_PER_PART`] scene triangles, uniform depth; if
+    /// that fails too: the scene in one piece, the switches saying why).
     Auto,
     /// This many parts (rounded up to a power of two).
     Parts(u32),

@@ -342,9 +342,29 @@ fn build_walled(
             Err(e) => built = Some(Err(e)),
         }
     }
-    let (mut mesh, report, _) = built
-        .expect("at least one split is tried")
-        .with_context(|| format!("cannot build `{}` in parts with walls", scene.name))?;
+    let (mut mesh, report, _) = match built.expect("at least one split is tried") {
+        Ok(b) => b,
+        // `auto` promises a mesh: where no walled build succeeds, the
+        // scene is built in one piece, and the switches say why.
+        Err(e) if walls == Walls::Auto => {
+            spinner.finish_and_clear();
+            let reason = format!("walls failed: {e}");
+            if !quiet {
+                eprintln!("{}: {reason}; building it in one piece", scene.name);
+            }
+            let one_piece = BuildFlags {
+                walls: None,
+                ..*flags
+            };
+            let (mesh, mut summary) = build_scene_in(scene, &one_piece, quiet, extra)?;
+            summary.switches = format!("{} ({reason})", summary.switches);
+            return Ok((mesh, summary));
+        }
+        Err(e) => {
+            return Err(e)
+                .with_context(|| format!("cannot build `{}` in parts with walls", scene.name));
+        }
+    };
     let tetgen_s = tetgen_start.elapsed().as_secs_f64();
     let reorder_start = Instant::now();
     if !flags.no_sort {
