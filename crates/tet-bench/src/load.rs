@@ -372,7 +372,17 @@ fn build_walled(
     }
     let reorder_s = reorder_start.elapsed().as_secs_f64();
     spinner.finish_and_clear();
-    let input_points: usize = report.part_points.iter().sum();
+    // Points that are no scene vertex: the walls' and TetGen's.
+    let scene_points: std::collections::HashSet<[u32; 3]> = scene
+        .vertices
+        .iter()
+        .map(|p| (*p + Vec3::ZERO).to_array().map(f32::to_bits))
+        .collect();
+    let added = mesh
+        .points
+        .iter()
+        .filter(|p| !scene_points.contains(&(**p + Vec3::ZERO).to_array().map(f32::to_bits)))
+        .count();
     let summary = BuildSummary {
         switches: format!(
             "{} in {} parts",
@@ -387,10 +397,8 @@ fn build_walled(
             ids.dedup();
             ids.len()
         },
-        steiner_points: mesh
-            .points
-            .len()
-            .saturating_sub(input_points.min(mesh.points.len())),
+        steiner_points: added,
+        // Cleaning, resolving, the cut and the merge are inside `tetgen_s`.
         clean_s: 0.0,
         resolve_s: 0.0,
         tetgen_s,
