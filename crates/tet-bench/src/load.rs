@@ -197,6 +197,27 @@ pub fn build_scene(
     build_scene_in(scene, flags, quiet, &[])
 }
 
+/// The out-of-core builder's options for `scene` built with `flags`: the
+/// enclosing box (holding `extra` points too), TetGen switches, worker
+/// isolation and self-intersection resolving, as a one-piece build has
+/// them; one part at a time and no limit on the process tree (callers
+/// that run parts in parallel or under a limit set those).
+#[cfg(feature = "tetgen")]
+pub fn seam_options(
+    scene: &Scene,
+    flags: &BuildFlags,
+    extra: &[Vec3],
+) -> Result<tet_build::outofcore::seam::SeamOptions> {
+    Ok(tet_build::outofcore::seam::SeamOptions {
+        enclosing_box: enclosing_box(scene, extra, flags.wide_box),
+        tetgen: flags.tetgen_options(scene.vertices.len()),
+        isolation: worker_isolation(flags.time_limit)?,
+        parallel_parts: 1,
+        tree_limit_bytes: None,
+        resolve: (!flags.no_resolve).then(Default::default),
+    })
+}
+
 /// The TetGen worker: this executable re-run as `tet-bench tetgen-worker`,
 /// killed after `time_limit` seconds.
 #[cfg(feature = "tetgen")]
@@ -302,12 +323,8 @@ fn build_walled(
     let depth = walls.depth(scene.triangles.len());
     spinner.set_message(format!("building {} in parts with walls", scene.name));
     let options = tet_build::outofcore::seam::SeamOptions {
-        enclosing_box: enclosing_box(scene, extra, flags.wide_box),
-        tetgen: flags.tetgen_options(scene.vertices.len()),
-        isolation: worker_isolation(flags.time_limit)?,
         parallel_parts: std::thread::available_parallelism().map_or(1, |n| n.get()),
-        tree_limit_bytes: None,
-        resolve: (!flags.no_resolve).then(Default::default),
+        ..seam_options(scene, flags, extra)?
     };
     // `auto`: the parts as the memory planner cuts them for a small
     // target (dense regions split, light ones and empty margins left

@@ -90,29 +90,26 @@ fn walls_auto_falls_back_where_a_walled_build_fails() {
             .output()
             .expect("tet-bench runs");
         let doc: Option<Value> = serde_json::from_slice(&o.stdout).ok();
+        let switches = doc
+            .as_ref()
+            .and_then(|d| d["build"]["switches"].as_str())
+            .unwrap_or_default()
+            .to_string();
         (
             o.status.success(),
-            doc,
+            switches,
             String::from_utf8_lossy(&o.stderr).into_owned(),
         )
     };
     let neptune = format!("{}#Neptune", scenes_json().display());
-    let (ok, doc, err) = build(&neptune, "auto");
+    let (ok, switches, err) = build(&neptune, "auto");
     assert!(ok, "{err}");
-    let switches = doc.unwrap()["build"]["switches"]
-        .as_str()
-        .unwrap()
-        .to_string();
     assert!(switches.ends_with("in 32 parts"), "{switches}");
     let boxed = format!("{}#Neptune in a Box", scenes_json().display());
     let (ok, _, err) = build(&boxed, "32");
     assert!(!ok && err.contains("in parts with walls"), "{err}");
-    let (ok, doc, err) = build(&boxed, "auto");
+    let (ok, switches, err) = build(&boxed, "auto");
     assert!(ok, "{err}");
-    let switches = doc.unwrap()["build"]["switches"]
-        .as_str()
-        .unwrap()
-        .to_string();
     assert!(switches.contains("walls failed"), "{switches}");
     for scene in [&neptune, &boxed] {
         for m in accuracy(scene, &["--walls", "auto"]) {

@@ -271,17 +271,14 @@ impl Limited<'_> {
         let (cleaned, cm) = tet_build::clean::clean_scene(scene)
             .map_err(|e| anyhow::anyhow!("cannot clean `{}`: {e}", scene.name))?;
         let clean_s = clean_start.elapsed().as_secs_f64();
-        let box_spec = crate::load::enclosing_box(scene, self.extra, flags.wide_box);
-        let b = EnclosingBox::new(cleaned.bounds(), box_spec)
+        let one_piece = crate::load::seam_options(scene, flags, self.extra)?;
+        let b = EnclosingBox::new(cleaned.bounds(), one_piece.enclosing_box)
             .with_context(|| format!("cannot build the enclosing box of `{}`", scene.name))?;
         let (split, parallel) = self.choose(&cleaned, (b.min, b.max), scene.triangles.len())?;
         let options = SeamOptions {
-            enclosing_box: box_spec,
-            tetgen: flags.tetgen_options(scene.vertices.len()),
-            isolation: crate::load::worker_isolation(flags.time_limit)?,
             parallel_parts: parallel,
             tree_limit_bytes: Some(limit_bytes),
-            resolve: (!flags.no_resolve).then(Default::default),
+            ..one_piece
         };
         Ok(Some(Plan {
             start,

@@ -2,10 +2,10 @@
 //! memory limit: the planner keeps every part's *prediction* under its
 //! share of the limit, but what this process holds while the parts run
 //! (the scene, the facets of the parts running, the results being taken
-//! in) is only known then. Before a worker starts, this process's resident memory
-//! *now*, the commitments of the parts still running and the new part's
-//! commitment must fit the limit; otherwise the part waits for one to
-//! finish. A part with nothing else running always starts (it was planned
+//! in) is only known then. Before a worker starts, this process's
+//! resident memory *now*, the commitments of the parts still running and
+//! the new part's commitment must fit the limit; otherwise the part
+//! waits for one to finish. A part with nothing else running always starts (it was planned
 //! to fit alone), so the parts never wait for each other forever.
 //!
 //! A part's commitment ([`commitment`]) is its predicted TetGen peak and

@@ -85,9 +85,9 @@
 //!   measured: see the tests); the caller's own memory is the planner's
 //!   inputs (the cleaned scene, the pieces of the triangles the planes cut
 //!   and the walls; a part's own triangles join its facets only while it
-//!   is built) plus, while parts run, one finished part (TetGen's output, then its assembled and
-//!   sorted [`tet_core::TetMesh`]) per worker thread; the streamed merge
-//!   then holds one part plus the seam maps. The in-memory merge (and
+//!   is built) plus, while parts run, one finished part (TetGen's output,
+//!   then its assembled and sorted [`tet_core::TetMesh`]) per worker
+//!   thread; the streamed merge then holds one part plus the seam maps. The in-memory merge (and
 //!   the whole-mesh Hilbert sort after it) holds the whole mesh. A caller
 //!   that bounds its whole process tree plans with
 //!   [`admission::worker_share`] and sets
