@@ -1,5 +1,7 @@
 //! The BVH baseline: obvhs's BVH2 (`slow_build` preset, SAH with
-//! reinsertion) over the scene triangles, with precomputed intersection
+//! reinsertion) over the scene triangles (as the user gave them:
+//! [`InputTriangles`] merges the pieces a resolved crossing or a wall cut
+//! a triangle into), with precomputed intersection
 //! triangles reordered to the BVH's primitive order — the strongest obvhs
 //! configuration for closest-hit single rays. It implements the same
 //! [`Tracer`] interface as the tet walks so every method renders the same
@@ -24,21 +26,24 @@ use obvhs::bvh2::builder::build_bvh2_from_tris;
 use obvhs::ray::{Ray as BvhRay, RayHit};
 use obvhs::rt_triangle::RtTriangle;
 use obvhs::triangle::Triangle;
-use tet_core::TetMesh;
+use tet_core::{InputTriangles, TetMesh};
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Hit, Ray, TraceOutcome};
 use tet_trace_cpu::walk::{Start, walk_scale};
 
-/// A BVH2 over the constrained faces of a mesh (the scene triangles).
+/// A BVH2 over the scene triangles of a mesh (its constrained faces
+/// merged back into their input triangles).
 pub struct BvhTracer<'m> {
-    /// The mesh whose constrained faces are the primitives.
+    /// The mesh whose input triangles are the primitives.
     mesh: &'m TetMesh,
-    /// obvhs's BVH2 over the faces.
+    /// Its input triangles and their pieces.
+    inputs: InputTriangles,
+    /// obvhs's BVH2 over the triangles.
     bvh: Bvh2,
     /// Intersection triangles in BVH primitive order.
     tris: Vec<RtTriangle>,
-    /// Constrained-face index of each BVH primitive.
-    faces: Vec<u32>,
+    /// Input-triangle index of each BVH primitive.
+    prims: Vec<u32>,
     /// Trace with [`BvhTracer::count_trace`] (nodes visited reported as
     /// `tets_visited`) instead of obvhs's traversal.
     count_nodes: bool,
@@ -72,14 +77,15 @@ fn a(v: Vec3) -> Vec3A {
 }
 
 impl<'m> BvhTracer<'m> {
-    /// Builds the BVH over `mesh.constrained`.
+    /// Builds the BVH over the input triangles of `mesh.constrained`.
     pub fn new(mesh: &'m TetMesh) -> Self {
         let scale = unit_scale(mesh);
-        let source: Vec<Triangle> = mesh
-            .constrained
+        let inputs = InputTriangles::of(mesh);
+        let source: Vec<Triangle> = inputs
+            .corners
             .iter()
-            .map(|cf| {
-                let [v0, v1, v2] = cf.vertices.map(|v| a(mesh.points[v as usize] * scale));
+            .map(|c| {
+                let [v0, v1, v2] = c.map(|v| a(mesh.points[v as usize] * scale));
                 Triangle { v0, v1, v2 }
             })
             .collect();
@@ -88,16 +94,17 @@ impl<'m> BvhTracer<'m> {
             BvhBuildParams::slow_build(),
             &mut Duration::default(),
         );
-        let faces: Vec<u32> = bvh.primitive_indices.clone();
-        let tris = faces
+        let prims: Vec<u32> = bvh.primitive_indices.clone();
+        let tris = prims
             .iter()
             .map(|&f| RtTriangle::from(&source[f as usize]))
             .collect();
         BvhTracer {
             mesh,
+            inputs,
             bvh,
             tris,
-            faces,
+            prims,
             count_nodes: false,
             scale,
         }
@@ -123,7 +130,7 @@ impl<'m> BvhTracer<'m> {
         (
             std::mem::size_of_val(self.bvh.nodes.as_slice()),
             std::mem::size_of_val(self.tris.as_slice())
-                + std::mem::size_of_val(self.faces.as_slice()),
+                + std::mem::size_of_val(self.prims.as_slice()),
         )
     }
 
@@ -216,6 +223,14 @@ fn direction_scale(d: Vec3) -> f32 {
     walk_scale(d.abs().max_element() as f64)
 }
 
+/// The hit record of a tracer over input triangles that found input
+/// triangle `i` at distance `t` along `ray`: [`face_hit`] on the piece of
+/// the triangle that holds the hit point.
+pub fn input_hit(mesh: &TetMesh, inputs: &InputTriangles, ray: &Ray, i: u32, t: f32) -> Hit {
+    let p = ray.origin.as_dvec3() + ray.direction.as_dvec3() * t as f64;
+    face_hit(mesh, ray, inputs.piece_at(mesh, i as usize, p), t)
+}
+
 /// The hit record of a BVH-style tracer that found constrained face `face`
 /// at distance `t` along `ray`: barycentrics and the tets on both sides
 /// recomputed from the mesh (so every method reports the same record;
@@ -272,7 +287,11 @@ impl Tracer for BvhTracer<'_> {
                 tets_visited: 0,
             };
         }
-        let skip = start.on_face().unwrap_or(u32::MAX);
+        // A ray leaving a face skips the whole input triangle (its plane).
+        let skip = start
+            .on_face()
+            .and_then(|f| self.inputs.of_face(f))
+            .unwrap_or(u32::MAX);
         // obvhs treats direction components below f32::EPSILON as zero: a
         // ray of a tiny (or huge) scene traverses with its direction
         // scaled by a power of two `k` (exact; `t` is then `t' · k`).
@@ -285,10 +304,10 @@ impl Tracer for BvhTracer<'_> {
         );
         r.tmin = ray.t_min / k;
         if self.count_nodes {
-            let (best, nodes) = self.count_trace(&r, |id| self.faces[id] != skip);
+            let (best, nodes) = self.count_trace(&r, |id| self.prims[id] != skip);
             return match best {
                 Some((id, t)) => {
-                    let mut h = face_hit(self.mesh, ray, self.faces[id], t * k);
+                    let mut h = input_hit(self.mesh, &self.inputs, ray, self.prims[id], t * k);
                     h.tets_visited = nodes;
                     TraceOutcome::Hit(h)
                 }
@@ -299,15 +318,15 @@ impl Tracer for BvhTracer<'_> {
         }
         let mut hit = RayHit::none();
         let found = self.bvh.ray_traverse(r, &mut hit, |r, id| {
-            if self.faces[id] == skip {
+            if self.prims[id] == skip {
                 f32::INFINITY
             } else {
                 self.tris[id].intersect(r)
             }
         });
         if found {
-            let face = self.faces[hit.primitive_id as usize];
-            TraceOutcome::Hit(face_hit(self.mesh, ray, face, hit.t * k))
+            let i = self.prims[hit.primitive_id as usize];
+            TraceOutcome::Hit(input_hit(self.mesh, &self.inputs, ray, i, hit.t * k))
         } else {
             TraceOutcome::Miss { tets_visited: 0 }
         }
@@ -337,7 +356,7 @@ mod tests {
         // Depth of each primitive's leaf, from an independent parent walk.
         let nodes = &plain.bvh.nodes;
         let mut depth = vec![0usize; nodes.len()];
-        let mut leaf_depth = vec![usize::MAX; plain.faces.len()];
+        let mut leaf_depth = vec![usize::MAX; plain.prims.len()];
         for (i, n) in nodes.iter().enumerate() {
             if n.is_leaf() {
                 for p in n.first_index..n.first_index + n.prim_count {
@@ -360,7 +379,8 @@ mod tests {
                 (TraceOutcome::Hit(x), TraceOutcome::Hit(y)) => {
                     hits += 1;
                     assert_eq!((x.face, x.t), (y.face, y.t));
-                    let prim = plain.faces.iter().position(|&f| f == y.face).unwrap();
+                    let input = plain.inputs.of_face(y.face).unwrap();
+                    let prim = plain.prims.iter().position(|&i| i == input).unwrap();
                     assert!(nodes_visited as usize > 2 * leaf_depth[prim]);
                 }
                 (TraceOutcome::Miss { .. }, TraceOutcome::Miss { .. }) => {}

@@ -108,8 +108,11 @@ pub struct BuildFlags {
     /// regions cut until each part's predicted TetGen peak is about 28 MiB
     /// (light parts and empty margins left whole; where no walled build
     /// succeeds, the scene in one piece); `N`: every part cut to the same
-    /// depth, N parts (rounded up to a power of two).
-    #[arg(long, value_name = "N|auto", value_parser = parse_walls)]
+    /// depth, N parts (rounded up to a power of two); `none`: one TetGen
+    /// run for the whole scene. Default: `auto`, or `none` with
+    /// `--no-box`, `--quality` or `--min-dihedral` (the papers' refined
+    /// builds are one piece).
+    #[arg(long, value_name = "N|auto|none", value_parser = parse_walls)]
     pub walls: Option<Walls>,
 }
 
@@ -123,6 +126,8 @@ pub enum Walls {
     Auto,
     /// This many parts (rounded up to a power of two).
     Parts(u32),
+    /// The scene in one piece: one TetGen run, no walls.
+    None,
 }
 
 #[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
@@ -141,6 +146,7 @@ impl Walls {
     /// scene of `triangles` triangles.
     pub fn depth(self, triangles: usize) -> usize {
         let parts = match self {
+            Walls::None => 1,
             Walls::Parts(n) => n as usize,
             Walls::Auto => {
                 let x = triangles as f64 / Self::TRIANGLES_PER_PART as f64;
@@ -695,6 +701,8 @@ mod tests {
     fn walls_parse_as_part_counts_or_auto() {
         assert_eq!(parse_walls("auto"), Ok(Walls::Auto));
         assert_eq!(parse_walls(" 8 "), Ok(Walls::Parts(8)));
+        assert_eq!(parse_walls("None"), Ok(Walls::None));
+        assert_eq!(Walls::None.depth(100_000), 0);
         for bad in ["0", "4097", "-2", "x", ""] {
             assert!(parse_walls(bad).is_err(), "{bad}");
         }
@@ -767,6 +775,11 @@ pub struct IsoArgs {
     /// Time step of the field (0-based).
     #[arg(long, default_value_t = 0)]
     pub time_step: usize,
+    /// Walks: let every ray walk until it leaves the volume, without the
+    /// min-max regions that cull rays meeting no straddling region (for
+    /// comparisons; the hits are the same).
+    #[arg(long)]
+    pub no_regions: bool,
     /// `buckycube` only: `N` bucky balls per axis, N³ in all (seed 004
     /// Table 3; 1 to 8, default 2).
     #[arg(long, value_name = "N")]
@@ -857,6 +870,30 @@ mod iso_args_tests {
         ] {
             assert!(parse_box(bad).is_err(), "{bad}");
         }
+    }
+
+    /// The walls a build uses: `auto` by default, none where there is no
+    /// box or a quality bound is asked for, and what `--walls` says.
+    #[test]
+    fn builds_are_walled_by_default_but_not_refined_or_boxless_ones() {
+        let walls = |extra: &[&str]| {
+            let mut argv = vec!["tet-bench", "build", "torus-knot", "-o", "x.tmesh"];
+            argv.extend_from_slice(extra);
+            let Command::Build(a) = Cli::try_parse_from(argv).unwrap().command else {
+                panic!("not build")
+            };
+            (a.build.walls(), a.build.resolved().walls)
+        };
+        assert_eq!(walls(&[]), (Walls::Auto, Some(Walls::Auto)));
+        assert_eq!(walls(&["--no-box"]).0, Walls::None);
+        assert_eq!(walls(&["--quality", "5"]).0, Walls::None);
+        assert_eq!(walls(&["--min-dihedral", "2"]).0, Walls::None);
+        assert_eq!(walls(&["--max-steiner", "1%"]).0, Walls::Auto);
+        assert_eq!(walls(&["--walls", "none"]).0, Walls::None);
+        assert_eq!(
+            walls(&["--walls", "8", "--quality", "5"]).0,
+            Walls::Parts(8)
+        );
     }
 
     #[test]
@@ -958,6 +995,29 @@ impl IsoMethod {
 }
 
 impl BuildFlags {
+    /// The walls these flags build with: `--walls` as given, else `auto`
+    /// for the unrefined build in a box and `none` where there is no box
+    /// to cut or a quality bound is asked for (the papers' refined builds
+    /// are one piece).
+    pub fn walls(&self) -> Walls {
+        self.walls.unwrap_or(
+            if self.no_box || self.quality.is_some() || self.min_dihedral.is_some() {
+                Walls::None
+            } else {
+                Walls::Auto
+            },
+        )
+    }
+
+    /// These flags with the walls they build with spelled out: builds that
+    /// come out the same compare equal.
+    pub fn resolved(&self) -> BuildFlags {
+        BuildFlags {
+            walls: Some(self.walls()),
+            ..*self
+        }
+    }
+
     /// The TetGen options these flags ask for: every TetGen flag given
     /// replaces its default, the rest keep [`tet_build::tetgen_options::TetgenOptions::default`]. The
     /// one mapping for in-core, out-of-core and job builds.
@@ -1001,17 +1061,22 @@ impl MaxSteiner {
     }
 }
 
-/// Parses `--walls N` (1 to 4096 parts) or `--walls auto`.
+/// Parses `--walls N` (1 to 4096 parts), `--walls auto` or `--walls none`.
 fn parse_walls(s: &str) -> Result<Walls, String> {
     if s.trim().eq_ignore_ascii_case("auto") {
         return Ok(Walls::Auto);
+    }
+    if s.trim().eq_ignore_ascii_case("none") {
+        return Ok(Walls::None);
     }
     s.trim()
         .parse::<u32>()
         .ok()
         .filter(|n| (1..=4096).contains(n))
         .map(Walls::Parts)
-        .ok_or_else(|| format!("`{s}` is neither a count of parts from 1 to 4096 nor `auto`"))
+        .ok_or_else(|| {
+            format!("`{s}` is neither a count of parts from 1 to 4096 nor `auto` or `none`")
+        })
 }
 
 /// Parses `--max-steiner N` or `--max-steiner P%` (P in (0, 1000]).

@@ -13,7 +13,7 @@
 //!   batch (the renderer's batches are 16×16 tiles, so packets are coherent).
 //!
 //! Hits are returned through the same record as every other method
-//! ([`crate::bvh::face_hit`]: t from Embree, barycentrics and sides
+//! ([`crate::bvh::input_hit`]: t from Embree, barycentrics and sides
 //! recomputed from the mesh), so images and accuracy compare like for like.
 //! A ray that starts on a face (secondary rays, [`Start::Face`]) must not
 //! hit that face again: Embree has no per-ray skip, so a hit on it is
@@ -27,12 +27,12 @@ use embree3::{
     BufferUsage, Device, Format, GeometryKind, IntersectContext, Ray as ERay, RayHit as ERayHit,
     Scene, ValidMask, ValidMaskN,
 };
-use tet_core::TetMesh;
+use tet_core::{InputTriangles, TetMesh};
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Failure, Ray, TraceOutcome};
 use tet_trace_cpu::walk::Start;
 
-use crate::bvh::face_hit;
+use crate::bvh::input_hit;
 
 /// Embree's "no hit" geometry id.
 const INVALID_ID: u32 = u32::MAX;
@@ -43,8 +43,11 @@ const SKIP_RETRIES: usize = 8;
 
 /// An Embree scene over the constrained faces of a mesh.
 pub struct EmbreeTracer<'m> {
-    /// The mesh whose constrained faces Embree holds.
+    /// The mesh whose input triangles Embree holds (its constrained faces
+    /// merged back: [`InputTriangles`]).
     mesh: &'m TetMesh,
+    /// The input triangles (Embree's primitive ids index them).
+    inputs: InputTriangles,
     /// Embree's committed scene (one triangle geometry).
     scene: Scene<'static>,
     /// `rtcIntersect8` packets (`embree8`) rather than single rays.
@@ -75,9 +78,10 @@ impl<'m> EmbreeTracer<'m> {
         if mesh.constrained.len() >= INVALID_ID as usize {
             return Err(EmbreeError::TooLarge(mesh.constrained.len()));
         }
+        let inputs = InputTriangles::of(mesh);
         let device = Device::new().map_err(|e| embree_err("device", e))?;
         let mut scene = device.create_scene().map_err(|e| embree_err("scene", e))?;
-        if !mesh.constrained.is_empty() {
+        if !inputs.is_empty() {
             let mut geom = device
                 .create_geometry(GeometryKind::TRIANGLE)
                 .map_err(|e| embree_err("geometry", e))?;
@@ -92,23 +96,18 @@ impl<'m> EmbreeTracer<'m> {
             .iter_mut()
             .zip(&mesh.points)
             .for_each(|(dst, p)| *dst = p.to_array());
-            geom.set_new_buffer::<[u32; 3]>(
-                BufferUsage::INDEX,
-                0,
-                Format::UINT3,
-                12,
-                mesh.constrained.len(),
-            )
-            .map_err(|e| embree_err("index buffer", e))?
-            .iter_mut()
-            .zip(&mesh.constrained)
-            .for_each(|(dst, cf)| *dst = cf.vertices);
+            geom.set_new_buffer::<[u32; 3]>(BufferUsage::INDEX, 0, Format::UINT3, 12, inputs.len())
+                .map_err(|e| embree_err("index buffer", e))?
+                .iter_mut()
+                .zip(&inputs.corners)
+                .for_each(|(dst, c)| *dst = *c);
             let geom = geom.commit();
             scene.attach_geometry(&geom);
         }
         scene.commit();
         Ok(EmbreeTracer {
             mesh,
+            inputs,
             scene,
             packets,
             _device: device,
@@ -130,7 +129,7 @@ impl<'m> EmbreeTracer<'m> {
         if prim == INVALID_ID {
             TraceOutcome::Miss { tets_visited: 0 }
         } else {
-            TraceOutcome::Hit(face_hit(self.mesh, ray, prim, t))
+            TraceOutcome::Hit(input_hit(self.mesh, &self.inputs, ray, prim, t))
         }
     }
 
@@ -143,10 +142,13 @@ impl<'m> EmbreeTracer<'m> {
                 tets_visited: 0,
             };
         }
-        self.trace_one(ctx, ray, start.on_face().unwrap_or(u32::MAX))
+        // A ray leaving a face skips the whole input triangle (its plane).
+        let skip = start.on_face().and_then(|f| self.inputs.of_face(f));
+        self.trace_one(ctx, ray, skip.unwrap_or(u32::MAX))
     }
 
-    /// A single ray that must not report face `skip` (u32::MAX: none),
+    /// A single ray that must not report input triangle `skip` (u32::MAX:
+    /// none),
     /// traced in `ctx` (coherent for the rays of a camera tile).
     fn trace_one(&self, ctx: &mut IntersectContext, ray: &Ray, skip: u32) -> TraceOutcome {
         let mut t_near = ray.t_min.max(0.0);

@@ -242,7 +242,8 @@ pub fn build_scene_in(
     use std::sync::Arc;
     use tet_build::pipeline::{BuildOptions, build};
 
-    if let Some(walls) = flags.walls {
+    let walls = flags.walls();
+    if walls != crate::cli::Walls::None {
         return build_walled(scene, flags, walls, quiet, extra);
     }
     let start = Instant::now();
@@ -346,7 +347,7 @@ fn build_walled(
             },
             uniform,
         ],
-        Walls::Parts(_) => vec![uniform],
+        Walls::Parts(_) | Walls::None => vec![uniform],
     };
     let tetgen_start = Instant::now();
     let mut built = None;
@@ -370,7 +371,7 @@ fn build_walled(
                 eprintln!("{}: {reason}; building it in one piece", scene.name);
             }
             let one_piece = BuildFlags {
-                walls: None,
+                walls: Some(Walls::None),
                 ..*flags
             };
             let (mesh, mut summary) = build_scene_in(scene, &one_piece, quiet, extra)?;

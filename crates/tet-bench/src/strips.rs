@@ -1,10 +1,10 @@
 //! The Ray-Strips method (Lauterbach et al., seed 002; the `ray-strips`
 //! crate) behind the same [`Tracer`] interface as the tet walks and the
-//! BVH: the structure is built over the mesh's constrained faces (the
-//! scene triangles after cleaning and resolving, exactly the BVH
-//! baseline's primitives), and a hit is reported as the BVH's record
-//! ([`crate::bvh::face_hit`]), so every method renders and is checked the
-//! same way.
+//! BVH: the structure is built over the mesh's input triangles (its
+//! constrained faces merged back into the scene's triangles:
+//! [`InputTriangles`], exactly the BVH baseline's primitives), and a hit
+//! is reported as the BVH's record ([`crate::bvh::input_hit`]), so every
+//! method renders and is checked the same way.
 //!
 //! `strips` traces one ray at a time; `strips-packets` hands each batch to
 //! [`RayStrips::intersect_packet`], which groups four consecutive rays
@@ -14,18 +14,20 @@
 use std::time::Instant;
 
 use ray_strips::{BuildOptions, RayStrips};
-use tet_core::TetMesh;
+use tet_core::{InputTriangles, TetMesh};
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Ray, TraceOutcome};
 use tet_trace_cpu::walk::{Start, Starts};
 
-use crate::bvh::face_hit;
+use crate::bvh::input_hit;
 
-/// Ray-Strips over the constrained faces of a mesh.
+/// Ray-Strips over the input triangles of a mesh.
 pub struct StripsTracer<'m> {
-    /// The mesh whose constrained faces are the triangles.
+    /// The mesh whose input triangles are the triangles.
     mesh: &'m TetMesh,
-    /// The structure (triangle `i` = constrained face `i`).
+    /// Its input triangles.
+    inputs: InputTriangles,
+    /// The structure (triangle `i` = input triangle `i`).
     strips: RayStrips,
     /// Trace batches as packets.
     packets: bool,
@@ -34,16 +36,18 @@ pub struct StripsTracer<'m> {
 }
 
 impl<'m> StripsTracer<'m> {
-    /// Builds Ray-Strips over `mesh.constrained` with the crate's default
-    /// options; `packets` selects the packet path for batches.
+    /// Builds Ray-Strips over the input triangles of `mesh.constrained`
+    /// with the crate's default options; `packets` selects the packet path
+    /// for batches.
     pub fn new(mesh: &'m TetMesh, packets: bool) -> anyhow::Result<Self> {
-        let triangles: Vec<[u32; 3]> = mesh.constrained.iter().map(|c| c.vertices).collect();
+        let inputs = InputTriangles::of(mesh);
         let t = Instant::now();
         // Scenes at 1e30 or 1e-30 need no scaling here: the crate works in
         // a frame of its own.
-        let strips = RayStrips::build(&mesh.points, &triangles, &BuildOptions::default())?;
+        let strips = RayStrips::build(&mesh.points, &inputs.corners, &BuildOptions::default())?;
         Ok(StripsTracer {
             mesh,
+            inputs,
             strips,
             packets,
             build_s: t.elapsed().as_secs_f64(),
@@ -63,14 +67,16 @@ impl<'m> StripsTracer<'m> {
     /// The hit record of a Ray-Strips hit.
     fn outcome(&self, ray: &Ray, hit: Option<ray_strips::Hit>) -> TraceOutcome {
         match hit {
-            Some(h) => TraceOutcome::Hit(face_hit(self.mesh, ray, h.triangle, h.t)),
+            Some(h) => TraceOutcome::Hit(input_hit(self.mesh, &self.inputs, ray, h.triangle, h.t)),
             None => TraceOutcome::Miss { tets_visited: 0 },
         }
     }
 
-    /// Closest hit skipping constrained face `skip` (a secondary ray
-    /// leaving it): the ray is re-cast just past each hit on that face.
+    /// Closest hit skipping the input triangle of constrained face `skip`
+    /// (a secondary ray leaving it): the ray is re-cast just past each hit
+    /// on that triangle.
     fn closest(&self, ray: &Ray, skip: Option<u32>) -> Option<ray_strips::Hit> {
+        let skip = skip.and_then(|f| self.inputs.of_face(f));
         let mut r = to_strips(ray);
         for _ in 0..8 {
             let h = self.strips.intersect(&r)?;

@@ -1023,8 +1023,9 @@ fn convert_round_trips_through_vtk_and_tetgen() {
 }
 
 /// `--walls N`: the scene cut into N parts with walls between them traces
-/// with no failure against the f64 reference, and hits what the in-core
-/// mesh hits (the walls are no scene faces).
+/// with no failure against the f64 reference, and hits what the one-piece
+/// mesh (`--walls none`) hits (the walls are no scene faces). Builds are
+/// walled by default, and `--walls none` is one TetGen run.
 #[test]
 fn walls_build_parts_that_trace_like_the_in_core_mesh() {
     let dir = tempfile::tempdir().unwrap();
@@ -1050,13 +1051,27 @@ fn walls_build_parts_that_trace_like_the_in_core_mesh() {
         assert_eq!(m["rays"], 2000 + 32 * 32);
     }
     let image = ["--method", "tet20", "--width", "64", "--height", "48"];
-    let hits = |scene: &str| {
-        let mut args = vec!["render", scene];
+    let hits = |scene: &[&str]| {
+        let mut args = vec!["render"];
+        args.extend(scene);
         args.extend(image);
         args.extend(["--frames", "1"]);
         json(&args)["hits"].as_u64().unwrap()
     };
-    assert_eq!(hits(walled), hits("torus-knot"));
+    assert_eq!(hits(&[walled]), hits(&["torus-knot", "--walls", "none"]));
+    let one_piece = dir.path().join("one.tmesh");
+    let one_piece = one_piece.to_str().unwrap();
+    let switches = |extra: &[&str]| {
+        let mut args = vec!["build", "torus-knot", "-o", one_piece];
+        args.extend(extra);
+        json(&args)["build"]["switches"]
+            .as_str()
+            .unwrap()
+            .to_owned()
+    };
+    assert!(switches(&[]).ends_with(" parts"), "{}", switches(&[]));
+    let s = switches(&["--walls", "none"]);
+    assert!(!s.contains("parts"), "{s}");
     // Parts are chosen by memory or by --walls, not both.
     let err = stderr_of(&[
         "build",

@@ -426,6 +426,27 @@ fn check_against_in_core(scene: &Scene, merged: &TetMesh) {
             sum[i]
         );
     }
+    // The pieces merge back into the scene's triangles, corners and
+    // winding (what the BVH baselines trace).
+    let inputs = tet_core::InputTriangles::of(merged);
+    assert_eq!(inputs.len(), scene.triangles.len());
+    let cut = (0..inputs.len())
+        .filter(|&i| inputs.pieces(i).len() > 1)
+        .count();
+    for (i, c) in inputs.corners.iter().enumerate() {
+        let t = scene.triangles[inputs.ids[i] as usize];
+        let at = |p: glam::Vec3| p.as_dvec3();
+        let mut want = t.map(|v| scene.vertices[v as usize].to_array().map(f32::to_bits));
+        let mut got = c.map(|v| merged.points[v as usize].to_array().map(f32::to_bits));
+        want.sort_unstable();
+        got.sort_unstable();
+        assert_eq!(got, want, "input triangle {}", inputs.ids[i]);
+        let n = |p: [glam::DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
+        let nw = n(t.map(|v| at(scene.vertices[v as usize])));
+        let ng = n(c.map(|v| at(merged.points[v as usize])));
+        assert!(nw.dot(ng) > 0.0, "input triangle {} flipped", inputs.ids[i]);
+    }
+    eprintln!("{cut} of {} scene triangles were cut", inputs.len());
     // Rays from a fixed pseudo-random set of origins and directions.
     let (lo, hi) = scene.bounds().unwrap();
     let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());

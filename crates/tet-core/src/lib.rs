@@ -54,6 +54,7 @@ pub mod error;
 pub mod fields;
 pub mod format;
 pub mod hilbert;
+pub mod input_triangles;
 pub mod layout;
 pub mod link;
 pub mod memory;
@@ -67,5 +68,6 @@ mod validate;
 
 pub use error::MeshError;
 pub use fields::ScalarField;
+pub use input_triangles::InputTriangles;
 pub use link::{Link, LinkKind, MAX_TETS};
 pub use mesh::{Attributes, ConstrainedFace, FACE_VERTICES, FaceSide, NO_TET, TetMesh, face_key};

@@ -11,7 +11,7 @@ use tet_core::TetMesh;
 use tet_core::scene::SceneInfo;
 
 use super::text::print_build;
-use crate::cli::{BuildArgs, MergeMode};
+use crate::cli::{BuildArgs, MergeMode, Walls};
 use crate::load::{BuildSummary, MESH_EXTENSION, load};
 use crate::outofcore::{Limited, MemoryReport, predict, tet20_speed};
 use crate::output::{outln, print_json};
@@ -91,7 +91,7 @@ pub fn run(args: &BuildArgs, json: bool) -> Result<()> {
             output.display()
         );
     }
-    if args.memory_limit.is_some() && args.build.walls.is_some() {
+    if args.memory_limit.is_some() && args.build.walls.is_some_and(|w| w != Walls::None) {
         bail!(
             "--walls and --memory-limit both cut the scene into parts: give one (--memory-limit chooses the parts by memory)"
         );

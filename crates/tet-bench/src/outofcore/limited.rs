@@ -190,8 +190,13 @@ impl Limited<'_> {
         let start = Instant::now();
         let own = builder_bytes(self.scene.triangles.len());
         let predicted = predict(self.scene, self.flags.no_box)?.predicted_peak_bytes;
+        // The limit chooses the parts: where the scene fits, one piece.
+        let one_piece = crate::cli::BuildFlags {
+            walls: Some(crate::cli::Walls::None),
+            ..*self.flags
+        };
         let (mesh, build) =
-            crate::load::build_scene_in(self.scene, self.flags, self.quiet, self.extra)?;
+            crate::load::build_scene_in(self.scene, &one_piece, self.quiet, self.extra)?;
         let report = MemoryReport {
             limit_bytes: self.limit_bytes,
             predicted_in_core_bytes: predicted,

@@ -76,9 +76,11 @@ pub struct SceneResult {
     /// as refinement points and no mesh optimisation
     /// (`--min-dihedral 2 --optimize 0/0 --max-steiner 1%`).
     pub min_dihedral2_capped: Option<QualityTrade>,
-    /// Full mode: the scene built in parts with walls between them
-    /// (`--walls auto`), `-pY` in each.
+    /// Full mode: the default build, in parts with walls between them
+    /// (`--walls auto`, `-pY` in each): the mesh of the other tables.
     pub walls: Option<QualityTrade>,
+    /// Full mode: the scene built in one TetGen run (`--walls none`).
+    pub one_piece: Option<QualityTrade>,
     /// Out-of-core builds under ½ and ⅓ of the in-core peak (full mode,
     /// first scene of each geometry only).
     pub out_of_core: Vec<OutOfCoreRow>,
@@ -189,7 +191,8 @@ pub struct TablesDoc {
 }
 
 /// How every scene of the tables is built: self-intersections resolved,
-/// TetGen `-pY` in a box, Hilbert order, the default time limit.
+/// TetGen `-pY` in a box cut into parts with walls between them
+/// (`--walls auto`, the default), Hilbert order, the default time limit.
 pub const TABLE_FLAGS: BuildFlags = BuildFlags {
     quality: None,
     min_dihedral: None,

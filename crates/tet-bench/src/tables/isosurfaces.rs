@@ -93,6 +93,7 @@ fn measure_methods(
         frames,
         time_step: 0,
         view: IsoView::of(&volume.mesh),
+        regions: true,
     };
     methods
         .iter()

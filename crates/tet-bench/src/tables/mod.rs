@@ -69,11 +69,11 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use tet_trace_cpu::render::RenderOptions;
 
-use crate::cli::TablesArgs;
+use crate::cli::{Method, TablesArgs};
 use crate::methods::cpu_methods;
 use crate::output::{error_chain, outln, print_json};
 use crate::timing::{pool, target_features};
-use doc::{SceneResult, Setup, TABLE_FLAGS, TablesDoc};
+use doc::{QualityTrade, SceneResult, Setup, TABLE_FLAGS, TablesDoc};
 use plan::{MeshCache, Planned, plan, scene_specs};
 use report::{markdown, write_atomic, write_outputs};
 
@@ -137,7 +137,7 @@ fn measure_scene(
         entry::measure(planned, cache, opts, frames, pool),
     );
     let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames);
-    let (quality5, min_dihedral2, min_dihedral2_capped, walls) = if args.quick {
+    let (quality5, min_dihedral2, min_dihedral2_capped, one_piece) = if args.quick {
         (None, None, None, None)
     } else {
         let mut trade = |flags, label: &str| {
@@ -154,7 +154,7 @@ fn measure_scene(
                 &quality::CAPPED,
                 "slivers-bounded, capped (--max-steiner 1%)",
             ),
-            trade(&quality::WALLS, "walled (--walls auto)"),
+            trade(&quality::ONE_PIECE, "one piece (--walls none)"),
         )
     };
     #[cfg(feature = "tetgen")]
@@ -171,7 +171,16 @@ fn measure_scene(
         quality5,
         min_dihedral2,
         min_dihedral2_capped,
-        walls,
+        // The default mesh is the walled one: its row is the render table's.
+        walls: one_piece.as_ref().and_then(|_| {
+            let tet20 = renders.iter().find(|r| r.method == Method::Tet20)?;
+            Some(QualityTrade {
+                tets: info.tets,
+                build: info.build.clone(),
+                tet20: tet20.clone(),
+            })
+        }),
+        one_piece,
         out_of_core,
         shares_mesh_with: planned.shares_with.clone(),
         mesh_reused,
@@ -248,6 +257,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
                     min_dihedral2: None,
                     min_dihedral2_capped: None,
                     walls: None,
+                    one_piece: None,
                     out_of_core: Vec::new(),
                     shares_mesh_with: planned.shares_with.clone(),
                     mesh_reused: false,

@@ -116,7 +116,7 @@ pub fn plan(specs: &[String]) -> Vec<Planned> {
 /// Meshes built for a group of scenes with the same geometry, by build flags.
 #[derive(Default)]
 pub struct MeshCache {
-    /// By geometry key and build flags (as `Debug` text).
+    /// By geometry key and build flags (resolved, as `Debug` text).
     meshes: HashMap<(u64, String), (TetMesh, BuildSummary)>,
 }
 
@@ -130,7 +130,7 @@ impl MeshCache {
         };
         let scene =
             Scene::load(&p.spec).with_context(|| format!("cannot load scene `{}`", p.spec))?;
-        let fk = (key, format!("{flags:?}"));
+        let fk = (key, format!("{:?}", flags.resolved()));
         if let Some((mesh, build)) = self.meshes.get(&fk) {
             let loaded = with_mesh(scene, mesh.clone(), Some(build.clone()));
             return Ok((loaded, true));

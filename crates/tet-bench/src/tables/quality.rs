@@ -4,8 +4,9 @@
 //! is below 2°, no radius-edge bound), and against that bound capped at
 //! 1 % of the scene's vertices with no mesh optimisation (the worst
 //! slivers go first, so a few hundred points do most of the work), and
-//! against `-pY` in parts with walls between them (`--walls auto`): tets,
-//! build time, tets per ray and tet20 speed.
+//! the default build, `-pY` in parts with walls between them (`--walls
+//! auto`), against `-pY` in one piece (`--walls none`): tets, build time,
+//! tets per ray and tet20 speed.
 
 use std::fmt::Write as _;
 
@@ -44,9 +45,9 @@ pub const CAPPED: BuildFlags = BuildFlags {
     ..MIN_DIHEDRAL2
 };
 
-/// The scene cut into parts with walls between them, `-pY` in each.
-pub const WALLS: BuildFlags = BuildFlags {
-    walls: Some(crate::cli::Walls::Auto),
+/// The scene in one TetGen run, `-pY`, no walls.
+pub const ONE_PIECE: BuildFlags = BuildFlags {
+    walls: Some(crate::cli::Walls::None),
     ..TABLE_FLAGS
 };
 
@@ -77,7 +78,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     }
     let _ = writeln!(
         m,
-        "\n## Build trade: surface-preserving `-pY`, slivers bounded (`--min-dihedral 2`, also capped at 1 % of the vertices), quality `-pYq5`, walls (`--walls auto`)\n"
+        "\n## Build trade: surface-preserving `-pY` in parts with walls between them (the default, `--walls auto`) and in one piece (`--walls none`), slivers bounded (`--min-dihedral 2`, also capped at 1 % of the vertices), quality `-pYq5`\n"
     );
     let _ = writeln!(
         m,
@@ -96,7 +97,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
         if let Some(base) = sc.renders.iter().find(|r| r.method == Method::Tet20) {
             let _ = writeln!(
                 m,
-                "| {} | -pY | {} | {:.2} | {:.1} | {:.2} |",
+                "| {} | -pY, --walls auto (default) | {} | {:.2} | {:.1} | {:.2} |",
                 i.name,
                 i.tets,
                 secs(&i.build),
@@ -105,13 +106,13 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
             );
         }
         for (label, t) in [
+            ("-pY, --walls none", sc.one_piece.as_ref()),
             (
                 "--min-dihedral 2 --optimize 0/0 --max-steiner 1%",
                 sc.min_dihedral2_capped.as_ref(),
             ),
             ("--min-dihedral 2", sc.min_dihedral2.as_ref()),
             ("-q5", Some(q)),
-            ("--walls auto", sc.walls.as_ref()),
         ] {
             if let Some(t) = t {
                 let _ = writeln!(
