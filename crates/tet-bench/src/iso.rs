@@ -167,6 +167,10 @@ pub struct IsoDoc {
     pub bytes: usize,
     /// Table 4's counters per primary ray (one untimed frame).
     pub per_ray: IsoCounts,
+    /// Walks: whether the regions' min-max tree culled rays that meet no
+    /// region straddling an isovalue (`--no-regions`: every ray walks);
+    /// false for the IBVH.
+    pub regions: bool,
 }
 
 /// What traces the rays.
@@ -193,6 +197,9 @@ pub struct IsoFrames {
     pub time_step: usize,
     /// Camera, clip box and light.
     pub view: IsoView,
+    /// Walks: cull the rays that meet no region straddling an isovalue
+    /// (the regions' min-max tree, `tet_trace_cpu::iso::regions`).
+    pub regions: bool,
 }
 
 /// What a frame looks at and how: the camera, an optional clip box (every
@@ -300,14 +307,15 @@ pub fn measure(
         IsoMethod::Ibvh => Traced::Ibvh(Ibvh::build_bih(mesh, values)?, false),
         IsoMethod::IbvhSah => Traced::Ibvh(Ibvh::build_sah(mesh, values)?, false),
         IsoMethod::IbvhPackets => Traced::Ibvh(Ibvh::build_bih(mesh, values)?, true),
-        IsoMethod::WalkTet20 => {
-            Traced::Walk(Box::new(IsoWalk::new(mesh, values, WalkLayout::Tet20)?))
-        }
-        IsoMethod::WalkTet16 => {
-            Traced::Walk(Box::new(IsoWalk::new(mesh, values, WalkLayout::Tet16)?))
-        }
-        IsoMethod::WalkTet32 => {
-            Traced::Walk(Box::new(IsoWalk::new(mesh, values, WalkLayout::Tet32)?))
+        IsoMethod::WalkTet20 | IsoMethod::WalkTet16 | IsoMethod::WalkTet32 => {
+            let layout = match method {
+                IsoMethod::WalkTet20 => WalkLayout::Tet20,
+                IsoMethod::WalkTet16 => WalkLayout::Tet16,
+                _ => WalkLayout::Tet32,
+            };
+            Traced::Walk(Box::new(IsoWalk::with_regions(
+                mesh, values, layout, f.regions,
+            )?))
         }
     };
     let build_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -415,6 +423,7 @@ pub fn measure(
         fps: 1e3 / best_ms,
         bytes,
         per_ray: IsoCounts::per_ray(&stats, rays),
+        regions: f.regions && matches!(traced, Traced::Walk(_)),
     };
     Ok((doc, image))
 }
@@ -548,6 +557,7 @@ mod tests {
             frames: 1,
             time_step: 0,
             view: view(&volume.mesh),
+            regions: true,
         };
         let images = IsoMethod::ALL
             .iter()

@@ -70,8 +70,33 @@ pub fn locate(mesh: &TetMesh, p: Vec3, source: u32) -> Result<u32, LocateError> 
             tets: mesh.tets.len(),
         });
     }
+    if let Some(t) = visibility_walk(mesh, p, source, 4 * mesh.tets.len() + 64) {
+        return Ok(t);
+    }
+    // The boundary or the step cap: outside a convex mesh, but a non-convex
+    // one may still hold the point elsewhere: scan. A point beyond the bounds of the mesh points lies in no tet: no scan
+    // (a camera or light outside a tight enclosing box, every frame).
+    let (lo, hi) = mesh.point_bounds();
+    if p.cmplt(lo).any() || p.cmpgt(hi).any() {
+        return Err(LocateError::OutsideMesh { point: p });
+    }
+    scan(mesh, p)
+}
+
+/// [`locate`]'s visibility walk alone, at most `max_steps` steps: a tet
+/// containing `p` (exact), or `None` when the walk reaches the mesh
+/// boundary or the cap (no exhaustive search: for callers with a fallback
+/// of their own, such as a walk that may start nearer its target).
+pub fn locate_near(mesh: &TetMesh, p: Vec3, source: u32, max_steps: usize) -> Option<u32> {
+    if !p.is_finite() || source as usize >= mesh.tets.len() {
+        return None;
+    }
+    visibility_walk(mesh, p, source, max_steps)
+}
+
+/// The visibility walk from `source` (module docs).
+fn visibility_walk(mesh: &TetMesh, p: Vec3, source: u32, cap: usize) -> Option<u32> {
     let q = p.as_dvec3();
-    let cap = 4 * mesh.tets.len() + 64;
     let mut tet = source;
     'walk: for step in 0..cap {
         let v = mesh.tet_points(tet).map(|x| x.as_dvec3());
@@ -84,21 +109,13 @@ pub fn locate(mesh: &TetMesh, p: Vec3, source: u32) -> Result<u32, LocateError> 
                         tet = side.tet;
                         continue 'walk;
                     }
-                    // Boundary: outside a convex mesh, but a non-convex one
-                    // may still hold the point elsewhere: scan.
-                    None => break 'walk,
+                    None => return None,
                 }
             }
         }
-        return Ok(tet);
+        return Some(tet);
     }
-    // A point beyond the bounds of the mesh points lies in no tet: no scan
-    // (a camera or light outside a tight enclosing box, every frame).
-    let (lo, hi) = mesh.point_bounds();
-    if p.cmplt(lo).any() || p.cmpgt(hi).any() {
-        return Err(LocateError::OutsideMesh { point: p });
-    }
-    scan(mesh, p)
+    None
 }
 
 /// Exhaustive exact search (the walk's fallback, also usable alone).

@@ -57,6 +57,7 @@ pub fn run(args: &IsoArgs, json: bool) -> Result<()> {
         frames: args.frames,
         time_step: args.time_step,
         view,
+        regions: !args.no_regions,
     };
     let (doc, image) = measure(&volume, &isovalues, args.method, frames, &pool)?;
     if let Some(path) = &args.output {

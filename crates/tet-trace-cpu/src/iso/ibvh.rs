@@ -134,25 +134,7 @@ impl Ibvh {
             .zip(values)
             .map(|(p, &v)| p.extend(v))
             .collect();
-        let prims: Vec<Prim> = mesh
-            .tets
-            .par_iter()
-            .map(|ids| {
-                let p = ids.map(|i| mesh.points[i as usize]);
-                let lo = p[0].min(p[1]).min(p[2].min(p[3]));
-                let hi = p[0].max(p[1]).max(p[2].max(p[3]));
-                Prim {
-                    lo,
-                    hi,
-                    c: (lo + hi) * 0.5,
-                }
-            })
-            .collect();
-        let mut order: Vec<u32> = (0..mesh.tets.len() as u32).collect();
-        let mut nodes = Vec::with_capacity(2 * mesh.tets.len() / LEAF_SIZE + 1);
-        if !order.is_empty() {
-            build_rec(&prims, &mut order, 0, kind, &mut nodes);
-        }
+        let (nodes, order) = tree(mesh, kind, LEAF_SIZE);
         let mut bvh = Ibvh {
             nodes,
             prims: order.iter().map(|&t| mesh.tets[t as usize]).collect(),
@@ -227,12 +209,38 @@ impl Ibvh {
     }
 }
 
+/// The tree's shape over the tets of `mesh` (of valid vertex ids): nodes
+/// depth first with zero bounds, leaves of at most `leaf` tets, and the tet
+/// order the leaves index into.
+pub(super) fn tree(mesh: &TetMesh, kind: BuildKind, leaf: usize) -> (Vec<Node>, Vec<u32>) {
+    let prims: Vec<Prim> = mesh
+        .tets
+        .par_iter()
+        .map(|ids| {
+            let p = ids.map(|i| mesh.points[i as usize]);
+            let lo = p[0].min(p[1]).min(p[2].min(p[3]));
+            let hi = p[0].max(p[1]).max(p[2].max(p[3]));
+            Prim {
+                lo,
+                hi,
+                c: (lo + hi) * 0.5,
+            }
+        })
+        .collect();
+    let mut order: Vec<u32> = (0..mesh.tets.len() as u32).collect();
+    let mut nodes = Vec::with_capacity(2 * mesh.tets.len() / leaf.max(1) + 1);
+    if !order.is_empty() {
+        build_rec(&prims, &mut order, 0, (kind, leaf.max(1)), &mut nodes);
+    }
+    (nodes, order)
+}
+
 /// Builds the subtree over `order` (primitives from `first`) into `nodes`.
 fn build_rec(
     prims: &[Prim],
     order: &mut [u32],
     first: usize,
-    kind: BuildKind,
+    (kind, leaf): (BuildKind, usize),
     nodes: &mut Vec<Node>,
 ) {
     let me = nodes.len();
@@ -242,7 +250,7 @@ fn build_rec(
         index: first as u32,
         count: order.len() as u32,
     });
-    if order.len() <= LEAF_SIZE {
+    if order.len() <= leaf {
         return;
     }
     let mid = match kind {
@@ -250,9 +258,9 @@ fn build_rec(
         BuildKind::Sah => split_sah(prims, order),
     };
     let (l, r) = order.split_at_mut(mid);
-    build_rec(prims, l, first, kind, nodes);
+    build_rec(prims, l, first, (kind, leaf), nodes);
     let right = nodes.len();
-    build_rec(prims, r, first + mid, kind, nodes);
+    build_rec(prims, r, first + mid, (kind, leaf), nodes);
     nodes[me].index = right as u32;
     nodes[me].count = 0;
 }

@@ -183,19 +183,25 @@ impl RayPre {
     /// `[lo, hi]` (entry > exit: missed).
     #[inline(always)]
     pub fn slab(&self, lo: Vec3, hi: Vec3) -> (f32, f32) {
-        let o = self.ray.origin;
-        let mut t0 = f32::NEG_INFINITY;
-        let mut t1 = f32::INFINITY;
-        for a in 0..3 {
-            let u = (lo[a] - o[a]) * self.inv_d[a];
-            let v = (hi[a] - o[a]) * self.inv_d[a];
-            // `f32::min`/`max` ignore the NaN of `0 · ∞` (origin on a slab
-            // plane of a parallel ray): that axis does not bound the ray.
-            t0 = t0.max(u.min(v));
-            t1 = t1.min(u.max(v));
-        }
-        (t0, t1)
+        slab(self.ray.origin, self.inv_d, lo, hi)
     }
+}
+
+/// Entry and exit parameters of the line `origin + t·d` (`inv_d = 1/d`)
+/// through the box `[lo, hi]` (entry > exit: missed).
+#[inline(always)]
+pub(super) fn slab(origin: Vec3, inv_d: Vec3, lo: Vec3, hi: Vec3) -> (f32, f32) {
+    let mut t0 = f32::NEG_INFINITY;
+    let mut t1 = f32::INFINITY;
+    for a in 0..3 {
+        let u = (lo[a] - origin[a]) * inv_d[a];
+        let v = (hi[a] - origin[a]) * inv_d[a];
+        // `f32::min`/`max` ignore the NaN of `0 · ∞` (origin on a slab
+        // plane of a parallel ray): that axis does not bound the ray.
+        t0 = t0.max(u.min(v));
+        t1 = t1.min(u.max(v));
+    }
+    (t0, t1)
 }
 
 #[cfg(test)]

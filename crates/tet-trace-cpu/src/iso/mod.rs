@@ -10,7 +10,8 @@
 //! * [`walk`]: the iso walk (beyond the paper): the watertight tet walk of
 //!   [`crate::walk`] over Tet32/Tet20/Tet16, testing each visited tet's value
 //!   range and locating the crossing from the field values where the ray
-//!   crosses the tet's faces;
+//!   crosses the tet's faces; tiles skip the rays that meet no region of
+//!   tets straddling an isovalue ([`regions`]);
 //! * [`ibvh`] / [`ibvh_trace`] / [`packet`]: the paper's implicit min-max BVH
 //!   (§5) over 4-D bounds `{x, y, z, v}`, built BIH-style or by SAH, refit
 //!   for new time steps (§6), traversed by single rays or by packets with
@@ -51,6 +52,7 @@ pub mod ibvh_trace;
 pub mod marching;
 pub mod packet;
 pub mod reference;
+pub mod regions;
 pub mod walk;
 mod walk_ray;
 

@@ -37,7 +37,7 @@ use crate::ray::Ray;
 pub const PACKET: usize = 256;
 
 /// Interval bounds of a packet's rays.
-struct Interval {
+pub(super) struct Interval {
     o_lo: Vec3,
     o_hi: Vec3,
     inv_lo: Vec3,
@@ -47,6 +47,11 @@ struct Interval {
 
 impl Interval {
     fn new(pre: &[RayPre]) -> Interval {
+        Self::of(pre.iter().map(|p| (&p.ray, p.inv_d)))
+    }
+
+    /// The bounds of rays given with their reciprocal directions.
+    pub(super) fn of<'a>(rays: impl IntoIterator<Item = (&'a Ray, Vec3)>) -> Interval {
         let mut iv = Interval {
             o_lo: Vec3::INFINITY,
             o_hi: Vec3::NEG_INFINITY,
@@ -54,19 +59,25 @@ impl Interval {
             inv_hi: Vec3::NEG_INFINITY,
             t_lo: f32::INFINITY,
         };
-        for p in pre {
-            iv.o_lo = iv.o_lo.min(p.ray.origin);
-            iv.o_hi = iv.o_hi.max(p.ray.origin);
-            iv.inv_lo = iv.inv_lo.min(p.inv_d);
-            iv.inv_hi = iv.inv_hi.max(p.inv_d);
-            iv.t_lo = iv.t_lo.min(p.ray.t_min);
+        for (ray, inv_d) in rays {
+            iv.o_lo = iv.o_lo.min(ray.origin);
+            iv.o_hi = iv.o_hi.max(ray.origin);
+            iv.inv_lo = iv.inv_lo.min(inv_d);
+            iv.inv_hi = iv.inv_hi.max(inv_d);
+            iv.t_lo = iv.t_lo.min(ray.t_min);
         }
         iv
     }
 
     /// True when every ray of the packet certainly misses the box before
     /// `t_far` (the largest far bound of the active rays).
-    fn misses(&self, lo: Vec3, hi: Vec3, t_far: f32) -> bool {
+    pub(super) fn misses(&self, lo: Vec3, hi: Vec3, t_far: f32) -> bool {
+        self.entry(lo, hi, t_far).is_none()
+    }
+
+    /// A lower bound of where the packet's rays enter the box `[lo, hi]`
+    /// before `t_far`, or `None` when every ray certainly misses it.
+    pub(super) fn entry(&self, lo: Vec3, hi: Vec3, t_far: f32) -> Option<f32> {
         let mut tn = self.t_lo;
         let mut tf = t_far;
         for a in 0..3 {
@@ -91,7 +102,7 @@ impl Interval {
             tn = tn.max(span(near).0);
             tf = tf.min(span(far).1);
         }
-        tn > tf + 1e-5 * (tn.abs() + tf.abs())
+        (tn <= tf + 1e-5 * (tn.abs() + tf.abs())).then_some(tn)
     }
 }
 

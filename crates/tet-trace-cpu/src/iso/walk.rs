@@ -34,6 +34,11 @@
 //! Volume meshes rarely have constrained faces; any the mesh has are
 //! walked through (the walk runs on a copy without them).
 //!
+//! A tile of rays ([`IsoWalk::trace_tile`]) first asks the regions'
+//! min-max tree ([`super::regions`]) which of its rays may meet an
+//! isosurface; the others are misses without a walk (most camera rays of a
+//! volume: the walk alone crosses the whole volume to learn that).
+//!
 //! Tiles of rays from outside the volume ([`IsoWalk::trace_tile`]) walk
 //! the stretch before the first tet that straddles an isovalue in the SIMD
 //! lockstep walk of the surface kernels and hand each ray to the scalar
@@ -41,6 +46,7 @@
 //! README's isosurface figures).
 
 mod lockstep;
+mod skip;
 
 use std::borrow::Cow;
 
@@ -50,6 +56,7 @@ use tet_core::{Link, TetMesh};
 
 use super::hull::Hull;
 use super::marching::RayPre;
+use super::regions::{RegionHit, RegionTree};
 use super::walk_ray::{Ctx, Found};
 use super::{IsoError, IsoHit, IsoQuery, IsoStats, check_values};
 use crate::entry::Viewpoint;
@@ -144,6 +151,24 @@ impl IsoOutcome {
         matches!(self, IsoOutcome::Failed { .. })
     }
 
+    /// True when this outcome is `whole`'s (the walk of the same ray from
+    /// its start) reached by a shorter walk: the same hit bit for bit, or a
+    /// miss or the same failure, with no more tets visited. A tile's rays
+    /// culled or started at their first region ([`super::regions`]) are
+    /// shortcuts of their whole walks.
+    pub fn is_shortcut_of(&self, whole: &IsoOutcome) -> bool {
+        let fewer = self.tets_visited() <= whole.tets_visited();
+        fewer
+            && match (self, whole) {
+                (IsoOutcome::Hit { hit: a, .. }, IsoOutcome::Hit { hit: b, .. }) => a == b,
+                (IsoOutcome::Miss { .. }, IsoOutcome::Miss { .. }) => true,
+                (IsoOutcome::Failed { failure: a, .. }, IsoOutcome::Failed { failure: b, .. }) => {
+                    a == b
+                }
+                _ => false,
+            }
+    }
+
     /// Tets visited.
     pub fn tets_visited(&self) -> u32 {
         match *self {
@@ -165,6 +190,9 @@ pub struct IsoWalk<'m> {
     ranges: Vec<[f32; 2]>,
     /// Boundary faces, when the boundary is convex (rays from outside).
     hull: Option<Hull>,
+    /// Min-max per region: tiles skip the walks of rays that meet no
+    /// region straddling an isovalue (`None`: every ray walks).
+    regions: Option<RegionTree>,
     cap: u32,
 }
 
@@ -212,6 +240,18 @@ impl<'m> IsoWalk<'m> {
     /// ([`BoundaryEntry::new`]); without one they are reported as
     /// [`Failure::Lost`].
     pub fn new(mesh: &'m TetMesh, values: &'m [f32], layout: WalkLayout) -> Result<Self, IsoError> {
+        Self::with_regions(mesh, values, layout, true)
+    }
+
+    /// [`IsoWalk::new`], with or without the regions' min-max tree
+    /// (`false`: every ray of a tile walks until it leaves the volume; the
+    /// outcomes of rays that meet an isosurface are the same).
+    pub fn with_regions(
+        mesh: &'m TetMesh,
+        values: &'m [f32],
+        layout: WalkLayout,
+        regions: bool,
+    ) -> Result<Self, IsoError> {
         check_values(values, mesh.points.len())?;
         let mesh = unconstrained(mesh);
         let err = |e: tet_core::layout::LayoutError| IsoError::Layout(e.to_string());
@@ -223,14 +263,29 @@ impl<'m> IsoWalk<'m> {
         let hull = BoundaryEntry::new(&mesh).ok().map(|_| Hull::new(&mesh));
         let cap = step_cap(&mesh);
         let ranges = tet_ranges(&mesh, values);
+        let regions = regions.then(|| RegionTree::new(&mesh, &ranges));
         Ok(IsoWalk {
             mesh,
             values,
             topo,
             ranges,
             hull,
+            regions,
             cap,
         })
+    }
+
+    /// The same walk without the regions' min-max tree: every ray of a
+    /// tile walks until it leaves the volume (comparisons and tests; the
+    /// outcomes of rays that meet an isosurface are the same).
+    pub fn without_regions(mut self) -> Self {
+        self.regions = None;
+        self
+    }
+
+    /// The regions' min-max tree, if the walk keeps one.
+    pub fn regions(&self) -> Option<&RegionTree> {
+        self.regions.as_ref()
     }
 
     /// The same walk over other values of the same points (a new time step:
@@ -239,6 +294,9 @@ impl<'m> IsoWalk<'m> {
         check_values(values, self.mesh.points.len())?;
         self.values = values;
         self.ranges = tet_ranges(&self.mesh, values);
+        if let Some(r) = &mut self.regions {
+            r.refit(&self.mesh, &self.ranges);
+        }
         Ok(self)
     }
 
@@ -248,8 +306,8 @@ impl<'m> IsoWalk<'m> {
     }
 
     /// Bytes of the walk's data: layout records, points, the per-tet value
-    /// ranges (8 bytes per tet) and the boundary faces' BVH (the values are
-    /// the caller's, 4 bytes per point, not counted).
+    /// ranges (8 bytes per tet), the boundary faces' BVH and the regions'
+    /// tree (the values are the caller's, 4 bytes per point, not counted).
     pub fn bytes(&self) -> usize {
         let (recs, pts) = match &self.topo {
             Topo::Tet32(m) => (std::mem::size_of_val(&m.tets[..]), m.points.len()),
@@ -259,6 +317,7 @@ impl<'m> IsoWalk<'m> {
         recs + pts * 12
             + std::mem::size_of_val(&self.ranges[..])
             + self.hull.as_ref().map_or(0, Hull::bytes)
+            + self.regions.as_ref().map_or(0, RegionTree::bytes)
     }
 
     /// Locates the viewpoint of many rays once ([`Viewpoint::locate`]).
@@ -421,6 +480,8 @@ impl<'m> IsoWalk<'m> {
         stats: &mut IsoStats,
     ) {
         let n = rays.len().min(out.len());
+        let regions = self.first_regions(&rays[..n], query, stats);
+        let mut prev = None;
         let mut hint = EntryHint::default();
         let mut lanes: [Option<(usize, WalkState)>; LANES] = std::array::from_fn(|_| None);
         let mut next = 0;
@@ -430,10 +491,15 @@ impl<'m> IsoWalk<'m> {
                 while slot.is_none() && next < n {
                     let i = next;
                     next += 1;
+                    if regions[i] == RegionHit::None {
+                        out[i] = IsoOutcome::Miss { tets_visited: 0 };
+                        continue;
+                    }
                     let ray = &rays[i];
-                    let start = match vp {
-                        Viewpoint::Inside(t) => Ok(Start::Tet(*t)),
-                        Viewpoint::Outside(_) => self.enter(ray, &mut hint),
+                    let start = match (self.skip_to(ray, regions[i], &mut prev), vp) {
+                        (Some(s), _) => Ok(s),
+                        (None, Viewpoint::Inside(t)) => Ok(Start::Tet(*t)),
+                        (None, Viewpoint::Outside(_)) => self.enter(ray, &mut hint),
                     };
                     let opened = match start {
                         _ if query.check().is_err() => Err(IsoOutcome::Failed {
@@ -461,6 +527,24 @@ impl<'m> IsoWalk<'m> {
                 return;
             }
         }
+    }
+
+    /// What the regions say of each ray of a tile
+    /// ([`RegionTree::first_regions`]; walk them all when the walk keeps no
+    /// regions or the query is invalid).
+    pub(super) fn first_regions(
+        &self,
+        rays: &[Ray],
+        query: &IsoQuery,
+        stats: &mut IsoStats,
+    ) -> Vec<RegionHit> {
+        let mut out = vec![RegionHit::Walk; rays.len()];
+        if let Some(r) = &self.regions
+            && query.check().is_ok()
+        {
+            r.first_regions(rays, query, &mut out, stats);
+        }
+        out
     }
 
     /// Traces `ray` from a walk start (`Err`: its outcome before any walk).

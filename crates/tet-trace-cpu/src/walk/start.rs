@@ -27,12 +27,15 @@ pub enum Start {
         /// The side to walk into.
         tet: u32,
     },
-    /// Entering the mesh from outside: the ray's origin lies outside the
-    /// mesh and its line enters `tet` through that tet's boundary face
-    /// `face` (0..=3, opposite vertex slot `face`, linked to
-    /// [`Link::BOUNDARY`]), ahead of the origin. Nothing lies outside the
-    /// mesh, so the walk starts there; see [`crate::entry`], which finds it
-    /// (and resolves a constrained face on the boundary itself).
+    /// Entering `tet` through its face `face` (0..=3, opposite vertex slot
+    /// `face`), ahead of the origin, as the walk would have entered it. A
+    /// boundary face ([`Link::BOUNDARY`]): the ray comes from outside the
+    /// mesh, where nothing lies, so the walk starts there; see
+    /// [`crate::entry`], which finds it (and resolves a constrained face on
+    /// the boundary itself). An inner face: the caller knows the walk finds
+    /// nothing before it and that the ray's line enters `tet` through it
+    /// (the iso walk's regions, [`crate::iso::regions`]); the walk then
+    /// goes on exactly as the whole walk would from there.
     Entry {
         /// The tet entered.
         tet: u32,
@@ -283,10 +286,11 @@ pub(crate) fn begin_with<P: Projection>(
                     .get(face as usize)
                     .and_then(|cf| cf.side_of(tet))
                     .map(|side| (tet, side.face as usize, Link::constrained(face))),
-                Start::Entry { tet, face } => {
-                    mesh.is_boundary_face(tet, face)
-                        .then_some((tet, face as usize, Link::BOUNDARY))
-                }
+                Start::Entry { tet, face } => mesh
+                    .neighbors
+                    .get(tet as usize)
+                    .filter(|_| face < 4)
+                    .map(|links| (tet, face as usize, links[face as usize])),
                 Start::Tet(_) => None,
             };
             return through

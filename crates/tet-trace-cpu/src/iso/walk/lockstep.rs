@@ -15,6 +15,7 @@
 
 use tet_core::TetMesh;
 
+use super::super::regions::RegionHit;
 use super::super::walk_ray::Ctx;
 use super::super::{IsoQuery, IsoStats};
 use super::{IsoOutcome, IsoWalk, WalkState, converted};
@@ -71,11 +72,23 @@ impl IsoWalk<'_> {
             return;
         }
         let mesh: &TetMesh = &self.mesh;
+        // Rays that meet no live region miss without a walk; the others
+        // start at their first region where that is far enough in.
+        let regions = self.first_regions(&rays[..n], query, stats);
+        let mut prev = None;
         // Each ray's entry face (rays that miss the volume end here).
         let mut hint = EntryHint::default();
         let (mut index, mut starts, mut walking) = (Vec::new(), Vec::new(), Vec::new());
         for (i, ray) in rays[..n].iter().enumerate() {
-            match self.enter(ray, &mut hint) {
+            if regions[i] == RegionHit::None {
+                out[i] = IsoOutcome::Miss { tets_visited: 0 };
+                continue;
+            }
+            let start = match self.skip_to(ray, regions[i], &mut prev) {
+                Some(s) => Ok(s),
+                None => self.enter(ray, &mut hint),
+            };
+            match start {
                 Ok(s) => {
                     index.push(i);
                     starts.push(s);
