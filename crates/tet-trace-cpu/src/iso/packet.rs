@@ -102,7 +102,12 @@ impl Interval {
             tn = tn.max(span(near).0);
             tf = tf.min(span(far).1);
         }
-        (tn <= tf + 1e-5 * (tn.abs() + tf.abs())).then_some(tn)
+        // A NaN bound (a zero times an infinite span) culls nothing.
+        if tn > tf + 1e-5 * (tn.abs() + tf.abs()) {
+            None
+        } else {
+            Some(tn)
+        }
     }
 }
 
