@@ -962,7 +962,7 @@ pub enum IsoMethod {
     IbvhSah,
     /// The BIH-built IBVH traced by 16×16 packets.
     IbvhPackets,
-    /// The iso walk over Tet20 (no BVH).
+    /// The iso walk over Tet20 (no BVH over the tets).
     WalkTet20,
     /// The iso walk over Tet16.
     WalkTet16,

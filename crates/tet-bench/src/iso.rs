@@ -7,9 +7,10 @@
 //! Methods: the paper's implicit min-max BVH built BIH-style (`ibvh`) or by
 //! SAH (`ibvh-sah`), traced one ray at a time, or the BIH one by 16×16
 //! packets (`ibvh-packets`); and the iso walk over our compact layouts
-//! (`walk-tet20`, `walk-tet16`, `walk-tet32`), which needs no BVH at all
-//! (each 16×16 tile's walks interleaved on one thread,
-//! [`IsoWalk::trace_tile`]).
+//! (`walk-tet20`, `walk-tet16`, `walk-tet32`), which needs no BVH over
+//! the tets: each 16×16 tile asks a small min-max tree over regions of
+//! tets which rays may meet an isosurface and where they may start
+//! (`--no-regions`: none), then walks them ([`IsoWalk::trace_tile`]).
 //! Every method sees the same rays of the same camera, which frames the
 //! volume's bounds the same way for all of them.
 

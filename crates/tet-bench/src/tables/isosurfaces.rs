@@ -238,7 +238,7 @@ fn static_markdown(m: &mut String, doc: &TablesDoc) {
     );
     let _ = writeln!(
         m,
-        "Synthetic stand-ins with the paper's tet counts (`tet_build::volume`; the originals are not public), one isovalue, the same camera and rays for every method; {} threads here, {}² pixels (fps scale with the pixel count: compare with the paper's 1024² at the same size). `ibvh`/`ibvh-sah`: the implicit min-max BVH built BIH-style or by SAH, single rays; `ibvh-packets`: 16×16 packets; `walk-*`: the iso walk over our compact layouts (no BVH). Paper: build ms on a dual Core 2 Duo (Table 1), fps at 1024² on a 2-core laptop (Table 2), 16×16 tests per ray (Table 4).\n",
+        "Synthetic stand-ins with the paper's tet counts (`tet_build::volume`; the originals are not public), one isovalue, the same camera and rays for every method; {} threads here, {}² pixels (fps scale with the pixel count: compare with the paper's 1024² at the same size). `ibvh`/`ibvh-sah`: the implicit min-max BVH built BIH-style or by SAH, single rays; `ibvh-packets`: 16×16 packets; `walk-*`: the iso walk over our compact layouts, with a min-max tree over regions of up to 64 tets that culls the rays meeting no straddling region and starts the others there (no BVH over the tets). Paper: build ms on a dual Core 2 Duo (Table 1), fps at 1024² on a 2-core laptop (Table 2), 16×16 tests per ray (Table 4).\n",
         doc.setup.threads,
         doc.isosurfaces
             .iter()
