@@ -26,6 +26,7 @@ use obvhs::bvh2::builder::build_bvh2_from_tris;
 use obvhs::ray::{Ray as BvhRay, RayHit};
 use obvhs::rt_triangle::RtTriangle;
 use obvhs::triangle::Triangle;
+use tet_core::input_triangles::plane_barycentrics;
 use tet_core::{InputTriangles, TetMesh};
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Hit, Ray, TraceOutcome};
@@ -237,15 +238,9 @@ pub fn input_hit(mesh: &TetMesh, inputs: &InputTriangles, ray: &Ray, i: u32, t: 
 /// `tets_visited` is 0).
 pub fn face_hit(mesh: &TetMesh, ray: &Ray, face: u32, t: f32) -> Hit {
     let cf = &mesh.constrained[face as usize];
-    // In f64: a scene at 1e30 has normals whose squared length overflows
-    // f32.
-    let [p0, p1, p2] = cf.vertices.map(|v| mesh.points[v as usize].as_dvec3());
-    let n = (p1 - p0).cross(p2 - p0);
+    let v = cf.vertices.map(|v| mesh.points[v as usize].as_dvec3());
     let p = ray.origin.as_dvec3() + ray.direction.as_dvec3() * t as f64;
-    let area = n.length_squared().max(f64::MIN_POSITIVE);
-    // Signed areas of the sub-triangles opposite vertices 1 and 2.
-    let b1 = (p - p0).cross(p2 - p0).dot(n) / area;
-    let b2 = (p1 - p0).cross(p - p0).dot(n) / area;
+    let (b, n) = plane_barycentrics(v, p);
     let from_front = ray.direction.as_dvec3().dot(n) < 0.0;
     let (near, far) = if from_front {
         (cf.front.tet, cf.back.tet)
@@ -256,7 +251,7 @@ pub fn face_hit(mesh: &TetMesh, ray: &Ray, face: u32, t: f32) -> Hit {
         triangle: cf.triangle,
         face,
         t,
-        barycentrics: [(1.0 - b1 - b2) as f32, b1 as f32, b2 as f32],
+        barycentrics: b.map(|w| w as f32),
         tet: near,
         far_tet: far,
         tets_visited: 0,

@@ -101,11 +101,8 @@ impl InputTriangles {
             let v = mesh.constrained[f as usize]
                 .vertices
                 .map(|v| mesh.points[v as usize].as_dvec3());
-            let n = (v[1] - v[0]).cross(v[2] - v[0]);
-            let area = n.length_squared().max(f64::MIN_POSITIVE);
-            let b1 = (p - v[0]).cross(v[2] - v[0]).dot(n) / area;
-            let b2 = (v[1] - v[0]).cross(p - v[0]).dot(n) / area;
-            (1.0 - b1 - b2).min(b1).min(b2)
+            let ([b0, b1, b2], _) = plane_barycentrics(v, p);
+            b0.min(b1).min(b2)
         };
         // The first piece that holds `p`, else the one it lies deepest in
         // (rounding puts a point on a seam a hair outside both pieces).
@@ -158,6 +155,19 @@ impl InputTriangles {
             [x, y, z]
         }
     }
+}
+
+/// The barycentric weights of point `p` (of the triangle's plane, or
+/// projected on it) with respect to the triangle `v`, signed (negative
+/// outside an edge), and the triangle's normal `(v1 − v0) × (v2 − v0)`.
+/// In f64: a scene at 1e30 has normals whose squared length overflows f32.
+pub fn plane_barycentrics(v: [DVec3; 3], p: DVec3) -> ([f64; 3], DVec3) {
+    let n = (v[1] - v[0]).cross(v[2] - v[0]);
+    let area = n.length_squared().max(f64::MIN_POSITIVE);
+    // Signed areas of the sub-triangles opposite vertices 1 and 2.
+    let b1 = (p - v[0]).cross(v[2] - v[0]).dot(n) / area;
+    let b2 = (v[1] - v[0]).cross(p - v[0]).dot(n) / area;
+    ([1.0 - b1 - b2, b1, b2], n)
 }
 
 #[cfg(test)]

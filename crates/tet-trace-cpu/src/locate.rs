@@ -74,8 +74,9 @@ pub fn locate(mesh: &TetMesh, p: Vec3, source: u32) -> Result<u32, LocateError> 
         return Ok(t);
     }
     // The boundary or the step cap: outside a convex mesh, but a non-convex
-    // one may still hold the point elsewhere: scan. A point beyond the bounds of the mesh points lies in no tet: no scan
-    // (a camera or light outside a tight enclosing box, every frame).
+    // one may still hold the point elsewhere: scan, unless the point lies
+    // beyond the bounds of the mesh points, in no tet (a camera or light
+    // outside a tight enclosing box, every frame).
     let (lo, hi) = mesh.point_bounds();
     if p.cmplt(lo).any() || p.cmpgt(hi).any() {
         return Err(LocateError::OutsideMesh { point: p });

@@ -77,9 +77,7 @@ fn check(mesh: &TetMesh, values: &[f32], query: &IsoQuery, rays: &[Ray]) -> (usi
     let (mut hits, mut handed) = (0, 0);
     for layout in WalkLayout::ALL {
         let culling = IsoWalk::new(mesh, values, layout).unwrap();
-        let w = IsoWalk::new(mesh, values, layout)
-            .unwrap()
-            .without_regions();
+        let w = IsoWalk::with_regions(mesh, values, layout, false).unwrap();
         let vp = w.viewpoint(rays[0].origin).unwrap();
         let run_on = |w: &IsoWalk, how| {
             let mut out = vec![IsoOutcome::Miss { tets_visited: 0 }; rays.len()];

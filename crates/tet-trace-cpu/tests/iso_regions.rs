@@ -85,9 +85,7 @@ fn compare(mesh: &TetMesh, values: &[f32], query: &IsoQuery, rays: &[Ray]) -> Co
     let mut n = Counts::default();
     for layout in [WalkLayout::Tet20, WalkLayout::Tet16] {
         let with = IsoWalk::new(mesh, values, layout).unwrap();
-        let plain = IsoWalk::new(mesh, values, layout)
-            .unwrap()
-            .without_regions();
+        let plain = IsoWalk::with_regions(mesh, values, layout, false).unwrap();
         assert!(with.bytes() > plain.bytes());
         let vp = with.viewpoint(rays[0].origin).unwrap();
         for how in [TileWalk::Lockstep, TileWalk::Interleaved] {

@@ -95,12 +95,7 @@ impl RegionTree {
     /// value range `ranges[t] = [min, max]`.
     pub fn new(mesh: &TetMesh, ranges: &[[f32; 2]]) -> RegionTree {
         let (nodes, order) = tree(mesh, BuildKind::Bih, REGION_TETS);
-        let (lo, hi) = mesh
-            .points
-            .iter()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(*p), hi.max(*p))
-            });
+        let (lo, hi) = mesh.point_bounds();
         let (diagonal, largest) = if mesh.points.is_empty() {
             (0.0, 0.0)
         } else {
@@ -153,11 +148,6 @@ impl RegionTree {
     /// Bytes of the tree (nodes and the tet order).
     pub fn bytes(&self) -> usize {
         std::mem::size_of_val(&self.nodes[..]) + std::mem::size_of_val(&self.order[..])
-    }
-
-    /// Regions (leaves).
-    pub fn regions(&self) -> usize {
-        self.nodes.iter().filter(|n| n.is_leaf()).count()
     }
 
     /// What the regions say of each ray of a tile ([`RegionHit`]):

@@ -36,8 +36,10 @@
 //!
 //! A tile of rays ([`IsoWalk::trace_tile`]) first asks the regions'
 //! min-max tree ([`super::regions`]) which of its rays may meet an
-//! isosurface; the others are misses without a walk (most camera rays of a
-//! volume: the walk alone crosses the whole volume to learn that).
+//! isosurface, and where: the others are misses without a walk (most camera
+//! rays of a volume: the walk alone crosses the whole volume to learn
+//! that), and a ray whose first region lies deep inside starts its walk
+//! there (`walk/skip.rs`).
 //!
 //! Tiles of rays from outside the volume ([`IsoWalk::trace_tile`]) walk
 //! the stretch before the first tet that straddles an isovalue in the SIMD
@@ -275,19 +277,6 @@ impl<'m> IsoWalk<'m> {
         })
     }
 
-    /// The same walk without the regions' min-max tree: every ray of a
-    /// tile walks until it leaves the volume (comparisons and tests; the
-    /// outcomes of rays that meet an isosurface are the same).
-    pub fn without_regions(mut self) -> Self {
-        self.regions = None;
-        self
-    }
-
-    /// The regions' min-max tree, if the walk keeps one.
-    pub fn regions(&self) -> Option<&RegionTree> {
-        self.regions.as_ref()
-    }
-
     /// The same walk over other values of the same points (a new time step:
     /// only the per-tet value ranges are recomputed, one pass over the tets).
     pub fn with_values(mut self, values: &'m [f32]) -> Result<Self, IsoError> {
@@ -491,15 +480,16 @@ impl<'m> IsoWalk<'m> {
                 while slot.is_none() && next < n {
                     let i = next;
                     next += 1;
-                    if regions[i] == RegionHit::None {
+                    let ray = &rays[i];
+                    let inside = match vp {
+                        Viewpoint::Inside(t) => Some(*t),
+                        Viewpoint::Outside(_) => None,
+                    };
+                    let Some(start) =
+                        self.tile_start(ray, regions[i], inside, &mut prev, &mut hint)
+                    else {
                         out[i] = IsoOutcome::Miss { tets_visited: 0 };
                         continue;
-                    }
-                    let ray = &rays[i];
-                    let start = match (self.skip_to(ray, regions[i], &mut prev), vp) {
-                        (Some(s), _) => Ok(s),
-                        (None, Viewpoint::Inside(t)) => Ok(Start::Tet(*t)),
-                        (None, Viewpoint::Outside(_)) => self.enter(ray, &mut hint),
                     };
                     let opened = match start {
                         _ if query.check().is_err() => Err(IsoOutcome::Failed {

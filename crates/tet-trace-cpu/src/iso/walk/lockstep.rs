@@ -15,7 +15,6 @@
 
 use tet_core::TetMesh;
 
-use super::super::regions::RegionHit;
 use super::super::walk_ray::Ctx;
 use super::super::{IsoQuery, IsoStats};
 use super::{IsoOutcome, IsoWalk, WalkState, converted};
@@ -80,13 +79,9 @@ impl IsoWalk<'_> {
         let mut hint = EntryHint::default();
         let (mut index, mut starts, mut walking) = (Vec::new(), Vec::new(), Vec::new());
         for (i, ray) in rays[..n].iter().enumerate() {
-            if regions[i] == RegionHit::None {
+            let Some(start) = self.tile_start(ray, regions[i], None, &mut prev, &mut hint) else {
                 out[i] = IsoOutcome::Miss { tets_visited: 0 };
                 continue;
-            }
-            let start = match self.skip_to(ray, regions[i], &mut prev) {
-                Some(s) => Ok(s),
-                None => self.enter(ray, &mut hint),
             };
             match start {
                 Ok(s) => {

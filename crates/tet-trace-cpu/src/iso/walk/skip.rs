@@ -18,10 +18,10 @@ use tet_core::FACE_VERTICES;
 use super::super::regions::RegionHit;
 use super::IsoWalk;
 use crate::locate::locate_near;
-use crate::ray::Ray;
+use crate::ray::{Ray, TraceOutcome};
 use crate::walk::projection::Projection;
 use crate::walk::start::start_scale;
-use crate::walk::{DuffF32, Start};
+use crate::walk::{DuffF32, EntryHint, Start};
 
 /// Steps of the point location from a neighbouring ray's start tet.
 const LOCATE_STEPS: usize = 32;
@@ -30,15 +30,32 @@ const LOCATE_STEPS: usize = 32;
 const MIN_STEPS_SAVED: f32 = 4.0;
 
 impl IsoWalk<'_> {
-    /// The start of `ray`'s walk at its first region `region`, if that is
-    /// worth it and found; `prev` carries the last start tet between the
-    /// rays of a tile (the point location's source).
-    pub(super) fn skip_to(
+    /// Where a tile's ray starts: `None` when the regions cull it (a miss
+    /// without a walk); else at its first region ([`IsoWalk::skip_to`]),
+    /// or else in the viewpoint's tet `inside`, or through the boundary face
+    /// its line enters by.
+    pub(super) fn tile_start(
         &self,
         ray: &Ray,
         region: RegionHit,
+        inside: Option<u32>,
         prev: &mut Option<u32>,
-    ) -> Option<Start> {
+        hint: &mut EntryHint,
+    ) -> Option<Result<Start, TraceOutcome>> {
+        if region == RegionHit::None {
+            return None;
+        }
+        Some(match (self.skip_to(ray, region, prev), inside) {
+            (Some(s), _) => Ok(s),
+            (None, Some(t)) => Ok(Start::Tet(t)),
+            (None, None) => self.enter(ray, hint),
+        })
+    }
+
+    /// The start of `ray`'s walk at its first region `region`, if that is
+    /// worth it and found; `prev` carries the last start tet between the
+    /// rays of a tile (the point location's source).
+    fn skip_to(&self, ray: &Ray, region: RegionHit, prev: &mut Option<u32>) -> Option<Start> {
         let RegionHit::At { t, near } = region else {
             return None;
         };
