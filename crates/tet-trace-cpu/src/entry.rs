@@ -38,7 +38,14 @@
 //! that the previous ray of the batch entered through is tested first
 //! (neighbouring pixels nearly always share it); when that fails, a slab
 //! test against the mesh bounds rejects most misses before the other faces
-//! are tested.
+//! are tested. A ray that misses the bounds by a clear margin (a millionth
+//! of its distance to them, far above the rounding of the face test) makes
+//! the next ray test the bounds first, before its projection is set up:
+//! the rays that stream past the mesh in the margins of a frame then cost a
+//! slab test each (the Armadillo seen from 2 000 units, 1920×1440, one
+//! thread: 48 → 28 ns per ray, obvhs 24 ns), and a ray that does not
+//! clearly miss takes the path above, so every outcome is the same as
+//! without it.
 
 use glam::Vec3;
 use tet_core::TetMesh;

@@ -430,7 +430,7 @@ pub fn render_scene_into<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
                 outcomes.resize(rays.len(), TraceOutcome::Miss { tets_visited: 0 });
                 view.trace_batch(tracer, &rays, &mut outcomes);
                 for ((ray, o), &k) in rays.iter().zip(&outcomes).zip(&ids) {
-                    let p = shade(shadow, mesh, ray, *o, k, &frame_lights, opts);
+                    let p = shade(shadow, mesh, ray, o, k, &frame_lights, opts);
                     let local = k as usize - (y0 * w) as usize;
                     color[local] = p.color;
                     tets[local] = p.tets;
@@ -473,7 +473,7 @@ fn shade<S: ShadowTracer + ?Sized>(
     shadow: &S,
     mesh: &TetMesh,
     ray: &Ray,
-    out: TraceOutcome,
+    out: &TraceOutcome,
     pixel: u32,
     lights: &FrameLights<'_>,
     opts: &RenderOptions,
@@ -492,7 +492,7 @@ fn shade<S: ShadowTracer + ?Sized>(
     };
     px.hit = true;
     px.triangle = hit.triangle;
-    let n = shading_normal(mesh, &hit);
+    let n = shading_normal(mesh, hit);
     let p = ray.at(hit.t);
     if opts.headlight {
         px.color = Vec3::splat(n.dot(-ray.direction.normalize()).abs());
@@ -507,7 +507,7 @@ fn shade<S: ShadowTracer + ?Sized>(
         }
         if opts.shadows {
             px.shadow_rays += 1;
-            match trace_shadow(shadow, &hit, target) {
+            match trace_shadow(shadow, hit, target) {
                 Some(TraceOutcome::Hit(_)) => continue,
                 Some(TraceOutcome::Failed { .. }) => px.shadow_failures += 1,
                 _ => {}
@@ -521,9 +521,9 @@ fn shade<S: ShadowTracer + ?Sized>(
             pixel,
         );
         let e = if opts.shadows {
-            irradiance(shadow, &hit, n, light, opts.area_samples, seed)
+            irradiance(shadow, hit, n, light, opts.area_samples, seed)
         } else {
-            irradiance_unshadowed(mesh, &hit, n, light, opts.area_samples, seed)
+            irradiance_unshadowed(mesh, hit, n, light, opts.area_samples, seed)
         };
         px.shadow_rays += e.rays;
         px.shadow_failures += e.failures;

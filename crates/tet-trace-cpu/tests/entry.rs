@@ -290,6 +290,71 @@ fn batches_from_outside_equal_single_rays() {
     }
 }
 
+/// Rays that stream past the mesh let the next ray test the bounds before
+/// anything else (`BoundaryEntry::clearly_misses`): a batch whose rays
+/// alternate between clear misses and rays aimed at the boundary's corners
+/// and edge midpoints, pushed outward by 0 to 10⁻³ of their distance, gives
+/// exactly the single-ray outcomes, and the rays aimed within rounding of
+/// the boundary still enter. Near the world origin and far from it.
+#[test]
+fn rays_streaming_past_the_mesh_equal_single_rays() {
+    for offset in [Vec3::ZERO, Vec3::new(3.0e4, -2.0e4, 1.0e4)] {
+        let mut mesh = grid(4, 0.1, 0.05, true, 8);
+        for p in &mut mesh.points {
+            *p += offset;
+        }
+        let origin = offset + Vec3::new(-3.0, 7.5, 9.0);
+        let view = Viewpoint::locate(&mesh, origin).unwrap();
+        let (lo, hi) = mesh.point_bounds();
+        let centre = (lo + hi) * 0.5;
+        let mut targets = Vec::new();
+        for x in [lo.x, centre.x, hi.x] {
+            for y in [lo.y, centre.y, hi.y] {
+                for z in [lo.z, centre.z, hi.z] {
+                    let p = Vec3::new(x, y, z);
+                    // Corners and edge midpoints: two or three coordinates on the bounds.
+                    let on = (0..3).filter(|&a| p[a] != centre[a]).count();
+                    if on >= 2 {
+                        targets.push(p);
+                    }
+                }
+            }
+        }
+        let away = Ray::new(origin, origin - centre);
+        let mut rays = Vec::new();
+        for p in &targets {
+            for push in [0.0f32, 1e-9, 1e-8, 1e-7, 1e-6, 3e-6, 1e-5, 1e-3] {
+                let out = (*p - centre).normalize() * (*p - origin).length() * push;
+                rays.push(away);
+                rays.push(Ray::new(origin, *p + out - origin));
+            }
+        }
+        for t in exact(&mesh) {
+            let mut out = vec![
+                TraceOutcome::Miss {
+                    tets_visited: u32::MAX
+                };
+                rays.len()
+            ];
+            view.trace_batch(t.as_ref(), &rays, &mut out);
+            let mut entered_near = 0;
+            for (k, (r, o)) in rays.iter().zip(&out).enumerate() {
+                assert_eq!(
+                    *o,
+                    trace_outside(t.as_ref(), &view, r),
+                    "{} on {r:?}",
+                    t.name()
+                );
+                // Aimed exactly at a visible boundary point (push 0).
+                if k % 16 == 1 && o.tets_visited() > 0 {
+                    entered_near += 1;
+                }
+            }
+            assert!(entered_near >= 4, "{}: {entered_near}", t.name());
+        }
+    }
+}
+
 /// A boundary with a pit (the top middle cell of a 3³ grid removed) is
 /// refused with the face where it bends inward; a viewpoint inside is
 /// located as before.

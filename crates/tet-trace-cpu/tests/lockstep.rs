@@ -20,7 +20,7 @@ use tet_trace_cpu::lockstep::{
 };
 use tet_trace_cpu::reference::{Aim, random_point_inside, ray_from_feature};
 use tet_trace_cpu::render::PinholeCamera;
-use tet_trace_cpu::walk::Topology;
+use tet_trace_cpu::walk::{Topology, start_scale};
 use tet_trace_cpu::{DuffF32, Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint, locate};
 
 mod common;
@@ -178,6 +178,58 @@ fn empty_and_tiny_batches() {
     for n in [0, 1, 2, 7, 8, 9, 17] {
         let rays = batch(&mesh, &mut rng, origin, n);
         check_batch(&t, &rays, start);
+    }
+}
+
+/// Rays from several origins inside one start tet, interleaved in one
+/// batch (`Starts::Same`): the batch reuses a projection scale only while
+/// the origin stays the same, so each ray walks as if alone. Also on the
+/// grid scaled by 2²⁰, where the scale is not 1 and differs between
+/// origins near a vertex and at the centroid of one tet.
+#[test]
+fn one_start_tet_many_origins() {
+    for scale in [1.0f32, (1u32 << 20) as f32] {
+        let mut mesh = grid(4, 0.1, 0.1, false, 11);
+        for p in &mut mesh.points {
+            *p *= scale;
+        }
+        let t = tet_trace_cpu::tet20::Tet20Tracer::<DuffF32>::new(&mesh).unwrap();
+        let mut rng = SplitMix64(12);
+        let mut checked = 0;
+        let mut mixed_scales = 0;
+        for tet in (0..mesh.tets.len() as u32).step_by(17) {
+            let v = mesh.tets[tet as usize].map(|i| mesh.points[i as usize]);
+            // Interior points of the tet; those that rounding puts in
+            // another tet are skipped.
+            let weights = [
+                [0.25f32; 4],
+                [0.94, 0.02, 0.02, 0.02],
+                [0.02, 0.02, 0.94, 0.02],
+                [0.1, 0.3, 0.3, 0.3],
+            ];
+            let origins: Vec<Vec3> = weights
+                .iter()
+                .map(|w| v[0] * w[0] + v[1] * w[1] + v[2] * w[2] + v[3] * w[3])
+                .filter(|&o| locate(&mesh, o, tet) == Ok(tet))
+                .collect();
+            if origins.len() < 2 {
+                continue;
+            }
+            let rays: Vec<Ray> = (0..40)
+                .flat_map(|i| batch(&mesh, &mut rng, origins[i % origins.len()], 1))
+                .collect();
+            let scales: Vec<u32> = rays
+                .iter()
+                .map(|r| start_scale(&mesh, r, Start::Tet(tet)).to_bits())
+                .collect();
+            mixed_scales += scales.iter().any(|&x| x != scales[0]) as usize;
+            check_batch(&t, &rays, Start::Tet(tet));
+            checked += 1;
+        }
+        assert!(checked > 10, "{checked} tets checked at scale {scale}");
+        if scale > 1.0 {
+            assert!(mixed_scales > 3, "{mixed_scales} batches mix scales");
+        }
     }
 }
 

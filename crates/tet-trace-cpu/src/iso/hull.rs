@@ -130,7 +130,7 @@ impl Hull {
             return None;
         }
         // The surface walk from the hint face.
-        let mut at = hint.0;
+        let mut at = hint.face;
         for _ in 0..SURFACE_STEPS {
             let Some(f) = self.faces.get(at) else { break };
             if !front(f) {
@@ -138,7 +138,7 @@ impl Hull {
             }
             let m = edges(f);
             if m == 7 {
-                hint.0 = at;
+                hint.face = at;
                 return Some(start(f));
             }
             let k = (!m).trailing_zeros() as usize;
@@ -158,7 +158,7 @@ impl Hull {
                 let range = n.index as usize..(n.index + n.count) as usize;
                 for j in range {
                     if enters(&self.faces[j]) {
-                        hint.0 = j;
+                        hint.face = j;
                         return Some(start(&self.faces[j]));
                     }
                 }

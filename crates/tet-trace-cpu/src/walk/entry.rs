@@ -50,10 +50,18 @@ struct EntryFace {
     link: Link,
 }
 
-/// The boundary face a previous ray entered through (coherent rays share
-/// it, so it is tested first).
+/// What the previous ray of a batch met, tested first for the next
+/// (coherent rays share it): the boundary face it entered through, or
+/// whether it missed the mesh's bounds clearly
+/// ([`BoundaryEntry::clearly_misses`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct EntryHint(pub(crate) usize);
+pub struct EntryHint {
+    /// Index of the face entered last.
+    pub(crate) face: usize,
+    /// The previous ray missed the bounds clearly: the next tests the
+    /// bounds before setting up its projection.
+    pub(crate) outside: bool,
+}
 
 /// The boundary faces of a convex mesh, for rays that start outside it.
 #[derive(Clone, Debug)]
@@ -156,10 +164,34 @@ impl BoundaryEntry {
         ray: &Ray,
         hint: &mut EntryHint,
     ) -> Result<Start, TraceOutcome> {
-        if !ray.is_valid() {
+        if !ray.is_valid() || self.misses_first(ray, hint) {
             return Err(miss_outside(ray));
         }
         self.start_projected(mesh, ray, &P::setup_scaled(ray, self.scale(ray)), hint)
+    }
+
+    /// For a valid ray, before its projection is set up: true when the
+    /// previous ray of the batch missed the mesh's bounds clearly and this
+    /// one does too, so that it is a miss that visits no tet; the hint
+    /// then keeps testing the bounds first. Rays that stream past the mesh
+    /// (the margins of a frame) so skip the projection and the face test.
+    #[inline(always)]
+    pub(crate) fn misses_first(&self, ray: &Ray, hint: &mut EntryHint) -> bool {
+        if !hint.outside {
+            return false;
+        }
+        hint.outside = self.clearly_misses(ray);
+        hint.outside
+    }
+
+    /// True when the ray misses the mesh's bounds grown by a millionth of
+    /// the distance from its origin to their farthest corner (plus the
+    /// padding of [`BoundaryEntry::misses_bounds`]): far more than the
+    /// rounding of the f32 face test, so no face can pass it.
+    pub(crate) fn clearly_misses(&self, ray: &Ray) -> bool {
+        let o = ray.origin.as_dvec3();
+        let far = (self.lo - o).abs().max((self.hi - o).abs()).max_element();
+        slab_misses(ray, self.lo, self.hi, far * 1e-6 + self.pad())
     }
 
     /// The factor of the projection of a ray from outside ([`walk_scale`]):
@@ -210,19 +242,20 @@ impl BoundaryEntry {
                 && (faced || faces_origin(mesh, f, ray.origin))
         };
         let n = self.faces.len();
-        let first = hint.0.min(n.saturating_sub(1));
+        let first = hint.face.min(n.saturating_sub(1));
         // The previous ray's face first: coherent rays nearly always share
         // it, and then need no bounds test.
         if n > 0 && enters(&self.faces[first]) {
             return Some(self.faces[first]);
         }
         if self.misses_bounds(ray) {
+            hint.outside = self.clearly_misses(ray);
             return None;
         }
         let k = (1..n)
             .map(|i| (first + i) % n)
             .find(|&k| enters(&self.faces[k]))?;
-        hint.0 = k;
+        hint.face = k;
         Some(self.faces[k])
     }
 
@@ -230,25 +263,35 @@ impl BoundaryEntry {
     /// (slab test in f64 on bounds grown by a relative 1e-9, far more than
     /// the rounding of the test).
     fn misses_bounds(&self, ray: &Ray) -> bool {
-        let o = ray.origin.as_dvec3();
-        let d = ray.direction.as_dvec3();
-        let pad = (self.hi - self.lo).max_element() * 1e-9 + 1e-30;
-        let (lo, hi) = (self.lo - DVec3::splat(pad), self.hi + DVec3::splat(pad));
-        let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
-        for a in 0..3 {
-            if d[a] == 0.0 {
-                if o[a] < lo[a] || o[a] > hi[a] {
-                    return true;
-                }
-                continue;
-            }
-            let inv = 1.0 / d[a];
-            let (u, v) = ((lo[a] - o[a]) * inv, (hi[a] - o[a]) * inv);
-            t0 = t0.max(u.min(v));
-            t1 = t1.min(u.max(v));
-        }
-        t0 > t1 * (1.0 + 1e-12)
+        slab_misses(ray, self.lo, self.hi, self.pad())
     }
+
+    /// The padding of the bounds in [`BoundaryEntry::misses_bounds`].
+    fn pad(&self) -> f64 {
+        (self.hi - self.lo).max_element() * 1e-9 + 1e-30
+    }
+}
+
+/// True when the ray certainly misses the box `lo..hi` grown by `pad` on
+/// every side ahead of its origin (slab test in f64).
+fn slab_misses(ray: &Ray, lo: DVec3, hi: DVec3, pad: f64) -> bool {
+    let o = ray.origin.as_dvec3();
+    let d = ray.direction.as_dvec3();
+    let (lo, hi) = (lo - DVec3::splat(pad), hi + DVec3::splat(pad));
+    let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+    for a in 0..3 {
+        if d[a] == 0.0 {
+            if o[a] < lo[a] || o[a] > hi[a] {
+                return true;
+            }
+            continue;
+        }
+        let inv = 1.0 / d[a];
+        let (u, v) = ((lo[a] - o[a]) * inv, (hi[a] - o[a]) * inv);
+        t0 = t0.max(u.min(v));
+        t1 = t1.min(u.max(v));
+    }
+    t0 > t1 * (1.0 + 1e-12)
 }
 
 /// True when `origin` lies on the outer side of face `f`'s plane or on it.

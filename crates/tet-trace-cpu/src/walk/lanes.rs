@@ -2,11 +2,12 @@
 //! every batch walk draws its lanes from, and the scalar interleaved walk
 //! ([`trace_interleaved`]).
 
+use glam::Vec3;
 use tet_core::TetMesh;
 
 use super::entry::{BoundaryEntry, EntryHint};
 use super::projection::Projection;
-use super::start::{Lane, Start, begin, begin_with};
+use super::start::{Lane, Start, begin, begin_with, start_scale};
 use super::step::{advance, finish_step};
 use super::stop::Advance;
 use super::topology::Topology;
@@ -43,6 +44,9 @@ pub(crate) struct Feed<'a> {
     /// The boundary face the last ray from outside entered through (tested
     /// first for the next, see [`crate::entry`]).
     hint: EntryHint,
+    /// The projection scale of the last ray started from [`Starts::Same`]
+    /// and its origin: rays from one viewpoint share it.
+    same_scale: Option<(Vec3, f32)>,
     pub(crate) out: &'a mut [TraceOutcome],
 }
 
@@ -63,6 +67,7 @@ impl<'a> Feed<'a> {
             start,
             next: 0,
             hint: EntryHint::default(),
+            same_scale: None,
             out: &mut out[..n],
         }
     }
@@ -77,7 +82,7 @@ impl<'a> Feed<'a> {
             self.next += 1;
             let ray = &self.rays[i];
             let lane = match self.start {
-                Starts::Same(s) => begin::<P>(mesh, ray, s),
+                Starts::Same(s) => begin_same::<P>(mesh, ray, s, &mut self.same_scale),
                 Starts::Each(s) => begin::<P>(mesh, ray, s[i]),
                 Starts::Outside(entry) => begin_outside::<P>(mesh, ray, entry, &mut self.hint),
             };
@@ -157,6 +162,33 @@ fn lane_event<P: Projection>(
     }
 }
 
+/// [`begin`] for rays that share a start: the projection scale, a
+/// function of the start tet and the origin ([`start_scale`]), is computed
+/// again only when the origin changes.
+#[inline(always)]
+fn begin_same<P: Projection>(
+    mesh: &TetMesh,
+    ray: &Ray,
+    start: Start,
+    last: &mut Option<(Vec3, f32)>,
+) -> Result<Lane<P>, TraceOutcome> {
+    if !ray.is_valid() {
+        return Err(TraceOutcome::Failed {
+            failure: Failure::InvalidRay,
+            tets_visited: 0,
+        });
+    }
+    let scale = match *last {
+        Some((o, scale)) if o == ray.origin => scale,
+        _ => {
+            let scale = start_scale(mesh, ray, start);
+            *last = Some((ray.origin, scale));
+            scale
+        }
+    };
+    begin_with(mesh, ray, P::setup_scaled(ray, scale), start)
+}
+
 /// [`begin`] for a ray from outside the mesh: its entry is decided with the
 /// projection the walk then uses (set up once).
 #[inline(always)]
@@ -171,6 +203,9 @@ fn begin_outside<P: Projection>(
             failure: Failure::InvalidRay,
             tets_visited: 0,
         });
+    }
+    if entry.misses_first(ray, hint) {
+        return Err(TraceOutcome::Miss { tets_visited: 0 });
     }
     let proj = P::setup_scaled(ray, entry.scale(ray));
     let start = entry.start_projected(mesh, ray, &proj, hint)?;

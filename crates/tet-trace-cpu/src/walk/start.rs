@@ -76,18 +76,34 @@ fn start_in_tet<P: Projection>(mesh: &TetMesh, proj: &P, tet: u32) -> Option<Sta
                 && proj.left(p[b], v[b], p[c], v[c])
                 && proj.left(p[c], v[c], p[a], v[a])
         })
-        .map(|k| exit_state(mesh, proj, tet, k))
+        .map(|k| exit_state_of(mesh, tet, k, v, p))
 }
 
 /// The walk state after choosing face `k` of `tet` as the exit.
 fn exit_state<P: Projection>(mesh: &TetMesh, proj: &P, tet: u32, k: usize) -> State<P> {
     let v = mesh.tets[tet as usize];
+    exit_state_of(
+        mesh,
+        tet,
+        k,
+        v,
+        v.map(|i| proj.project(mesh.points[i as usize])),
+    )
+}
+
+/// [`exit_state`] from the tet's vertices `v` and their projections `p`.
+fn exit_state_of<P: Projection>(
+    mesh: &TetMesh,
+    tet: u32,
+    k: usize,
+    v: [u32; 4],
+    p: [P::P; 4],
+) -> State<P> {
     let [a, b, c] = FACE_VERTICES[k];
-    let ids = [v[a], v[b], v[c]];
     State {
         tet,
-        ids,
-        p: P::face(ids.map(|i| proj.project(mesh.points[i as usize]))),
+        ids: [v[a], v[b], v[c]],
+        p: P::face([p[a], p[b], p[c]]),
         link: mesh.neighbors[tet as usize][k].0,
         visited: 1,
     }
