@@ -52,8 +52,8 @@ struct EntryFace {
 
 /// What the previous ray of a batch met, tested first for the next
 /// (coherent rays share it): the boundary face it entered through, or
-/// whether it missed the mesh's bounds clearly
-/// ([`BoundaryEntry::clearly_misses`]).
+/// whether it missed the mesh's bounds by a clear margin (a millionth of
+/// its distance to them).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct EntryHint {
     /// Index of the face entered last.
