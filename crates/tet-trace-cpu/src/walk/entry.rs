@@ -188,17 +188,25 @@ impl BoundaryEntry {
     /// the distance from its origin to their farthest corner (plus the
     /// padding of [`BoundaryEntry::misses_bounds`]): far more than the
     /// rounding of the f32 face test, so no face can pass it.
-    pub(crate) fn clearly_misses(&self, ray: &Ray) -> bool {
+    fn clearly_misses(&self, ray: &Ray) -> bool {
+        slab_misses(
+            ray,
+            self.lo,
+            self.hi,
+            self.farthest(ray) * 1e-6 + self.pad(),
+        )
+    }
+
+    /// The largest `|corner − origin|∞` over the corners of the bounds.
+    fn farthest(&self, ray: &Ray) -> f64 {
         let o = ray.origin.as_dvec3();
-        let far = (self.lo - o).abs().max((self.hi - o).abs()).max_element();
-        slab_misses(ray, self.lo, self.hi, far * 1e-6 + self.pad())
+        (self.lo - o).abs().max((self.hi - o).abs()).max_element()
     }
 
     /// The factor of the projection of a ray from outside ([`walk_scale`]):
     /// from the farthest corner of the mesh's bounds seen from its origin.
     pub(crate) fn scale(&self, ray: &Ray) -> f32 {
-        let o = ray.origin.as_dvec3();
-        walk_scale((self.lo - o).abs().max((self.hi - o).abs()).max_element())
+        walk_scale(self.farthest(ray))
     }
 
     /// [`BoundaryEntry::start_with`] for a valid ray whose projection is set

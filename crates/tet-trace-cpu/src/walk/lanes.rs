@@ -7,7 +7,7 @@ use tet_core::TetMesh;
 
 use super::entry::{BoundaryEntry, EntryHint};
 use super::projection::Projection;
-use super::start::{Lane, Start, begin, begin_with, start_scale};
+use super::start::{Lane, Start, begin, begin_scaled, begin_with, start_scale};
 use super::step::{advance, finish_step};
 use super::stop::Advance;
 use super::topology::Topology;
@@ -172,12 +172,6 @@ fn begin_same<P: Projection>(
     start: Start,
     last: &mut Option<(Vec3, f32)>,
 ) -> Result<Lane<P>, TraceOutcome> {
-    if !ray.is_valid() {
-        return Err(TraceOutcome::Failed {
-            failure: Failure::InvalidRay,
-            tets_visited: 0,
-        });
-    }
     let scale = match *last {
         Some((o, scale)) if o == ray.origin => scale,
         _ => {
@@ -186,11 +180,14 @@ fn begin_same<P: Projection>(
             scale
         }
     };
-    begin_with(mesh, ray, P::setup_scaled(ray, scale), start)
+    begin_scaled(mesh, ray, start, scale)
 }
 
 /// [`begin`] for a ray from outside the mesh: its entry is decided with the
-/// projection the walk then uses (set up once).
+/// projection the walk then uses (set up once). The steps of
+/// [`BoundaryEntry::start_with`], spelled out here: one function returning
+/// the projection with the start served both, and the batch walks from
+/// outside ran 3–5 % slower (Torus Knots and Armadillo, one thread).
 #[inline(always)]
 fn begin_outside<P: Projection>(
     mesh: &TetMesh,

@@ -76,34 +76,33 @@ fn start_in_tet<P: Projection>(mesh: &TetMesh, proj: &P, tet: u32) -> Option<Sta
                 && proj.left(p[b], v[b], p[c], v[c])
                 && proj.left(p[c], v[c], p[a], v[a])
         })
-        .map(|k| exit_state_of(mesh, tet, k, v, p))
+        .map(|k| {
+            let [a, b, c] = FACE_VERTICES[k];
+            exit_state_of(mesh, tet, k, [v[a], v[b], v[c]], [p[a], p[b], p[c]])
+        })
 }
 
 /// The walk state after choosing face `k` of `tet` as the exit.
 fn exit_state<P: Projection>(mesh: &TetMesh, proj: &P, tet: u32, k: usize) -> State<P> {
     let v = mesh.tets[tet as usize];
-    exit_state_of(
-        mesh,
-        tet,
-        k,
-        v,
-        v.map(|i| proj.project(mesh.points[i as usize])),
-    )
+    let [a, b, c] = FACE_VERTICES[k];
+    let ids = [v[a], v[b], v[c]];
+    let p = ids.map(|i| proj.project(mesh.points[i as usize]));
+    exit_state_of(mesh, tet, k, ids, p)
 }
 
-/// [`exit_state`] from the tet's vertices `v` and their projections `p`.
+/// [`exit_state`] from the face's vertex ids and their projections.
 fn exit_state_of<P: Projection>(
     mesh: &TetMesh,
     tet: u32,
     k: usize,
-    v: [u32; 4],
-    p: [P::P; 4],
+    ids: [u32; 3],
+    p: [P::P; 3],
 ) -> State<P> {
-    let [a, b, c] = FACE_VERTICES[k];
     State {
         tet,
-        ids: [v[a], v[b], v[c]],
-        p: P::face([p[a], p[b], p[c]]),
+        ids,
+        p: P::face(p),
         link: mesh.neighbors[tet as usize][k].0,
         visited: 1,
     }
@@ -227,18 +226,25 @@ pub(crate) fn begin<P: Projection>(
     ray: &Ray,
     start: Start,
 ) -> Result<Lane<P>, TraceOutcome> {
+    begin_scaled(mesh, ray, start, start_scale(mesh, ray, start))
+}
+
+/// [`begin`] with the projection's scale for `ray` and `start` known
+/// ([`start_scale`]; rays from one origin share it).
+#[inline(always)]
+pub(crate) fn begin_scaled<P: Projection>(
+    mesh: &TetMesh,
+    ray: &Ray,
+    start: Start,
+    scale: f32,
+) -> Result<Lane<P>, TraceOutcome> {
     if !ray.is_valid() {
         return Err(TraceOutcome::Failed {
             failure: Failure::InvalidRay,
             tets_visited: 0,
         });
     }
-    begin_with(
-        mesh,
-        ray,
-        P::setup_scaled(ray, start_scale(mesh, ray, start)),
-        start,
-    )
+    begin_with(mesh, ray, P::setup_scaled(ray, scale), start)
 }
 
 /// The factor of a walk's projection ([`walk_scale`]) for `ray` starting
