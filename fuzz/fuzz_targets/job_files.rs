@@ -1,7 +1,7 @@
 //! cargo-fuzz target `job_files`: a thin wrapper around the shared body in
 //! `fuzz/targets_common/job_files.rs` (also run on stable by the corpus
-//! tests). Needs `--features job` (the out-of-core job module lives behind
-//! tet-build's `tetgen` feature).
+//! tests). Needs the fuzz crate's `job` feature, on by default (the
+//! out-of-core job module lives behind tet-build's `tetgen` feature).
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
