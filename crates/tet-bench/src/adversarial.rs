@@ -14,8 +14,14 @@ use tet_trace_cpu::walk::Start;
 /// random interior point exactly at a vertex, at a point of an edge, at a
 /// point of a face; along an edge (from one vertex of a tet towards
 /// another); from a point of a face, and from a vertex, in a random
-/// direction. The triangle each ray uses is a scene triangle every other
-/// ray and a face of a random tet (a scene triangle or not) otherwise.
+/// direction; and lying in the triangle's plane (the rays of flat
+/// surfaces: CAD caps, walls, floors): from a point of the face, and from
+/// a point of the plane a random distance before a point of an edge (the
+/// edge point itself where that lies outside the mesh), in a
+/// random direction of the plane (exactly in it when the plane is
+/// axis-aligned, else up to the direction's f32 rounding). The triangle
+/// each ray uses is a scene triangle every other ray and a face of a
+/// random tet (a scene triangle or not) otherwise.
 /// Points of edges and faces are random combinations rounded to f32 (on
 /// the feature up to that rounding). Each ray starts in a tet holding its
 /// origin (exact location).
@@ -50,10 +56,10 @@ pub fn adversarial_rays(mesh: &TetMesh, n: usize, seed: u64) -> Vec<(Ray, Option
         };
         let d = tri.map(|v| v.as_dvec3());
         let on_face = (d[0] + (d[1] - d[0]) * a + (d[2] - d[0]) * b).as_vec3();
-        let (origin, dir, hint) = match k % 6 {
+        let (origin, dir, hint) = match k % 8 {
             0..=2 => {
                 let (o, at) = tet_trace_cpu::reference::random_point_inside(mesh, &mut rng);
-                let target = [tri[0], on_edge, on_face][k % 6];
+                let target = [tri[0], on_edge, on_face][k % 8];
                 (o, target - o, at)
             }
             3 => {
@@ -62,7 +68,17 @@ pub fn adversarial_rays(mesh: &TetMesh, n: usize, seed: u64) -> Vec<(Ray, Option
                 (p[i], p[j] - p[i], t)
             }
             4 => (on_face, random_direction(&mut rng), near),
-            _ => (tri[0], random_direction(&mut rng), near),
+            5 => (tri[0], random_direction(&mut rng), near),
+            6 => (on_face, in_plane(&d, &mut rng), near),
+            _ => {
+                // From a point of the plane before the edge; from the edge
+                // itself where that point lies outside the mesh.
+                let dir = in_plane(&d, &mut rng);
+                let back = (d[1] - d[0]).length().max((d[2] - d[0]).length()) * rng.next_f64();
+                let before = on_edge - dir * back as f32;
+                let inside = tet_trace_cpu::locate(mesh, before, t).is_ok();
+                (if inside { before } else { on_edge }, dir, near)
+            }
         };
         if dir == Vec3::ZERO || !dir.is_finite() {
             continue;
@@ -77,4 +93,21 @@ pub fn adversarial_rays(mesh: &TetMesh, n: usize, seed: u64) -> Vec<(Ray, Option
         }
     }
     out
+}
+
+/// A random unit direction in the plane of triangle `v` (f64, rounded to
+/// f32); zero for a degenerate triangle (the ray is then skipped).
+fn in_plane(v: &[glam::DVec3; 3], rng: &mut SplitMix64) -> Vec3 {
+    let n = (v[1] - v[0]).cross(v[2] - v[0]);
+    if n.length_squared() == 0.0 {
+        return Vec3::ZERO;
+    }
+    let n = n.normalize();
+    loop {
+        let r = random_direction(rng).as_dvec3();
+        let d = r - n * r.dot(n);
+        if d.length() > 0.1 {
+            return d.normalize().as_vec3();
+        }
+    }
 }

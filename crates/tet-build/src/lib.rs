@@ -41,6 +41,7 @@
 
 pub mod bbox;
 pub mod clean;
+pub mod flat;
 pub mod intersect;
 #[cfg(feature = "tetgen")]
 pub mod outofcore;

@@ -44,6 +44,8 @@ pub const NAMES: &[&str] = &[
     "sphere",
     "two-quads",
     "thin-slab",
+    "gear",
+    "flat-parts",
 ];
 
 /// Parameterised names accepted by [`by_name`] besides [`NAMES`]:
@@ -65,6 +67,8 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "sphere" => single("sphere", icosphere(2)),
         "two-quads" => single("two-quads", two_quads(0.5)),
         "thin-slab" => single("thin-slab", thin_slab(0.01)),
+        "gear" => single("gear", crate::flat::gear(12, 0.3, 0.3)),
+        "flat-parts" => crate::flat::flat_parts(),
         _ => return by_pattern(name),
     })
 }

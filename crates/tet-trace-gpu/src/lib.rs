@@ -45,7 +45,7 @@
 //! | GETNEXTTET32/20/16 (Alg. 3, 5, 7) | `Topology::exit_link` | `layout_exit` |
 //! | `order_a`, `order_b` | `rank_of` | `rank_of` |
 //! | entry link (Tet16) | `Lane::entry_raw` | `s_entry` |
-//! | tie rule (symbolic perturbation) | `left_2d!` | `left` |
+//! | exact sign of a zero determinant, tie rule (symbolic perturbation) | `ExactDet`, `left_2d!` | `product_error`, `left` |
 //! | constrained-face crossing / hit | `resolve_face`, `face_hit` | `resolve` |
 //!
 //! GPU buffers: points (`12 B` each, `f32 x,y,z`), the layout's tet records
@@ -65,7 +65,13 @@
 //!   break watertightness. The kernel therefore compares the two rounded
 //!   products, `a.x·b.y > a.y·b.x`: for finite values `fl(l − r) > 0 ⇔ l > r`
 //!   (gradual underflow), so this is the CPU decision bit for bit, and no
-//!   contraction can apply (there is no addition). Differences only when a
+//!   contraction can apply (there is no addition). Equal rounded products
+//!   are decided, as on the CPU (`ExactDet`), by the exact determinant: the
+//!   difference of the two products' rounding errors, each exact by
+//!   Dekker's two-product over halves split with a bit mask (every partial
+//!   product is exact, so a fused multiply-add cannot change it); this is
+//!   what ends rays lying in the plane of flat faces (see
+//!   [`tet_trace_cpu::walk`], "Why the walk ends"). Differences only when a
 //!   product overflows to ±∞ or underflows into a subnormal on an adapter that
 //!   flushes subnormals to zero (coordinates beyond `~1e19` or below `~1e-19`
 //!   relative to the ray origin).

@@ -12,15 +12,42 @@ fn project(p: vec3<f32>) -> vec2<f32> {
                      r_v.x * q.x + r_v.y * q.y + r_v.z * q.z);
 }
 
+// x rounded to its upper 12 significant bits (half an ulp of those added to
+// the magnitude's bits, then masked): x - hi(x) is exact with at most 11
+// significant bits, the split of Dekker's product (Veltkamp's, without its
+// multiply, which a driver could fuse into a different split). Finite x of
+// the walk's magnitudes only (see `walk_scale` on the CPU).
+fn split_hi(x: f32) -> f32 {
+    return bitcast<f32>((bitcast<u32>(x) + 0x800u) & 0xFFFFF000u);
+}
+
+// The rounding error of p = fl(a * b), exactly: a * b = p + err (Dekker's
+// two-product). Every product of halves is exact, so a driver's fused
+// multiply-adds cannot change it.
+fn product_error(a: f32, b: f32, p: f32) -> f32 {
+    let ah = split_hi(a);
+    let al = a - ah;
+    let bh = split_hi(b);
+    let bl = b - bh;
+    return al * bl - (((p - ah * bh) - al * bh) - ah * bl);
+}
+
 // True when the ray passes left of the directed edge a -> b:
-// det(a, b) = a.x*b.y - a.y*b.x > 0, decided by comparing the two products
-// (never subtracted, so no fused multiply-add can break the exact
-// antisymmetry), ties by the symbolic perturbation of the CPU walk.
+// det(a, b) = a.x*b.y - a.y*b.x > 0, decided by comparing the two rounded
+// products (never subtracted, so no fused multiply-add can break the exact
+// antisymmetry; rounding is monotonic, so unequal rounded products order
+// the exact ones). Equal rounded products are decided by the exact
+// determinant, the difference of their rounding errors, as the CPU's
+// `ExactDet`; an exact zero by the symbolic perturbation of the CPU walk.
 fn left(a: vec2<f32>, ia: u32, b: vec2<f32>, ib: u32) -> bool {
     let l = a.x * b.y;
     let r = a.y * b.x;
     if (l != r) {
         return l > r;
+    }
+    let exact = product_error(a.x, b.y, l) - product_error(a.y, b.x, r);
+    if (exact != 0.0) {
+        return exact > 0.0;
     }
     if (a.y != b.y) {
         return a.y > b.y;

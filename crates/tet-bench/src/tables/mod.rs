@@ -230,8 +230,11 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
     for (index, planned) in plan(&scene_specs(args)?).into_iter().enumerate() {
         let spec = planned.spec.clone();
         eprintln!("scene {spec}");
-        // The robustness table's 10⁸ rays: on the first scene only.
-        let streamed = args.streamed_robustness_rays().filter(|_| index == 0);
+        // The robustness table's 10⁸ rays: on the first scene and on the
+        // flat-faced scene (rays in the planes of its flat faces).
+        let streamed = args
+            .streamed_robustness_rays()
+            .filter(|_| index == 0 || spec == plan::FLAT_SCENE);
         let result = measure_scene(&planned, &mut cache, args, &opts, frames, &pool, streamed);
         if planned.last
             && let Some(key) = planned.key

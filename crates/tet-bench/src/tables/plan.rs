@@ -15,8 +15,14 @@ use tet_core::TetMesh;
 use crate::cli::{BuildFlags, TablesArgs};
 use crate::load::{BuildSummary, Loaded, MESH_EXTENSION, build_scene_in, load, with_mesh};
 
+/// The default run's flat-faced scene ("Flat Parts": CAD-like solids on one
+/// shared plane, [`tet_build::flat::flat_parts`]), whose robustness rows
+/// take the full run's 10⁸ rays like the first scene's.
+pub const FLAT_SCENE: &str = "flat-parts";
+
 /// The scenes of a run: those of `--scenes`, then those of `--scene`;
-/// the procedural Torus Knots scenes when neither is given.
+/// the procedural Torus Knots scenes and [`FLAT_SCENE`] when neither is
+/// given.
 pub fn scene_specs(args: &TablesArgs) -> Result<Vec<String>> {
     let mut specs = Vec::new();
     if let Some(path) = &args.scenes {
@@ -29,7 +35,11 @@ pub fn scene_specs(args: &TablesArgs) -> Result<Vec<String>> {
     }
     specs.extend(args.scene.iter().cloned());
     if specs.is_empty() {
-        specs = vec!["torus-knots".into(), "torus-knots-box".into()];
+        specs = vec![
+            "torus-knots".into(),
+            "torus-knots-box".into(),
+            FLAT_SCENE.into(),
+        ];
     }
     Ok(specs)
 }

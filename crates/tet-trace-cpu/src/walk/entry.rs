@@ -12,7 +12,7 @@ use thiserror::Error;
 
 use super::projection::{DuffF32, Projection, walk_scale};
 use super::start::Start;
-use super::stop::{Resolved, resolve_constrained};
+use super::stop::{Resolved, face_hit, resolve_constrained};
 use crate::locate::LocateError;
 use crate::ray::{Failure, Ray, TraceOutcome};
 
@@ -185,8 +185,8 @@ impl BoundaryEntry {
     }
 
     /// True when the ray misses the mesh's bounds grown by a millionth of
-    /// the distance from its origin to their farthest corner (plus the
-    /// padding of [`BoundaryEntry::misses_bounds`]): far more than the
+    /// the distance from its origin to their farthest corner (plus a
+    /// relative 1e-9 of their size): far more than the
     /// rounding of the f32 face test, so no face can pass it.
     fn clearly_misses(&self, ray: &Ray) -> bool {
         slab_misses(
@@ -242,8 +242,8 @@ impl BoundaryEntry {
         hint: &mut EntryHint,
     ) -> Option<EntryFace> {
         let faced = self.seen_from == Some(ray.origin);
-        let enters = |f: &EntryFace| {
-            let p = f.ids.map(|i| proj.project(mesh.points[i as usize]));
+        let project = |f: &EntryFace| f.ids.map(|i| proj.project(mesh.points[i as usize]));
+        let winds = |f: &EntryFace, p: &[P::P; 3]| {
             proj.left(p[0], f.ids[0], p[1], f.ids[1])
                 && proj.left(p[1], f.ids[1], p[2], f.ids[2])
                 && proj.left(p[2], f.ids[2], p[0], f.ids[0])
@@ -253,28 +253,66 @@ impl BoundaryEntry {
         let first = hint.face.min(n.saturating_sub(1));
         // The previous ray's face first: coherent rays nearly always share
         // it, and then need no bounds test.
-        if n > 0 && enters(&self.faces[first]) {
-            return Some(self.faces[first]);
+        if n > 0 {
+            let p = project(&self.faces[first]);
+            if winds(&self.faces[first], &p) {
+                return Some(
+                    self.nearest_if_flat::<P>(mesh, ray, first, &p, |f| winds(f, &project(f))),
+                );
+            }
         }
         if self.misses_bounds(ray) {
-            hint.outside = self.clearly_misses(ray);
+            hint.outside = true;
             return None;
         }
-        let k = (1..n)
-            .map(|i| (first + i) % n)
-            .find(|&k| enters(&self.faces[k]))?;
+        let (k, p) = (1..n).map(|i| (first + i) % n).find_map(|k| {
+            let p = project(&self.faces[k]);
+            winds(&self.faces[k], &p).then_some((k, p))
+        })?;
         hint.face = k;
-        Some(self.faces[k])
+        Some(self.nearest_if_flat::<P>(mesh, ray, k, &p, |f| winds(f, &project(f))))
     }
 
-    /// True when the ray certainly misses the bounds of the mesh points
-    /// (slab test in f64 on bounds grown by a relative 1e-9, far more than
-    /// the rounding of the test).
+    /// Face `k` (projected `p`), which the ray's line enters, unless the
+    /// ray runs in (or within rounding of) its plane: then the walk's
+    /// decisions describe a line through a boundary that rounding made
+    /// slightly non-convex (see the walk's module docs, "Why the walk
+    /// ends"), the line may enter through several faces, and the one
+    /// nearest along the ray (f64 [`face_hit`]; the first in order on a
+    /// tie) is the entry, whatever face the search met first (so a batch
+    /// and a single ray agree).
+    fn nearest_if_flat<P: Projection>(
+        &self,
+        mesh: &TetMesh,
+        ray: &Ray,
+        k: usize,
+        p: &[P::P; 3],
+        enters: impl Fn(&EntryFace) -> bool,
+    ) -> EntryFace {
+        if !P::flat(p) {
+            return self.faces[k];
+        }
+        let t = |f: &EntryFace| face_hit(mesh, ray, f.ids).0;
+        self.faces
+            .iter()
+            .filter(|f| enters(f))
+            .map(|f| (t(f), f))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or(self.faces[k], |(_, f)| *f)
+    }
+
+    /// True when the ray certainly misses the bounds of the mesh points:
+    /// [`BoundaryEntry::clearly_misses`]. The margin (a millionth of the
+    /// distance to the farthest corner) exceeds the rounding of the f32
+    /// walk's own face test, which may take a ray running along a boundary
+    /// plane as entering it; a tighter bound (a relative 1e-9 once) culled
+    /// such rays alone but not after a ray that entered the same face,
+    /// so a batch and a single ray disagreed.
     fn misses_bounds(&self, ray: &Ray) -> bool {
-        slab_misses(ray, self.lo, self.hi, self.pad())
+        self.clearly_misses(ray)
     }
 
-    /// The padding of the bounds in [`BoundaryEntry::misses_bounds`].
+    /// The size-relative part of [`BoundaryEntry::clearly_misses`]' margin.
     fn pad(&self) -> f64 {
         (self.hi - self.lo).max_element() * 1e-9 + 1e-30
     }

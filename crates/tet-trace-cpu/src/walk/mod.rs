@@ -37,13 +37,69 @@
 //!    `fl(x − y) = −fl(y − x)`, so `det(p_b, pₐ) = −det(pₐ, p_b)` exactly
 //!    (no fused multiply-add is used: Rust never contracts implicitly), i.e.
 //!    seen from either orientation of the edge the answer is the same;
-//! 3. one tie rule for zero (the ray touches the edge's projection, e.g. it
-//!    passes through a vertex or along an edge): the origin is perturbed
-//!    symbolically to `(ε, ε²)` (simulation of simplicity), so a zero
-//!    determinant is decided by `sign(pₐ.y − p_b.y)`, then `sign(p_b.x − pₐ.x)`
-//!    (exact comparisons), and, when both points coincide (an edge parallel to
-//!    the ray), by the global vertex indices (`a < b` ⇒ left). Each step is
-//!    antisymmetric, so the rule never answers differently for the same edge.
+//! 3. exact signs: the two products are rounded monotonically
+//!    (`A ≤ B ⇒ fl(A) ≤ fl(B)`), so a non-zero rounded determinant already
+//!    has the sign of the exact `pₐ.x·p_b.y − pₐ.y·p_b.x` of the rounded
+//!    points; a zero is decided first by that exact determinant
+//!    (`ExactDet`: the products in f64 for f32 points, the products'
+//!    rounding errors by fused multiply-adds for f64 points), on the cold
+//!    path only;
+//! 4. one tie rule for an exact zero (the ray touches the edge's
+//!    projection, e.g. it passes through a vertex or along an edge): the
+//!    origin is perturbed symbolically to `(ε, ε²)` (simulation of
+//!    simplicity), so a zero determinant is decided by `sign(pₐ.y − p_b.y)`,
+//!    then `sign(p_b.x − pₐ.x)` (exact comparisons), and, when both points
+//!    coincide (an edge parallel to the ray), by the global vertex indices
+//!    (`a < b` ⇒ left). Each step is antisymmetric, so the rule never
+//!    answers differently for the same edge.
+//!
+//! # Why the walk ends, even in the plane of flat faces
+//!
+//! Watertightness alone does not end a walk: consistent answers per edge
+//! can still describe no line at all, and then the walk can circle. That
+//! is what rays lying in the plane of flat constrained faces did (a CAD
+//! part's cap, a city's wall, with the tets' faces around them in the same
+//! plane): every vertex of the plane projects to within rounding of one 2-D
+//! line through the origin, every edge of the plane has a determinant of
+//! the size of its rounding error, and deciding those by rounded products
+//! or by the perturbation alone gave answers no line could give (f32 walks
+//! ran to the step cap).
+//!
+//! With rules 3 and 4, every decision is the exact sign, with the symbolic
+//! perturbation, of a determinant of the *rounded* projected points. So the
+//! walk is exactly the walk of a line through another mesh: each vertex `P`
+//! moved to `P′ = o + pₓ·u + p_y·v + ((P − o)·d̂)·d̂`, i.e. by its
+//! projection's rounding error (a few ulps of `|P − o|`) across the ray, and
+//! the line `o + t·d` moved by `(ε, ε²)`. The moved line is in general
+//! position with respect to the moved mesh whatever the input, and a line
+//! meets a convex tet in one segment, so it crosses each moved tet at most
+//! once: the walk visits each tet at most once and ends, as long as no tet
+//! is inverted by moving its vertices a few ulps (a tet whose height is
+//! below f32's rounding of its distance to the ray origin: a sliver at f32
+//! precision, a limit the in-plane case does not add to). A ray in the
+//! plane of flat faces is such a line too: the moved line passes just above
+//! or just below each face of the plane, as the perturbation decides, and
+//! may cross the plane where rounding moved its vertices; each such
+//! crossing of a constrained face is a hit on that face (a ray lying in a
+//! face meets it), never a loop; its hit record is the point of the face
+//! the ray runs along ([`face_hit`]), not the crossing with the face's
+//! plane, which lies anywhere or nowhere.
+//!
+//! The moved mesh has three more consequences:
+//!
+//! * the start: the moved mesh can leave an origin on a face (the ray in
+//!   the face's plane) just outside the tets around it, so when none of
+//!   them has a counter-clockwise exit face, the tets next to them are
+//!   tried (`start::next_to_star`) before the last-resort guess;
+//! * the entry from outside: coplanar boundary faces moved by rounding make
+//!   the boundary slightly non-convex, so a ray running in their plane may
+//!   enter through several; the one nearest along the ray is taken
+//!   ([`BoundaryEntry`]), whatever the search met first;
+//! * tets thinner than the rounding (slivers between nearly coplanar
+//!   constrained faces of a plane f32 cannot hold exactly, e.g. a tilted
+//!   CAD cap): a moved tet may be inverted, and there the walk may still
+//!   circle to the step cap (reported as a failure; the f64 walk and the
+//!   exact walk of [`crate::exact`] decide such rays).
 //!
 //! # Interleaving and the hot loop
 //!

@@ -30,6 +30,14 @@ pub trait Projection: Copy + Send + Sync {
     }
     /// Projects one mesh vertex (must be a pure function of `p` and the ray).
     fn project(&self, p: Vec3) -> Self::P;
+    /// True when the projected triangle `p` is flat up to rounding (its
+    /// area below a millionth of its edges' product): the ray runs in, or
+    /// within rounding of, the triangle's plane. Used off the hot path
+    /// only (the boundary entry's choice among faces).
+    fn flat(p: &[Self::P; 3]) -> bool {
+        let _ = p;
+        false
+    }
     /// True when the ray passes to the left of the directed edge `a → b`,
     /// i.e. `det(pa, pb) > 0` with the tie rule of the module docs.
     /// Exactly antisymmetric: `left(a, b) == !left(b, a)`.
@@ -159,14 +167,22 @@ macro_rules! simd_face {
 }
 pub(crate) use simd_face;
 
-/// The tie rule of the module docs for 2-D points with an already computed
-/// determinant.
+/// The tie rule of the module docs for 2-D points: the rounded
+/// determinant when it is not zero (its sign is exact, see
+/// [`ExactDet`]), else the exact determinant's sign, else the symbolic
+/// perturbation.
 macro_rules! left_2d {
     ($a:expr, $ia:expr, $b:expr, $ib:expr) => {{
         let (a, b) = ($a, $b);
         let det = a.x * b.y - a.y * b.x;
+        let exact;
         if det != 0.0 {
             det > 0.0
+        } else if {
+            exact = $crate::walk::projection::ExactDet::exact_det(a, b);
+            exact != 0.0
+        } {
+            exact > 0.0
         } else if a.y != b.y {
             a.y > b.y
         } else if a.x != b.x {
@@ -177,6 +193,55 @@ macro_rules! left_2d {
     }};
 }
 pub(crate) use left_2d;
+
+/// The determinant `det(a, b) = a.x·b.y − a.y·b.x` of two projected points
+/// with its exact sign, for the tie rule (step 3 of the module docs), on
+/// the cold path only: the walk reaches it when the rounded determinant is
+/// zero.
+///
+/// Why the rounded determinant needs no check when it is not zero: the
+/// products are rounded monotonically (`A ≤ B ⇒ fl(A) ≤ fl(B)`), so
+/// `fl(A) ≠ fl(B)` already orders the exact products, and the subtraction
+/// of two floats is zero only when they are equal. A zero, though, may hide
+/// two different exact products that rounded to the same float; this is
+/// what decides them.
+pub(crate) trait ExactDet: Copy {
+    /// A value with the sign of the exact `a.x·b.y − a.y·b.x` (zero only
+    /// when it is exactly zero).
+    fn exact_det(a: Self, b: Self) -> f64;
+}
+
+impl ExactDet for Vec2 {
+    /// Products of two f32 are exact in f64 (24 + 24 bits < 53), and a
+    /// rounded difference keeps the sign of the exact one.
+    #[inline]
+    fn exact_det(a: Vec2, b: Vec2) -> f64 {
+        a.x as f64 * b.y as f64 - a.y as f64 * b.x as f64
+    }
+}
+
+impl ExactDet for DVec2 {
+    /// Called when `fl(fl(A) − fl(B)) = 0`, i.e. `fl(A) = fl(B)`: then
+    /// `A − B = errA − errB`, each product's rounding error exact by a fused
+    /// multiply-add (no overflow or underflow for the walk's magnitudes,
+    /// see [`walk_scale`]); a rounded difference keeps the sign.
+    #[inline]
+    fn exact_det(a: DVec2, b: DVec2) -> f64 {
+        let (pa, pb) = (a.x * b.y, a.y * b.x);
+        if pa != pb {
+            // Not reached from `left_2d!` (kept exact for any caller).
+            return pa - pb;
+        }
+        a.x.mul_add(b.y, -pa) - a.y.mul_add(b.x, -pb)
+    }
+}
+
+/// [`Projection::flat`] of the 2-D projections, in f64.
+fn flat_2d(p: [DVec2; 3]) -> bool {
+    let (e, f) = (p[1] - p[0], p[2] - p[0]);
+    let area = e.perp_dot(f);
+    area * area <= 1e-12 * e.length_squared() * f.length_squared()
+}
 
 /// The tie rule of the module docs on f32 2-D points (shared by every f32
 /// 2-D projection).
@@ -245,6 +310,9 @@ impl Projection for DuffF32 {
     type P = Vec2;
     simd_face!();
     const NAME: &'static str = "f32";
+    fn flat(p: &[Vec2; 3]) -> bool {
+        flat_2d(p.map(|q| q.as_dvec2()))
+    }
     fn setup(ray: &Ray) -> Self {
         Self::setup_scaled(ray, 1.0)
     }
@@ -285,6 +353,9 @@ impl Projection for OriginF32 {
     type P = Vec2;
     simd_face!();
     const NAME: &'static str = "f32-po";
+    fn flat(p: &[Vec2; 3]) -> bool {
+        flat_2d(p.map(|q| q.as_dvec2()))
+    }
     fn setup(ray: &Ray) -> Self {
         Self::setup_scaled(ray, 1.0)
     }
@@ -319,6 +390,9 @@ impl Projection for DuffF64 {
     type P = DVec2;
     array_face!(DVec2);
     const NAME: &'static str = "f64";
+    fn flat(p: &[DVec2; 3]) -> bool {
+        flat_2d(*p)
+    }
     fn setup(ray: &Ray) -> Self {
         let (u, v) = duff_basis(ray.direction.as_dvec3().normalize());
         DuffF64 {

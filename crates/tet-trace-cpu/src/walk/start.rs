@@ -171,11 +171,44 @@ fn boundary_face_at(mesh: &TetMesh, p: Vec3, around: &[u32]) -> Option<(u32, usi
     })
 }
 
-/// Last resort when rounding left no tet around the origin with a
-/// counter-clockwise exit face: the face of `tet` whose smallest f64 edge
-/// function `d · (qa × qb)` is largest (the face the line leaves through, up
-/// to rounding).
+/// When rounding left no tet around the origin with a counter-clockwise
+/// exit face: a tet next to them ([`next_to_star`]), else, as a last
+/// resort, the face of `tet` whose smallest f64 edge function
+/// `d · (qa × qb)` is largest (the face the line leaves through, up to
+/// rounding).
 fn start_fallback<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) -> State<P> {
+    next_to_star(mesh, proj, ray, tet).unwrap_or_else(|| best_exit_guess(mesh, proj, ray, tet))
+}
+
+/// The walk's decisions are those of a line through the mesh with each
+/// vertex moved by its projection's rounding (see the module docs, "Why
+/// the walk ends"), and that moved mesh can leave the origin just outside
+/// the tets around it (an origin on or within rounding of a face, the ray
+/// running in the face's plane): the moved line then starts in a tet next
+/// to them, across a constrained face or not. Of the tets sharing a face
+/// with the origin's star that have a counter-clockwise exit face (the
+/// moved line passes through them, so a walk from one is a line's walk),
+/// the one whose centroid lies nearest the origin along the ray.
+fn next_to_star<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) -> Option<State<P>> {
+    let around = star(mesh, ray.origin, tet, STAR_FIRST);
+    let (o, d) = (ray.origin.as_dvec3(), ray.direction.as_dvec3());
+    let along = |t: u32| {
+        let c = mesh.tet_points(t).map(|x| x.as_dvec3());
+        ((c[0] + c[1] + c[2] + c[3]) * 0.25 - o).dot(d).abs()
+    };
+    around
+        .iter()
+        .flat_map(|&t| (0..4).filter_map(move |k| mesh.across(t, k)))
+        .map(|side| side.tet)
+        .filter(|n| !around.contains(n))
+        .filter_map(|n| start_in_tet(mesh, proj, n).map(|s| (along(n), s)))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, s)| s)
+}
+
+/// The face of `tet` whose smallest f64 edge function `d · (qa × qb)` is
+/// largest (the face the line leaves through, up to rounding).
+fn best_exit_guess<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) -> State<P> {
     let v = mesh.tets[tet as usize];
     let o = ray.origin.as_dvec3();
     let d = ray.direction.as_dvec3();

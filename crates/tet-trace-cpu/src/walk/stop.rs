@@ -2,6 +2,8 @@
 //! or a constrained face (a hit, a miss beyond `t_max`, or a crossing into
 //! the far side before `t_min`), and the f64 hit record.
 
+use glam::DVec3;
+use tet_core::input_triangles::plane_barycentrics;
 use tet_core::{Link, NO_TET, TetMesh};
 
 use crate::ray::{Failure, Hit, Ray, TraceOutcome};
@@ -73,23 +75,97 @@ pub(crate) fn degenerate_crossing(t: f64, bary: &[f32; 3]) -> bool {
 
 /// Ray parameter and barycentrics (w.r.t. `ids`) of the line's crossing with
 /// triangle `ids`, in f64 (computed once per ray, at the hit).
+///
+/// The walk decides *that* the ray crosses the face; this says where: the
+/// crossing of the line with the face's plane. A line lying in the face's
+/// plane, or running within a millionth of a radian of it, has no such
+/// crossing to speak of (that formula gave the centroid's `t`, or a point
+/// far off the face): it touches the face along a segment, or runs past it
+/// near an edge, where the walk's tie rule took it across (see the walk's
+/// module docs, "Why the walk ends"). The hit is then the point of that
+/// segment at `t_min` if it holds it, else its end nearer `t_min`
+/// ([`along_face`]), so the hit lies on the face.
 pub fn face_hit(mesh: &TetMesh, ray: &Ray, ids: [u32; 3]) -> (f64, [f64; 3]) {
     let o = ray.origin.as_dvec3();
     let d = ray.direction.as_dvec3();
-    let q = ids.map(|i| mesh.points[i as usize].as_dvec3() - o);
+    let v = ids.map(|i| mesh.points[i as usize].as_dvec3());
+    let q = v.map(|p| p - o);
     let w = [
         d.dot(q[1].cross(q[2])),
         d.dot(q[2].cross(q[0])),
         d.dot(q[0].cross(q[1])),
     ];
+    // `sum = d · n` for the face normal `n = (v₁ − v₀) × (v₂ − v₀)`.
     let sum = w[0] + w[1] + w[2];
-    let w = if sum != 0.0 && sum.is_finite() {
-        w.map(|x| x / sum)
-    } else {
-        [1.0 / 3.0; 3]
+    let n = (v[1] - v[0]).cross(v[2] - v[0]);
+    if sum.abs() > PARALLEL * d.length() * n.length() && sum.is_finite() {
+        let w = w.map(|x| x / sum);
+        let hit = q[0] * w[0] + q[1] * w[1] + q[2] * w[2];
+        return (hit.dot(d) / d.length_squared(), w);
+    }
+    along_face(o, d, v, ray.t_min as f64)
+}
+
+/// The sine of the angle between a ray and a face's plane below which
+/// [`face_hit`] takes the ray as running along the face: far below any
+/// crossing a walk decides in general position, far above the f32
+/// rounding of a direction meant to lie in the plane (about 1e-8).
+const PARALLEL: f64 = 1e-6;
+
+/// [`face_hit`] for a line lying in (or running nearly parallel to) the
+/// plane of triangle `v`: the points of the triangle's edges nearest to the
+/// line bound the segment `[t₀, t₁]` of the line along the triangle; the
+/// hit is at `t_min` when `t₀ ≤ t_min ≤ t₁`, else at `t₀` (ahead of
+/// `t_min`) or `t₁` (behind it: the walk crosses on), with the
+/// barycentrics of the nearest point of the triangle, clamped onto it.
+fn along_face(o: DVec3, d: DVec3, v: [DVec3; 3], t_min: f64) -> (f64, [f64; 3]) {
+    let a = d.length_squared();
+    // (t, point of the triangle, distance) for each edge: the nearest
+    // point, or both ends when the line runs parallel to the edge.
+    let mut near = [(0.0, DVec3::ZERO, f64::INFINITY); 6];
+    for i in 0..3 {
+        let (p, e) = (v[i], v[(i + 1) % 3] - v[i]);
+        let w0 = o - p;
+        let (b, c, dw, ew) = (d.dot(e), e.dot(e), d.dot(w0), e.dot(w0));
+        let den = a * c - b * b;
+        let ends = if den > 1e-12 * a * c {
+            let s = ((a * ew - b * dw) / den).clamp(0.0, 1.0);
+            [s, s]
+        } else {
+            [0.0, 1.0]
+        };
+        for (k, s) in ends.into_iter().enumerate() {
+            let t = (s * b - dw) / a;
+            let x = p + e * s;
+            near[2 * i + k] = (t, x, (o + d * t - x).length());
+        }
+    }
+    let best = near.iter().map(|n| n.2).fold(f64::INFINITY, f64::min);
+    let scale = v.iter().map(|p| (*p - o).length()).fold(0.0, f64::max);
+    let touching = near.iter().filter(|n| n.2 <= best + 1e-9 * scale);
+    let first = touching.clone().min_by(|x, y| x.0.total_cmp(&y.0));
+    let last = touching.max_by(|x, y| x.0.total_cmp(&y.0));
+    let (Some(&(t0, x0, _)), Some(&(t1, x1, _))) = (first, last) else {
+        return (f64::NAN, [f64::NAN; 3]);
     };
-    let hit = q[0] * w[0] + q[1] * w[1] + q[2] * w[2];
-    (hit.dot(d) / d.length_squared(), w)
+    let (t, x) = if t0 >= t_min {
+        (t0, x0)
+    } else if t1 < t_min {
+        (t1, x1)
+    } else {
+        (t_min, o + d * t_min)
+    };
+    let (b, _) = plane_barycentrics(v, x);
+    let b = b.map(|x| x.clamp(0.0, 1.0));
+    let sum = b[0] + b[1] + b[2];
+    (
+        t,
+        if sum > 0.0 {
+            b.map(|x| x / sum)
+        } else {
+            [1.0 / 3.0; 3]
+        },
+    )
 }
 
 /// What one [`advance`](super::step::advance) did.

@@ -1,6 +1,6 @@
 //! Unit tests of the edge test, the tie rule, Algorithm 1's table and the basis.
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec2, DVec3, Vec2, Vec3};
 
 use super::*;
 use crate::ray::Ray;
@@ -83,4 +83,61 @@ fn basis_is_right_handed_around_the_direction() {
         let (u, v) = duff_basis(d);
         assert!((u.cross(v) - d).length() < 1e-12);
     }
+}
+
+/// A zero rounded determinant that hides a non-zero exact one is decided
+/// by the exact sign (the tie rule's first step), checked against integer
+/// arithmetic: integer coordinates `B + δ` (B = 24,576, below 2²⁴, exact
+/// in f32) have products near 2²⁹ that f32 rounds to multiples of 64,
+/// and with `δ_ax + δ_by = δ_ay + δ_bx` the exact determinant is the
+/// small `δ_ax·δ_by − δ_ay·δ_bx` (exact in i64).
+#[test]
+fn zero_rounded_determinants_take_the_exact_sign() {
+    let p32 = DuffF32::setup(&Ray::new(Vec3::ZERO, Vec3::Z));
+    let p64 = DuffF64::setup(&Ray::new(Vec3::ZERO, Vec3::Z));
+    let mut rng = SplitMix64(11);
+    let mut hidden = 0;
+    for _ in 0..20_000 {
+        let c = |rng: &mut SplitMix64| (rng.next_u64() % 8) as i64;
+        let (dax, dby, day) = (c(&mut rng), c(&mut rng), c(&mut rng));
+        let base = 24_576i64;
+        let (ax, by, ay) = (base + dax, base + dby, base + day);
+        let bx = base + dax + dby - day;
+        let exact = ax * by - ay * bx;
+        let (a, b) = (
+            Vec2::new(ax as f32, ay as f32),
+            Vec2::new(bx as f32, by as f32),
+        );
+        let rounded = a.x * b.y - a.y * b.x;
+        if rounded != 0.0 || exact == 0 {
+            continue;
+        }
+        hidden += 1;
+        assert_eq!(p32.left(a, 1, b, 2), exact > 0, "{a:?} {b:?}");
+        assert_eq!(p32.left(b, 2, a, 1), exact < 0, "{a:?} {b:?}");
+    }
+    assert!(hidden > 100, "only {hidden} hidden signs drawn");
+    // f64: integers 2⁴⁰ + δ (exact), whose products (about 2⁸⁰) round to
+    // multiples of 2²⁸; with δ_ax + δ_by = δ_ay + δ_bx the exact
+    // determinant is δ_ax·δ_by − δ_ay·δ_bx (below 2²⁴), exact in i128.
+    let mut hidden = 0;
+    for _ in 0..20_000 {
+        let c = |rng: &mut SplitMix64| (rng.next_u64() % 4096) as i64;
+        let (dax, dby, day) = (c(&mut rng), c(&mut rng), c(&mut rng));
+        let dbx = dax + dby - day;
+        let base = 1i64 << 40;
+        let (ax, by, ay, bx) = (base + dax, base + dby, base + day, base + dbx);
+        let exact = ax as i128 * by as i128 - ay as i128 * bx as i128;
+        let (a, b) = (
+            DVec2::new(ax as f64, ay as f64),
+            DVec2::new(bx as f64, by as f64),
+        );
+        if a.x * b.y - a.y * b.x != 0.0 || exact == 0 {
+            continue;
+        }
+        hidden += 1;
+        assert_eq!(p64.left(a, 1, b, 2), exact > 0, "{a:?} {b:?}");
+        assert_eq!(p64.left(b, 2, a, 1), exact < 0, "{a:?} {b:?}");
+    }
+    assert!(hidden > 100, "only {hidden} hidden signs drawn");
 }
