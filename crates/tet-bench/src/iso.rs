@@ -12,7 +12,10 @@
 //! tets which rays may meet an isosurface and where they may start
 //! (`--no-regions`: none), then walks them ([`IsoWalk::trace_tile`]).
 //! Every method sees the same rays of the same camera, which frames the
-//! volume's bounds the same way for all of them.
+//! volume's bounds the same way for all of them, and each document
+//! compares the method's hits pixel by pixel with single rays through the
+//! BIH-built IBVH, traced untimed on the same pixels
+//! ([`IsoDoc::hit_mismatches`], [`IsoDoc::crossing_mismatches`]).
 
 use std::time::Instant;
 
@@ -25,7 +28,7 @@ use tet_core::TetMesh;
 use tet_core::scene::Camera;
 use tet_trace_cpu::Ray;
 use tet_trace_cpu::iso::{
-    ClipBox, Ibvh, IsoHit, IsoOutcome, IsoQuery, IsoStats, IsoWalk, WalkLayout,
+    BuildKind, ClipBox, Ibvh, IsoHit, IsoOutcome, IsoQuery, IsoStats, IsoWalk, WalkLayout,
 };
 use tet_trace_cpu::render::PinholeCamera;
 
@@ -172,6 +175,38 @@ pub struct IsoDoc {
     /// region straddling an isovalue (`--no-regions`: every ray walks);
     /// false for the IBVH.
     pub regions: bool,
+    /// Hits of single rays through the BIH-built IBVH (`ibvh`) on the same
+    /// pixels: the yardstick of [`IsoDoc::hit_mismatches`] and
+    /// [`IsoDoc::crossing_mismatches`] (one untimed frame).
+    pub ibvh_hits: u64,
+    /// Pixels this method hits and single IBVH rays miss, or the reverse
+    /// (0 for `ibvh` itself; the packets and `ibvh-sah` must give 0, the
+    /// walks may differ on rays grazing a silhouette).
+    pub hit_mismatches: u64,
+    /// Pixels both hit at another crossing: another tet or isovalue, or,
+    /// for the IBVH methods (which share the single-ray isopolygon test and
+    /// must give the same bits), another `t`.
+    pub crossing_mismatches: u64,
+}
+
+/// How `image` differs from single-ray hits `reference` on the same
+/// pixels: `(hit_mismatches, crossing_mismatches)` as in [`IsoDoc`];
+/// `exact_t`: the `t` of a crossing must have the same bits.
+pub fn compare_hits(image: &[IsoPixel], reference: &[Option<IsoHit>], exact_t: bool) -> (u64, u64) {
+    let (mut hit, mut crossing) = (0, 0);
+    for (p, r) in image.iter().zip(reference) {
+        match (p.hit, r) {
+            (Some(a), Some(b)) => {
+                let same = a.tet == b.tet
+                    && a.isovalue_index == b.isovalue_index
+                    && (!exact_t || a.t.to_bits() == b.t.to_bits());
+                crossing += !same as u64;
+            }
+            (None, None) => {}
+            _ => hit += 1,
+        }
+    }
+    (hit, crossing)
 }
 
 /// What traces the rays.
@@ -400,6 +435,38 @@ pub fn measure(
         Traced::Ibvh(b, _) => b.bytes(),
         Traced::Walk(w) => w.bytes(),
     };
+    // The yardstick: single rays through the BIH-built IBVH, untimed.
+    let reference: Vec<Option<IsoHit>> = if method == IsoMethod::Ibvh {
+        image.iter().map(|p| p.hit).collect()
+    } else {
+        let own;
+        let bih = match &traced {
+            Traced::Ibvh(b, _) if b.kind == BuildKind::Bih => b,
+            _ => {
+                own = Ibvh::build_bih(mesh, values)?;
+                &own
+            }
+        };
+        let w = f.width as usize;
+        pool.install(|| {
+            (0..image.len())
+                .into_par_iter()
+                .map(|k| bih.trace(&camera.ray((k % w) as u32, (k / w) as u32), &query))
+                .collect()
+        })
+    };
+    let exact_t = matches!(traced, Traced::Ibvh(..));
+    let (hit_mismatches, crossing_mismatches) = compare_hits(&image, &reference, exact_t);
+    if exact_t && hit_mismatches + crossing_mismatches > 0 {
+        eprintln!(
+            "warning: {} {}: {} pixels differ from single ibvh rays ({} hit by one only, {} at another crossing); they should be the same",
+            volume.name,
+            method.name(),
+            hit_mismatches + crossing_mismatches,
+            hit_mismatches,
+            crossing_mismatches
+        );
+    }
     let doc = IsoDoc {
         volume: volume.name.clone(),
         method,
@@ -425,6 +492,9 @@ pub fn measure(
         bytes,
         per_ray: IsoCounts::per_ray(&stats, rays),
         regions: f.regions && matches!(traced, Traced::Walk(_)),
+        ibvh_hits: reference.iter().filter(|h| h.is_some()).count() as u64,
+        hit_mismatches,
+        crossing_mismatches,
     };
     Ok((doc, image))
 }
@@ -565,6 +635,68 @@ mod tests {
             .map(|&m| measure(&volume, &isos, m, f, &pool).unwrap().1)
             .collect();
         (volume, isos, images)
+    }
+
+    /// Every document compares its method's hits with single IBVH rays on
+    /// the same pixels: the counts match those of the `ibvh` image itself,
+    /// with a clip box too, and the IBVH methods give the same bits.
+    #[test]
+    fn documents_count_differences_from_single_ibvh_rays() {
+        let volume = load_iso_volume("linear").unwrap();
+        let (lo, hi) = volume.mesh.point_bounds();
+        let isos = [volume.default_isovalue];
+        let pool = crate::timing::pool(Some(1)).unwrap();
+        for clip in [
+            None,
+            Some(ClipBox {
+                lo,
+                hi: Vec3::new(hi.x, 0.5 * (lo.y + hi.y), hi.z),
+                mode: ClipMode::KeepInside,
+            }),
+        ] {
+            let mut view = IsoView::of(&volume.mesh);
+            view.clip = clip;
+            let f = IsoFrames {
+                width: 48,
+                height: 40,
+                frames: 1,
+                time_step: 0,
+                view,
+                regions: true,
+            };
+            let runs: Vec<(IsoDoc, Vec<IsoPixel>)> = IsoMethod::ALL
+                .iter()
+                .map(|&m| measure(&volume, &isos, m, f, &pool).unwrap())
+                .collect();
+            let ibvh = &runs[IsoMethod::ALL
+                .iter()
+                .position(|&m| m == IsoMethod::Ibvh)
+                .unwrap()]
+            .1;
+            let ibvh_hits = ibvh.iter().filter(|p| p.hit.is_some()).count() as u64;
+            assert!(ibvh_hits > 100, "{ibvh_hits}");
+            for (doc, image) in &runs {
+                let name = doc.method.name();
+                assert_eq!(doc.ibvh_hits, ibvh_hits, "{name}");
+                let hit = image
+                    .iter()
+                    .zip(ibvh)
+                    .filter(|(a, b)| a.hit.is_some() != b.hit.is_some())
+                    .count() as u64;
+                assert_eq!(doc.hit_mismatches, hit, "{name}");
+                if doc.method.name().starts_with("ibvh") {
+                    assert_eq!(
+                        (doc.hit_mismatches, doc.crossing_mismatches),
+                        (0, 0),
+                        "{name}"
+                    );
+                    assert!(
+                        image.iter().zip(ibvh).all(|(a, b)| a.hit == b.hit),
+                        "{name}"
+                    );
+                }
+            }
+        }
     }
 
     /// Pixels on which two methods differ (hit or not, shadowed or not).

@@ -106,6 +106,12 @@ pub fn run(args: &IsoArgs, json: bool) -> Result<()> {
             c.isopolygon_tests,
             c.frustum_culls
         )?;
+        outln!(
+            "  vs single ibvh rays ({} hits): {} pixels hit by one only, {} at another crossing",
+            doc.ibvh_hits,
+            doc.hit_mismatches,
+            doc.crossing_mismatches
+        )?;
     }
     Ok(())
 }

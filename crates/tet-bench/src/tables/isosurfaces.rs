@@ -183,14 +183,14 @@ fn scaling_markdown(m: &mut String, doc: &TablesDoc) {
     }
     let _ = writeln!(
         m,
-        "\n### Isosurfaces as the model grows (seed 004 Table 3)\n\nThe bucky ball replicated n³ times without instancing (`iso buckycube --replications n`), {} threads here; the paper's fps are at 1024² on four 2.4 GHz Opteron cores. Memory is the method's own structure beside the mesh.\n",
+        "\n### Isosurfaces as the model grows (Wald et al. 2007, Table 3)\n\nThe bucky ball replicated n³ times without instancing (`iso buckycube --replications n`), {} threads here; the paper's fps are at 1024² on four 2.4 GHz Opteron cores. Memory is the method's own structure beside the mesh. Last column: pixels whose hit differs from single rays through the BIH-built IBVH (`ibvh`, traced untimed on the same pixels): hit by one and missed by the other / hit at another crossing (another tet or isovalue, or for the packets another t).\n",
         doc.setup.threads
     );
     let _ = writeln!(
         m,
-        "| balls | tets (paper) | method | pixels | build ms | fps | Mrays/s | MB | paper fps |"
+        "| balls | tets (paper) | method | pixels | build ms | fps | Mrays/s | MB | paper fps | hits | pixels ≠ ibvh: hit / crossing |"
     );
-    let _ = writeln!(m, "|---:|---:|---|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(m, "|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for row in &doc.iso_scaling {
         let paper = PAPER_SCALING.iter().find(|p| p.0 == row.balls);
         let (paper_tets, paper_fps) = paper.map_or(("–".to_string(), "–".to_string()), |p| {
@@ -199,7 +199,7 @@ fn scaling_markdown(m: &mut String, doc: &TablesDoc) {
         if let Some(e) = &row.error {
             let _ = writeln!(
                 m,
-                "| {} | ({paper_tets}) | failed: {e} | | | | | | {paper_fps} |",
+                "| {} | ({paper_tets}) | failed: {e} | | | | | | {paper_fps} | | |",
                 row.balls
             );
             continue;
@@ -207,7 +207,7 @@ fn scaling_markdown(m: &mut String, doc: &TablesDoc) {
         for d in &row.docs {
             let _ = writeln!(
                 m,
-                "| {} | {} ({paper_tets}) | {} | {}² | {:.0} | {:.2} | {:.2} | {:.1} | {paper_fps} |",
+                "| {} | {} ({paper_tets}) | {} | {}² | {:.0} | {:.2} | {:.2} | {:.1} | {paper_fps} | {} | {} |",
                 row.balls,
                 d.tets,
                 d.method.name(),
@@ -216,8 +216,21 @@ fn scaling_markdown(m: &mut String, doc: &TablesDoc) {
                 d.fps,
                 d.mrays_per_s,
                 d.bytes as f64 / 1e6,
+                d.hits,
+                differences(d),
             );
         }
+    }
+}
+
+/// The table cell comparing a method's hits with single IBVH rays on the
+/// same pixels: pixels hit by one and missed by the other / pixels hit at
+/// another crossing; `ibvh` itself is the yardstick.
+fn differences(d: &crate::iso::IsoDoc) -> String {
+    if d.method == IsoMethod::Ibvh {
+        "(yardstick)".to_string()
+    } else {
+        format!("{} / {}", d.hit_mismatches, d.crossing_mismatches)
     }
 }
 
@@ -234,11 +247,11 @@ fn static_markdown(m: &mut String, doc: &TablesDoc) {
     }
     let _ = writeln!(
         m,
-        "\n## Isosurfaces of tet volumes (seed 004 Tables 1, 2, 4)\n"
+        "\n## Isosurfaces of tet volumes (Wald et al. 2007, Tables 1, 2, 4)\n"
     );
     let _ = writeln!(
         m,
-        "Synthetic stand-ins with the paper's tet counts (`tet_build::volume`; the originals are not public), one isovalue, the same camera and rays for every method; {} threads here, {}² pixels (fps scale with the pixel count: compare with the paper's 1024² at the same size). `ibvh`/`ibvh-sah`: the implicit min-max BVH built BIH-style or by SAH, single rays; `ibvh-packets`: 16×16 packets; `walk-*`: the iso walk over our compact layouts, with a min-max tree over regions of up to 64 tets that culls the rays meeting no straddling region and starts the others there (no BVH over the tets). Paper: build ms on a dual Core 2 Duo (Table 1), fps at 1024² on a 2-core laptop (Table 2), 16×16 tests per ray (Table 4).\n",
+        "Synthetic stand-ins with the paper's tet counts (`tet_build::volume`; the originals are not public), one isovalue, the same camera and rays for every method; {} threads here, {}² pixels (fps scale with the pixel count: compare with the paper's 1024² at the same size). `ibvh`/`ibvh-sah`: the implicit min-max BVH built BIH-style or by SAH, single rays; `ibvh-packets`: 16×16 packets; `walk-*`: the iso walk over our compact layouts, with a min-max tree over regions of up to 64 tets that culls the rays meeting no straddling region and starts the others there (no BVH over the tets). Paper: build ms on a dual Core 2 Duo (Table 1), fps at 1024² on a 2-core laptop (Table 2), 16×16 tests per ray (Table 4). Last column: every method's hits compared pixel by pixel with single `ibvh` rays (traced untimed on the same pixels): pixels hit by one and missed by the other / pixels both hit at another crossing (another tet or isovalue, or for the IBVH methods, which must give the same bits, another t); the walks may differ on rays grazing a silhouette.\n",
         doc.setup.threads,
         doc.isosurfaces
             .iter()
@@ -247,15 +260,19 @@ fn static_markdown(m: &mut String, doc: &TablesDoc) {
     );
     let _ = writeln!(
         m,
-        "| volume | tets (paper) | method | build ms | paper build ms | fps | Mrays/s | paper laptop fps | MB | box tests/ray | isopolygon tests/ray | paper 16×16 box / isopolygon tests |"
+        "| volume | tets (paper) | method | build ms | paper build ms | fps | Mrays/s | paper laptop fps | MB | box tests/ray | isopolygon tests/ray | paper 16×16 box / isopolygon tests | hits | pixels ≠ ibvh: hit / crossing |"
     );
     let _ = writeln!(
         m,
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for row in &doc.isosurfaces {
         if let Some(e) = &row.error {
-            let _ = writeln!(m, "| {} | | failed: {e} | | | | | | | | | |", row.volume);
+            let _ = writeln!(
+                m,
+                "| {} | | failed: {e} | | | | | | | | | | | |",
+                row.volume
+            );
             continue;
         }
         let paper = PAPER.iter().find(|p| p.name == row.volume);
@@ -273,7 +290,7 @@ fn static_markdown(m: &mut String, doc: &TablesDoc) {
                 });
             let _ = writeln!(
                 m,
-                "| {} | {} ({}) | {} | {:.1} | {build} | {:.1} | {:.2} | {} | {:.2} | {:.2} | {:.2} | {tests} |",
+                "| {} | {} ({}) | {} | {:.1} | {build} | {:.1} | {:.2} | {} | {:.2} | {:.2} | {:.2} | {tests} | {} | {} |",
                 row.volume,
                 d.tets,
                 paper.map_or_else(dash, |p| p.tets.to_string()),
@@ -285,6 +302,8 @@ fn static_markdown(m: &mut String, doc: &TablesDoc) {
                 d.bytes as f64 / 1e6,
                 d.per_ray.box_tests,
                 d.per_ray.isopolygon_tests,
+                d.hits,
+                differences(d),
             );
         }
         let speed = |m: IsoMethod| {
@@ -300,7 +319,7 @@ fn static_markdown(m: &mut String, doc: &TablesDoc) {
         ) {
             let _ = writeln!(
                 m,
-                "| {} | | walk-tet20 ÷ ibvh = {:.2}, ÷ ibvh-packets = {:.2} | | | | | | | | | |",
+                "| {} | | walk-tet20 ÷ ibvh = {:.2}, ÷ ibvh-packets = {:.2} | | | | | | | | | | | |",
                 row.volume,
                 w / b,
                 w / p

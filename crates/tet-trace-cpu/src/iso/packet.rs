@@ -6,7 +6,9 @@
 //!    hits the node's box, descend without testing the others;
 //! 3. otherwise an interval-arithmetic test (Boulos et al., Reshetov et al.:
 //!    bounds of the origins and reciprocal directions over the packet)
-//!    rejects a node that every ray misses;
+//!    rejects a node that every ray misses before the largest far bound
+//!    (`t_max`, or the nearest crossing so far) of the node's own active
+//!    rays;
 //! 4. otherwise first-active tracking: the rays before the first one that
 //!    hits the box are inactive below this node.
 //!
@@ -18,8 +20,13 @@
 //! Each ray keeps the nearest crossing by [`IsoHit::before`] among those it
 //! tests, with the single-ray tests of [`super::ibvh_trace`]. A ray
 //! deactivated at a node misses its (padded) box before its nearest crossing
-//! so far, so the node holds no crossing that could win; a crossing a ray
-//! does test only competes by its `(t, tet, isovalue)` key. The result is
+//! so far, so the node holds no crossing that could win; a node the
+//! interval test rejects is missed so by every ray still active in it (the
+//! far bound is the maximum over the rays from the node's own first active
+//! ray, kept as suffix maxima: a node pushed before a deeper node advanced
+//! the first active ray keeps the earlier rays, whose crossings may lie
+//! far behind the later rays'); a crossing a ray does test only competes
+//! by its `(t, tet, isovalue)` key. The result is
 //! bit for bit that of [`Ibvh::trace`] (tested), whatever the visiting order.
 //! The paper's frustum culling of isopolygons (corner rays against the
 //! polygon's edge half-spaces) is not done: the single-ray test projects per
@@ -46,8 +53,14 @@ pub(super) struct Interval {
 }
 
 impl Interval {
-    fn new(pre: &[RayPre]) -> Interval {
-        Self::of(pre.iter().map(|p| (&p.ray, p.inv_d)))
+    /// The bounds of the rays of `pre` that are not `done` (invalid).
+    fn new(pre: &[RayPre], done: &[bool]) -> Interval {
+        Self::of(
+            pre.iter()
+                .zip(done)
+                .filter(|(_, d)| !**d)
+                .map(|(p, _)| (&p.ray, p.inv_d)),
+        )
     }
 
     /// The bounds of rays given with their reciprocal directions.
@@ -117,6 +130,12 @@ struct Lanes<'a> {
     best: &'a mut [Option<IsoHit>],
     done: Vec<bool>,
     any: bool,
+    /// `far[r]`: the largest far bound (`t_max`, or the nearest crossing
+    /// so far plus the cull slack) over the active rays `r..`; negative
+    /// infinity when none is active. Stale while `far_stale`.
+    far: Vec<f32>,
+    /// Some ray's nearest crossing changed since `far` was computed.
+    far_stale: bool,
 }
 
 impl Lanes<'_> {
@@ -131,17 +150,35 @@ impl Lanes<'_> {
         t0 <= t1 && t1 >= p.ray.t_min && t0 <= p.ray.t_max && may_beat(t0, self.best[r].as_ref())
     }
 
-    /// Largest far bound over rays `first..`.
-    fn t_far(&self, first: usize) -> f32 {
-        (first..self.pre.len())
-            .filter(|&r| !self.done[r])
-            .map(|r| {
+    /// The largest far bound over the active rays `first..`, recomputing
+    /// the suffix maxima [`Lanes::far`] when a leaf changed some ray's
+    /// nearest crossing since.
+    ///
+    /// A node on the stack is culled for its own active rays `first..`,
+    /// and nodes pushed before a deeper node advanced `first` keep a
+    /// smaller one: the bound of a node must be taken over the rays from
+    /// its own `first`, never from the `first` of the leaf that shrank it.
+    fn far_from(&mut self, first: usize) -> f32 {
+        if self.far_stale {
+            self.far_stale = false;
+            self.update_far();
+        }
+        self.far[first]
+    }
+
+    /// Recomputes [`Lanes::far`] from the rays' current far bounds.
+    fn update_far(&mut self) {
+        let mut m = f32::NEG_INFINITY;
+        for r in (0..self.pre.len()).rev() {
+            if !self.done[r] {
                 let t = self.pre[r].ray.t_max;
-                self.best[r].map_or(t, |b| {
+                let t = self.best[r].map_or(t, |b| {
                     t.min(b.t + super::ibvh_trace::CULL_SLACK * b.t.abs())
-                })
-            })
-            .fold(f32::NEG_INFINITY, f32::max)
+                });
+                m = m.max(t);
+            }
+            self.far[r] = m;
+        }
     }
 }
 
@@ -198,14 +235,15 @@ impl Ibvh {
         let Some(start) = done.iter().position(|&d| !d) else {
             return;
         };
-        let iv = Interval::new(&pre);
+        let iv = Interval::new(&pre, &done);
         let mut lanes = Lanes {
             pre,
             best: &mut out[..n],
             done,
             any,
+            far: vec![f32::NEG_INFINITY; n],
+            far_stale: true,
         };
-        let mut t_far = lanes.t_far(start);
         let mut stack: Vec<(u32, u32)> = Vec::with_capacity(64);
         stack.push((0, start as u32));
         while let Some((node, first)) = stack.pop() {
@@ -218,7 +256,8 @@ impl Ibvh {
             let (lo, hi) = (nd.lo3(), nd.hi3());
             stats.box_tests += 1;
             if !lanes.hits(first, lo, hi) {
-                if iv.misses(lo, hi, t_far) {
+                // The bound of this node's own active rays `first..`.
+                if iv.misses(lo, hi, lanes.far_from(first)) {
                     stats.frustum_culls += 1;
                     continue;
                 }
@@ -240,7 +279,7 @@ impl Ibvh {
                     &mut lanes,
                     stats,
                 ) {
-                    t_far = lanes.t_far(first);
+                    lanes.far_stale = true;
                 }
                 continue;
             }
