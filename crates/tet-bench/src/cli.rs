@@ -119,8 +119,9 @@ pub struct BuildFlags {
 /// How finely `--walls` cuts the enclosing box.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Walls {
-    /// Parts of about [`Walls::PART_TARGET_BYTES`] predicted TetGen peak
-    /// (if that build fails: one part per about
+    /// Parts of about 28 MiB predicted TetGen peak
+    /// (`tet_build::outofcore::split::RAY_PART_TARGET_BYTES`, the size every
+    /// build shaped for rays cuts toward; if that build fails: one part per about
     /// [`Walls::TRIANGLES_PER_PART`] scene triangles, uniform depth; if
     /// that fails too: the scene in one piece, the switches saying why).
     Auto,
@@ -132,12 +133,6 @@ pub enum Walls {
 
 #[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
 impl Walls {
-    /// `auto`'s target for a part's predicted TetGen peak: tets per ray
-    /// within 10 % of `-q5`'s (or fewer) on Torus Knots and Armadillo,
-    /// alone and in a box, Nefertiti and `fan-sphere:200000` (20, 24, 28
-    /// and 32 MiB tried; 32 left Torus Knots 19 % above).
-    pub const PART_TARGET_BYTES: u64 = 28 << 20;
-
     /// `auto`'s fallback: scene triangles per part at uniform depth (Torus
     /// Knots: 32 parts, Armadillo and Nefertiti: 64).
     pub const TRIANGLES_PER_PART: usize = 2_000;

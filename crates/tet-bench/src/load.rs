@@ -339,14 +339,7 @@ fn build_walled(
     };
     use crate::cli::Walls;
     let splits = match walls {
-        Walls::Auto => vec![
-            SplitOptions {
-                limit_bytes: Walls::PART_TARGET_BYTES,
-                best_effort: true,
-                ..SplitOptions::default()
-            },
-            uniform,
-        ],
+        Walls::Auto => vec![SplitOptions::shaped_for_rays(u64::MAX), uniform],
         Walls::Parts(_) | Walls::None => vec![uniform],
     };
     let tetgen_start = Instant::now();

@@ -134,7 +134,18 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
     let j = jobdir.to_str().unwrap();
     let out = dir.path().join("slurm.tmesh");
     let limit = "300M";
-    let plan = json(&["build", scene, "--plan", j, "--memory-limit", limit]);
+    // Cut for the limit alone (`--walls none`): a few parts of seconds
+    // each, where the default cut for rays would make ~100 small ones.
+    let plan = json(&[
+        "build",
+        scene,
+        "--plan",
+        j,
+        "--memory-limit",
+        limit,
+        "--walls",
+        "none",
+    ]);
     let n = plan["parts"].as_u64().unwrap() as usize;
     assert!(n >= 4, "{plan}");
     println!(
@@ -245,6 +256,8 @@ fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
         &local_limit,
         "--threads",
         "1",
+        "--walls",
+        "none",
     ]);
     assert!(
         std::fs::read(&out).unwrap() == std::fs::read(&local).unwrap(),

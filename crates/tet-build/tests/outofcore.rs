@@ -320,6 +320,70 @@ fn split_recurses_until_parts_fit() {
     }
 }
 
+/// A target below the bound cuts further, every part stays under the
+/// bound, and `plan_split_within` plans exactly `plan_split`'s tree where
+/// one fits and gives up where none does.
+#[test]
+fn a_target_cuts_further_within_the_bound() {
+    use tet_build::outofcore::split::plan_split_within;
+    let scene = knot_grid(2, 60, 8);
+    let (lo, hi) = scene.bounds().unwrap();
+    let bounds = (lo - Vec3::splat(4.0), hi + Vec3::splat(4.0));
+    let (v, t) = (&scene.vertices, &scene.triangles);
+    let whole = plan_split(v, t, bounds, &SplitOptions::default()).max_predicted_bytes();
+    let limit = whole / 2;
+    let memory = plan_split(v, t, bounds, &SplitOptions::under_limit(limit, false));
+    let shaped = SplitOptions {
+        target_bytes: whole / 6,
+        ..SplitOptions::under_limit(limit, true)
+    };
+    let rays = plan_split(v, t, bounds, &shaped);
+    assert!(memory.max_predicted_bytes() <= limit);
+    assert!(rays.max_predicted_bytes() <= limit);
+    assert!(
+        rays.parts() > memory.parts(),
+        "{} parts for rays, {} for memory",
+        rays.parts(),
+        memory.parts()
+    );
+    assert_eq!(plan_split_within(v, t, bounds, &shaped), Some(rays));
+    // Under a limit no part can reach, within gives up; the plain plan
+    // keeps leaves above it.
+    let tiny = SplitOptions::under_limit(1 << 20, true);
+    assert_eq!(plan_split_within(v, t, bounds, &tiny), None);
+    assert!(plan_split(v, t, bounds, &tiny).max_predicted_bytes() > 1 << 20);
+}
+
+/// Once a part's seams and box alone are predicted above the target, it
+/// is cut for the target only while its own content is above it: a fan
+/// sphere under a target below even an empty part's prediction is cut
+/// until its parts hold little, not into the 65,536 leaves of depth 16
+/// (`fan-sphere:1m` under the walled build's 28 MiB went to 39,250 parts,
+/// now 816).
+#[test]
+fn a_target_out_of_reach_does_not_split_down_to_the_deepest_level() {
+    let scene = tet_build::procedural::by_name("fan-sphere:20000").unwrap();
+    let (lo, hi) = scene.bounds().unwrap();
+    let bounds = (lo - Vec3::ONE, hi + Vec3::ONE);
+    let empty = SplitOptions::default().model.predict_part(0, 20);
+    let split = SplitOptions {
+        target_bytes: empty / 2,
+        ..SplitOptions::default()
+    };
+    let tree = plan_split(&scene.vertices, &scene.triangles, bounds, &split);
+    // Every part above the target, as every part is here, used to be cut
+    // down to `max_depth`: 2^16 leaves. Now the cuts stop with the
+    // content (a pole's fan, which every plane near the pole cuts whole,
+    // still runs down as one chain of parts).
+    assert!(tree.parts() >= 8, "{} parts", tree.parts());
+    assert!(
+        tree.parts() < 1 << 10,
+        "{} parts, depth {}",
+        tree.parts(),
+        tree.depth()
+    );
+}
+
 // ---------------------------------------------------------------------------
 // Exact seams (one plane, two halves, merge).
 
@@ -1355,4 +1419,112 @@ fn million_triangle_fan_sphere_matches_in_core() {
     );
     assert!(report.part_tets.len() > 1);
     check_against_in_core(&scene, &mesh);
+}
+
+// ---------------------------------------------------------------------------
+// Jobs shaped for rays.
+
+/// Tets per camera ray of tet20 on `mesh`: 96×72 rays from outside the
+/// scene's box, looking at its middle (the walk enters through the mesh's
+/// boundary), no shadow rays.
+fn tets_per_ray(mesh: &TetMesh, scene: &Scene) -> f64 {
+    use tet_trace_cpu::render::{RenderOptions, render};
+    let tracer = <tet_trace_cpu::tet20::Tet20Tracer<'_>>::new(mesh).unwrap();
+    let (lo, hi) = scene.bounds().unwrap();
+    let c = (lo + hi) * 0.5;
+    let camera = tet_core::scene::Camera {
+        position: c + Vec3::new(0.7, 0.5, 1.0) * 2.5 * (hi - lo).max_element(),
+        target: c,
+        up: Vec3::Y,
+        vfov_deg: 40.0,
+    };
+    let opts = RenderOptions {
+        width: 96,
+        height: 72,
+        ..RenderOptions::default()
+    };
+    let stats = render(&tracer, &camera, &[], &opts).unwrap().stats;
+    assert_eq!(stats.failures, 0);
+    assert!(stats.hits > 0);
+    stats.tets_visited as f64 / stats.rays as f64
+}
+
+/// A job whose limit would allow the whole scene in one part is still cut
+/// into the walled build's parts (`SplitOptions::shaped_for_rays`), so its
+/// merged mesh takes as few tets per ray as the default walled build
+/// (within 5 %) and clearly fewer than the one-piece TetGen mesh, whose
+/// sliver fans fill the box's empty margin (what a job cut for memory
+/// alone merged into before).
+#[test]
+fn a_job_plan_gets_the_walls_of_the_default_build() {
+    use tet_build::outofcore::job::{PartOutcome, PlanOptions, build_part, merge_job, plan_job};
+    use tet_build::outofcore::tree::build_tree_with_memory_limit;
+
+    // Eight knots in a box twice their size: dense detail and a thick
+    // empty margin, where walls pay.
+    let scene = knot_grid(2, 120, 12);
+    let enclosing_box = BoxSpec::Relative { margin: 0.5 };
+    let seam = SeamOptions {
+        enclosing_box,
+        isolation: worker(),
+        ..SeamOptions::default()
+    };
+    let whole = predict_peak_memory(scene.vertices.len() + 8, scene.triangles.len() + 12);
+
+    let dir = tempfile::tempdir().unwrap();
+    let jobdir = dir.path().join("job");
+    let limit = 2 * whole;
+    let job = plan_job(
+        &scene,
+        &PlanOptions {
+            seam: seam.clone(),
+            limit_bytes: Some(limit),
+            ..PlanOptions::default()
+        },
+        &jobdir,
+    )
+    .unwrap();
+    assert!(
+        job.parts.len() > 1,
+        "one part: the job was cut for memory only"
+    );
+    for k in 0..job.parts.len() {
+        assert!(matches!(
+            build_part(&jobdir, &job, k, &worker()).unwrap(),
+            PartOutcome::Built(_)
+        ));
+    }
+    let out = dir.path().join("job.tmesh");
+    merge_job(&jobdir, &job, &out).unwrap();
+    let merged = tet_core::format::load(&out).unwrap();
+    merged.validate().unwrap();
+
+    let (walled, report, _) =
+        build_tree_with_memory_limit(&scene, &SplitOptions::shaped_for_rays(u64::MAX), &seam)
+            .unwrap();
+    assert_eq!(report.part_tets.len(), job.parts.len());
+    let one_piece = build(
+        &scene,
+        &BuildOptions {
+            enclosing_box: Some(enclosing_box),
+            ..BuildOptions::default()
+        },
+    )
+    .unwrap()
+    .0;
+    // The same box filled.
+    let (vm, vr) = (volume(&merged), volume(&one_piece));
+    assert!(((vm - vr) / vr).abs() < 1e-9, "volume {vm} vs {vr}");
+
+    let (job_tpr, walled_tpr, one_tpr) = (
+        tets_per_ray(&merged, &scene),
+        tets_per_ray(&walled, &scene),
+        tets_per_ray(&one_piece, &scene),
+    );
+    eprintln!(
+        "tets per ray: job {job_tpr:.1} ({} parts), walled {walled_tpr:.1}, one piece {one_tpr:.1}",
+        job.parts.len()
+    );
+    assert!(job_tpr <= 1.05 * walled_tpr, "{job_tpr} vs {walled_tpr}");
+    assert!(job_tpr < 0.95 * one_tpr, "{job_tpr} vs {one_tpr}");
 }

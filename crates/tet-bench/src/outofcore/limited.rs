@@ -13,7 +13,7 @@ use anyhow::{Context, Result, bail};
 use tet_build::bbox::EnclosingBox;
 use tet_build::outofcore::admission::{builder_bytes, worker_share};
 use tet_build::outofcore::seam::{SeamOptions, SeamReport, build_slabs, build_slabs_to_file};
-use tet_build::outofcore::split::{SlabPlan, SplitOptions, plan_slabs, plan_split};
+use tet_build::outofcore::split::{SlabPlan, SplitOptions, plan_slabs, plan_split_within};
 use tet_build::outofcore::stream::{StreamOptions, StreamSummary};
 use tet_build::outofcore::tree::{
     CutTree, TreePlan, build_tree_with_memory_limit, build_tree_with_memory_limit_to_file,
@@ -315,10 +315,13 @@ impl Limited<'_> {
     ) -> Result<(Split, usize)> {
         let (scene, limit_bytes) = (self.scene, self.limit_bytes);
         let own = builder_bytes(triangles);
-        let share = |p: usize| SplitOptions {
-            limit_bytes: worker_share(limit_bytes, triangles, p),
-            ..SplitOptions::default()
-        };
+        // Each leaf under its share and, as the default build is walled
+        // (`--walls auto`), cut toward the part size of that build where
+        // the share is larger: a mesh shaped for rays (the job planner
+        // cuts the same way). `--walls none`: for the limit alone.
+        let shaped = self.flags.walls() == crate::cli::Walls::Auto;
+        let share =
+            |p: usize| SplitOptions::under_limit(worker_share(limit_bytes, triangles, p), shaped);
         let max_parallel = self.max_parallel.max(1);
         // The paper's recursive tree (planes through the mean of the axis
         // of largest variance, moved to cut fewer triangles) first: on
@@ -331,9 +334,11 @@ impl Limited<'_> {
             .then(|| {
                 (1..=max_parallel).rev().find_map(|p| {
                     let opts = share(p);
-                    let plan = plan_split(&cleaned.vertices, &cleaned.triangles, bounds, &opts);
-                    (plan.max_predicted_bytes() <= opts.limit_bytes && plan.parts() >= p)
-                        .then_some((Split::Tree(opts), p))
+                    // A share too small gives up at its first part that
+                    // does not fit, not after planning the whole tree.
+                    plan_split_within(&cleaned.vertices, &cleaned.triangles, bounds, &opts)
+                        .filter(|plan| plan.parts() >= p)
+                        .map(|_| (Split::Tree(opts), p))
                 })
             })
             .flatten();

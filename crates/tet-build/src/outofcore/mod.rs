@@ -23,7 +23,9 @@
 //!   variance, moved to a nearby plane cutting fewer triangles — the
 //!   paper's future work; a thick empty margin around the scene's detail
 //!   is cut off first, [`split::peel_plane`]) as a [`split::SplitTree`] with the triangles cut
-//!   at every node; [`split::plan_slabs`] cuts parallel slabs on the axis
+//!   at every node; [`split::SplitOptions::shaped_for_rays`] also cuts
+//!   toward the part size of a mesh shaped for rays within the limit (the
+//!   default walled build, the local limited build and job plans); [`split::plan_slabs`] cuts parallel slabs on the axis
 //!   of largest variance at corner quantiles, as many as needed for every
 //!   slab's prediction to fit (the fallback when no tree fits).
 //! * [`seam_index`]: which points and faces lie on a seam (exact), for the

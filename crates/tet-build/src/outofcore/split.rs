@@ -159,6 +159,64 @@ pub struct SplitOptions {
     /// mesh shaped for rays), and [`super::tree::build_tree_with_memory_limit`]
     /// does not refuse with `LimitTooSmall`.
     pub best_effort: bool,
+    /// Parts are cut further, as far as the planes allow, until their
+    /// prediction is at most this (bytes; `u64::MAX`: no target): a target
+    /// for the walls of a mesh shaped for rays, never a bound, while
+    /// `limit_bytes` stays the bound. A part is cut for the target only
+    /// where its halves stay within the bound, and, once its seams and box
+    /// alone are predicted above the target (every part below carries them
+    /// whole), only while its own scene content is too. See
+    /// [`SplitOptions::shaped_for_rays`].
+    pub target_bytes: u64,
+}
+
+/// The part size that shapes a walled mesh for rays
+/// ([`SplitOptions::shaped_for_rays`]): dense regions cut until each
+/// part's predicted TetGen peak is about this, light parts and empty
+/// margins left whole. An unrefined `-pY` CDT fills empty space with long
+/// fans of slivers from the fine surface to the box's corners, which every
+/// ray crosses; walls cut them short. Tets per ray within 10 % of `-q5`'s
+/// (or fewer) on Torus Knots and Armadillo, alone and in a box, Nefertiti
+/// and `fan-sphere:200000` (20, 24, 28 and 32 MiB tried; 32 left Torus
+/// Knots 19 % above).
+pub const RAY_PART_TARGET_BYTES: u64 = 28 << 20;
+
+impl SplitOptions {
+    /// The split of every build that shapes its mesh for rays: parts cut
+    /// toward [`RAY_PART_TARGET_BYTES`] (a target), each predicted under
+    /// `limit_bytes` (a bound; `u64::MAX` for none). `tet-bench`'s
+    /// `--walls auto`, the local `--memory-limit` build and the job
+    /// planner ([`super::job::plan_job`]) all cut with it, so a job's or
+    /// a limited build's merged mesh takes no more tets per ray than the
+    /// default walled build where its limit allows parts of that size.
+    pub fn shaped_for_rays(limit_bytes: u64) -> SplitOptions {
+        SplitOptions {
+            limit_bytes,
+            target_bytes: RAY_PART_TARGET_BYTES,
+            ..SplitOptions::default()
+        }
+    }
+
+    /// The split of a build under `limit_bytes` (a bound on every part's
+    /// prediction): [`SplitOptions::shaped_for_rays`] when `for_rays` (the
+    /// walled default), else cut for the limit alone (fewer, larger
+    /// parts; as `--walls none` builds one piece).
+    pub fn under_limit(limit_bytes: u64, for_rays: bool) -> SplitOptions {
+        if for_rays {
+            SplitOptions::shaped_for_rays(limit_bytes)
+        } else {
+            SplitOptions {
+                limit_bytes,
+                ..SplitOptions::default()
+            }
+        }
+    }
+
+    /// The size a part is cut down to: the bound or, when lower, the
+    /// target.
+    fn cut_above(&self) -> u64 {
+        self.limit_bytes.min(self.target_bytes)
+    }
 }
 
 impl Default for SplitOptions {
@@ -171,6 +229,7 @@ impl Default for SplitOptions {
             search_step: 1.0 / 32.0,
             min_depth: 0,
             best_effort: false,
+            target_bytes: u64::MAX,
         }
     }
 }
@@ -355,94 +414,165 @@ pub fn peel_plane(
 }
 
 /// Plans the recursive split of the scene triangles inside `bounds` (the
-/// enclosing box of the whole build) under `options.limit_bytes`.
+/// enclosing box of the whole build) under `options.limit_bytes`. A part
+/// that no plane brings under the limit by `options.max_depth` stays a
+/// leaf above it ([`SplitTree::max_predicted_bytes`] tells);
+/// [`plan_split_within`] gives up at the first such part instead.
 pub fn plan_split(
     vertices: &[Vec3],
     triangles: &[[u32; 3]],
     bounds: (Vec3, Vec3),
     options: &SplitOptions,
 ) -> SplitTree {
-    let part: Vec<u32> = (0..triangles.len() as u32).collect();
-    let tolerance = NEAR_PLANE * (bounds.1 - bounds.0).max_element() as f64;
-    plan_part(vertices, triangles, part, 0, bounds, 0, options, tolerance)
+    Planning::new(vertices, triangles, bounds, options, false)
+        .part((0..triangles.len() as u32).collect(), 0, bounds, 0)
+        .expect("a plan that does not stop at the limit always ends")
 }
 
-#[allow(clippy::too_many_arguments)]
-fn plan_part(
+/// [`plan_split`] when every part must fit `options.limit_bytes`: `None`
+/// as soon as one part cannot (a leaf at `max_depth`, or one no plane
+/// splits, still above the limit), without planning the rest. The plans it
+/// returns are [`plan_split`]'s; a limit too small costs a few descents to
+/// `max_depth` instead of a whole tree split down to it (a builder trying
+/// several shares keeps its planning peak that of the plan it builds).
+pub fn plan_split_within(
     vertices: &[Vec3],
     triangles: &[[u32; 3]],
-    part: Vec<u32>,
-    seam_vertices: usize,
     bounds: (Vec3, Vec3),
-    depth: usize,
     options: &SplitOptions,
-    tolerance: f64,
-) -> SplitTree {
-    let mut used: Vec<u32> = part.iter().flat_map(|&t| triangles[t as usize]).collect();
-    used.sort_unstable();
-    used.dedup();
-    let points_estimate = used.len() + seam_vertices + 8;
-    let triangles_estimate = part.len() + 3 * seam_vertices + 12;
-    let predicted_bytes = predict_part(options, used.len(), part.len(), seam_vertices);
-    let wants_split = depth < options.min_depth
-        || (predicted_bytes > options.limit_bytes && depth < options.max_depth);
-    let leaf = |part: Vec<u32>| SplitTree::Leaf {
+) -> Option<SplitTree> {
+    Planning::new(vertices, triangles, bounds, options, true).part(
+        (0..triangles.len() as u32).collect(),
+        0,
         bounds,
-        triangles: part,
-        points_estimate,
-        triangles_estimate,
-        predicted_bytes,
-    };
-    if !wants_split {
-        return leaf(part);
-    }
-    let Some((plane, cut)) = peel_plane(vertices, triangles, &part, bounds, tolerance)
-        .or_else(|| choose_plane_avoiding(vertices, triangles, &part, bounds, options, tolerance))
-    else {
-        return leaf(part);
-    };
-    let (mut below, mut above) = (Vec::new(), Vec::new());
-    for &t in &part {
-        let tri = triangles[t as usize].map(|v| vertices[v as usize]);
-        match plane.classify(tri) {
-            Side::Below => below.push(t),
-            Side::Above => above.push(t),
-            Side::Cut | Side::InPlane => {
-                below.push(t);
-                above.push(t);
-            }
+        0,
+    )
+}
+
+/// What every part of one [`plan_split`] shares.
+struct Planning<'a> {
+    vertices: &'a [Vec3],
+    triangles: &'a [[u32; 3]],
+    options: &'a SplitOptions,
+    /// Planes within this of a vertex (not through it) are avoided.
+    tolerance: f64,
+    /// Give up (`None`) at the first part that stays above the limit.
+    stop: bool,
+}
+
+impl<'a> Planning<'a> {
+    fn new(
+        vertices: &'a [Vec3],
+        triangles: &'a [[u32; 3]],
+        bounds: (Vec3, Vec3),
+        options: &'a SplitOptions,
+        stop: bool,
+    ) -> Self {
+        Planning {
+            vertices,
+            triangles,
+            options,
+            tolerance: NEAR_PLANE * (bounds.1 - bounds.0).max_element() as f64,
+            stop,
         }
     }
-    let (lo, hi) = bounds;
-    let mut mid_hi = hi;
-    mid_hi[plane.axis] = plane.value;
-    let mut mid_lo = lo;
-    mid_lo[plane.axis] = plane.value;
-    let seam = seam_vertices + cut;
-    SplitTree::Split {
-        bounds,
-        plane,
-        triangles_cut: cut,
-        below: Box::new(plan_part(
-            vertices,
-            triangles,
-            below,
-            seam,
-            (lo, mid_hi),
-            depth + 1,
-            options,
-            tolerance,
-        )),
-        above: Box::new(plan_part(
-            vertices,
-            triangles,
-            above,
-            seam,
-            (mid_lo, hi),
-            depth + 1,
-            options,
-            tolerance,
-        )),
+
+    /// The plan of one part (`None`: it or a part below stays above the
+    /// limit and `self.stop`).
+    fn part(
+        &self,
+        part: Vec<u32>,
+        seam_vertices: usize,
+        bounds: (Vec3, Vec3),
+        depth: usize,
+    ) -> Option<SplitTree> {
+        let (vertices, triangles, options) = (self.vertices, self.triangles, self.options);
+        let mut used: Vec<u32> = part.iter().flat_map(|&t| triangles[t as usize]).collect();
+        used.sort_unstable();
+        used.dedup();
+        let points_estimate = used.len() + seam_vertices + 8;
+        let triangles_estimate = part.len() + 3 * seam_vertices + 12;
+        let predicted_bytes = predict_part(options, used.len(), part.len(), seam_vertices);
+        drop(used);
+        // Where the part's seams and box alone are predicted above the
+        // target, every part below carries them whole and never reaches
+        // it: the part is cut for the target only while its own scene
+        // content is predicted above it, so that the cuts spread the
+        // content and stop when only the seams are left (cut on regardless,
+        // such parts went down to `max_depth`: `fan-sphere:1m`, whose pole
+        // fans the planes near a pole cut, made 39,250 parts, now 816).
+        let floor = predict_part(options, 0, 0, seam_vertices);
+        let reachable = floor <= options.target_bytes
+            || predicted_bytes.saturating_sub(floor) > options.target_bytes;
+        let over = if reachable {
+            options.cut_above()
+        } else {
+            options.limit_bytes
+        };
+        let wants_split =
+            depth < options.min_depth || (predicted_bytes > over && depth < options.max_depth);
+        // A part within the bound but above the target is cut only where
+        // its halves stay within the bound (every ancestor's seam counts
+        // whole in a deeper part's estimate, so a half can be predicted
+        // above its parent): the target shapes the walls, it never turns a
+        // plan that fits into one that does not.
+        let within = predicted_bytes <= options.limit_bytes;
+        let for_target_only = depth >= options.min_depth && within;
+        let leaf = |part: Vec<u32>| {
+            (within || !self.stop).then_some(SplitTree::Leaf {
+                bounds,
+                triangles: part,
+                points_estimate,
+                triangles_estimate,
+                predicted_bytes,
+            })
+        };
+        if !wants_split {
+            return leaf(part);
+        }
+        let Some((plane, cut)) = peel_plane(vertices, triangles, &part, bounds, self.tolerance)
+            .or_else(|| {
+                choose_plane_avoiding(vertices, triangles, &part, bounds, options, self.tolerance)
+            })
+        else {
+            return leaf(part);
+        };
+        let (mut below, mut above) = (Vec::new(), Vec::new());
+        for &t in &part {
+            let tri = triangles[t as usize].map(|v| vertices[v as usize]);
+            match plane.classify(tri) {
+                Side::Below => below.push(t),
+                Side::Above => above.push(t),
+                Side::Cut | Side::InPlane => {
+                    below.push(t);
+                    above.push(t);
+                }
+            }
+        }
+        let (lo, hi) = bounds;
+        let mut mid_hi = hi;
+        mid_hi[plane.axis] = plane.value;
+        let mut mid_lo = lo;
+        mid_lo[plane.axis] = plane.value;
+        let seam = seam_vertices + cut;
+        let halves = self
+            .part(below, seam, (lo, mid_hi), depth + 1)
+            .and_then(|b| Some((b, self.part(above, seam, (mid_lo, hi), depth + 1)?)));
+        let split = halves.map(|(below, above)| SplitTree::Split {
+            bounds,
+            plane,
+            triangles_cut: cut,
+            below: Box::new(below),
+            above: Box::new(above),
+        });
+        match split {
+            Some(s) if for_target_only && s.max_predicted_bytes() > options.limit_bytes => {
+                leaf(part)
+            }
+            Some(s) => Some(s),
+            None if for_target_only => leaf(part),
+            None => None,
+        }
     }
 }
 

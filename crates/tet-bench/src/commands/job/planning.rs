@@ -62,6 +62,9 @@ pub fn plan(args: &BuildArgs, dir: &Path, json: bool) -> Result<()> {
             CliPlanner::Tree => Planner::Tree,
             CliPlanner::Slabs => Planner::Slabs,
         },
+        // As the default build: walled unless `--walls none` (or a
+        // quality bound, whose builds are one piece).
+        shaped_for_rays: flags.walls() == crate::cli::Walls::Auto,
         sort_parts: !flags.no_sort,
         time_limit_s: flags.time_limit,
         scene_info: SceneInfo {

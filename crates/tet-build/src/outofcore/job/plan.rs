@@ -52,6 +52,13 @@ pub struct PlanOptions {
     pub parts: usize,
     /// How to cut.
     pub planner: Planner,
+    /// Cut the tree's parts further, within the limit, toward the part
+    /// size of the default walled build
+    /// ([`SplitOptions::shaped_for_rays`]), so that the merged mesh takes
+    /// as few tets per ray as that build; `false`: cut for the limit alone
+    /// (fewer, larger parts: fewer tasks to schedule, a mesh slower to
+    /// trace).
+    pub shaped_for_rays: bool,
     /// Hilbert-sort each part before writing its result.
     pub sort_parts: bool,
     /// Seconds a part's TetGen worker may run.
@@ -67,6 +74,7 @@ impl Default for PlanOptions {
             limit_bytes: None,
             parts: 1,
             planner: Planner::Auto,
+            shaped_for_rays: true,
             sort_parts: true,
             time_limit_s: 600.0,
             scene_info: SceneInfo::default(),
@@ -136,10 +144,13 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
     // held while the tree's parts are made.
     drop(cleaned);
     let limit = options.limit_bytes.unwrap_or(u64::MAX);
+    // Cut as the local builds cut: under the limit and, unless told
+    // otherwise, toward the part size that shapes the merged mesh for rays
+    // (the walls of the default build), so that a job's mesh is traced as
+    // fast as theirs.
     let split = SplitOptions {
-        limit_bytes: limit,
         min_depth: min_depth(options.parts),
-        ..SplitOptions::default()
+        ..SplitOptions::under_limit(limit, options.shaped_for_rays)
     };
     let seam = &options.seam;
     let tree = match options.planner {

@@ -308,13 +308,22 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
         return Err(SeamError::EmptyScene);
     }
     let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
-    let plan =
-        super::split::plan_split(&cleaned.vertices, &cleaned.triangles, (b.min, b.max), split);
-    if plan.max_predicted_bytes() > split.limit_bytes && !split.best_effort {
+    let (vertices, triangles) = (&cleaned.vertices, &cleaned.triangles);
+    let plan = if split.best_effort {
+        Some(super::split::plan_split(
+            vertices,
+            triangles,
+            (b.min, b.max),
+            split,
+        ))
+    } else {
+        super::split::plan_split_within(vertices, triangles, (b.min, b.max), split)
+    };
+    let Some(plan) = plan else {
         return Err(SeamError::LimitTooSmall {
             limit_bytes: split.limit_bytes,
         });
-    }
+    };
     let mut tree = CutTree::from_split_tree(&plan);
     drop(cleaned);
     let mut moves = 0;
