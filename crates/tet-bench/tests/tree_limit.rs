@@ -9,15 +9,20 @@ use std::process::{Command, Stdio};
 use serde_json::Value;
 use tet_build::outofcore::tree_memory::TreeSampler;
 
-/// Runs `tet-bench ARGS` while sampling its process tree (it must
-/// succeed): its stdout and the sampled peak (KiB).
-fn sampled(args: &[&str]) -> (Vec<u8>, u64) {
-    let child = Command::new(env!("CARGO_BIN_EXE_tet-bench"))
+/// Starts `tet-bench ARGS` with its output piped.
+fn spawn(args: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_tet-bench"))
         .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .expect("tet-bench runs");
+        .expect("tet-bench runs")
+}
+
+/// Runs `tet-bench ARGS` while sampling its process tree (it must
+/// succeed): its stdout and the sampled peak (KiB).
+fn sampled(args: &[&str]) -> (Vec<u8>, u64) {
+    let child = spawn(args);
     let sampler = TreeSampler::start(child.id());
     let output = child.wait_with_output().unwrap();
     let peak = sampler.finish().expect("/proc is readable");
@@ -172,12 +177,7 @@ fn has_worker(pid: u32) -> bool {
 fn sampled_planning(args: &[&str]) -> (Vec<u8>, u64, u64) {
     use std::sync::atomic::{AtomicBool, Ordering};
     use tet_build::outofcore::tree_memory::tree_resident_kib;
-    let child = Command::new(env!("CARGO_BIN_EXE_tet-bench"))
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("tet-bench runs");
+    let child = spawn(args);
     let pid = child.id();
     let done = AtomicBool::new(false);
     let (output, (tree, planning)) = std::thread::scope(|s| {
