@@ -1,7 +1,7 @@
 //! Rays from a viewpoint outside the mesh enter it through its boundary.
 //!
 //! The papers' meshes hold the camera: the walk of every primary ray starts
-//! in the tet around it (seed 000 §4.2). When the enclosing box must hold the
+//! in the tet around it (Aman et al. 2022, §4.2). When the enclosing box must hold the
 //! camera, every primary ray first crosses the empty space between the
 //! camera and the scene, tet by tet: with a camera well outside the scene
 //! that is a large share of the tets a ray visits, and the rays that miss
@@ -50,9 +50,9 @@
 use glam::Vec3;
 use tet_core::TetMesh;
 
-use crate::kernel::Tracer;
 use crate::locate::{LocateError, locate};
 use crate::ray::{Ray, TraceOutcome};
+use crate::tracer::Tracer;
 pub use crate::walk::{BoundaryEntry, EntryHint, ViewpointError};
 use crate::walk::{Start, Starts};
 

@@ -65,8 +65,8 @@ use glam::Vec3;
 use tet_core::link::Link;
 use tet_core::{FACE_VERTICES, NO_TET, TetMesh};
 
-use crate::kernel::Tracer;
 use crate::ray::{Failure, Hit, Ray, TraceOutcome};
+use crate::tracer::Tracer;
 use crate::walk::{EntryHint, LANES, Start, Starts, face_hit, prefetch_index, step_cap};
 use predicates::{Line, side_filtered};
 use tet_core::predicates::orient3d_f32;

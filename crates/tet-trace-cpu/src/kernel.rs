@@ -1,5 +1,6 @@
-//! Shared plumbing of the kernel modules: the [`Tracer`] trait, the
-//! tracer type every layout kernel instantiates, and the [`WalkRecord`]
+//! Shared plumbing of the kernel modules: the tracer type every layout
+//! kernel instantiates ([`WalkTracer`], the [`Tracer`] trait re-exported
+//! from [`crate::tracer`]), and the [`WalkRecord`]
 //! glue that makes every index-based layout container ([`LayoutMesh`]) a
 //! [`Topology`] with one constructor.
 
@@ -10,88 +11,14 @@ use tet_core::layout::{LayoutError, LayoutMesh, LayoutRecord};
 use tet_core::link::Link;
 
 use crate::batch::BatchWalk;
+use crate::lost::{exact_if_lost, exact_where_lost};
 use crate::ray::{Ray, TraceOutcome};
+pub use crate::tracer::Tracer;
 pub use crate::walk::LANES;
 use crate::walk::{
     BoundaryEntry, EntryHint, ExitRule, Projection, RecordWords, Start, Starts, Topology,
     prefetch_index, step_cap, trace, trace_interleaved, trace_until,
 };
-
-/// A ray-traversal method over one mesh.
-pub trait Tracer: Sync {
-    /// Method name for reports (`"tet20/f32"`, ...).
-    fn name(&self) -> String;
-    /// The canonical mesh (cold data: points, constrained faces, attributes).
-    fn mesh(&self) -> &TetMesh;
-    /// Traces one ray from `start` (see [`Start`]).
-    fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome;
-
-    /// Traces many rays from one start into `out` (same length), e.g. the
-    /// primary rays of a tile. Kernels may interleave walks; the results
-    /// equal [`Tracer::trace`] ray by ray.
-    fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
-        for (r, o) in rays.iter().zip(out.iter_mut()) {
-            *o = self.trace(r, start);
-        }
-    }
-
-    /// Traces many rays into `out` (same length) from `starts`: one start
-    /// for all, one per ray, or each ray's entry into the mesh from outside
-    /// ([`Starts::Outside`], [`crate::entry`]; the entry decided by
-    /// [`Tracer::start_outside`]). Kernels may interleave walks; the results
-    /// equal [`Tracer::trace`] ray by ray.
-    fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
-        let mut hint = EntryHint::default();
-        for (i, (r, o)) in rays.iter().zip(out.iter_mut()).enumerate() {
-            let start = match starts {
-                Starts::Same(s) => Ok(s),
-                Starts::Each(s) => Ok(s[i]),
-                Starts::Outside(entry) => self.start_outside(entry, r, &mut hint),
-            };
-            *o = match start {
-                Ok(s) => self.trace(r, s),
-                Err(done) => done,
-            };
-        }
-    }
-
-    /// How a ray whose origin lies outside the mesh begins (see
-    /// [`BoundaryEntry::start_with`]): the entering boundary face decided
-    /// with this tracer's own edge test, so that entry and walk agree on
-    /// every boundary edge. The default decides with [`crate::DuffF32`],
-    /// the projection of the f32 kernels.
-    fn start_outside(
-        &self,
-        entry: &BoundaryEntry,
-        ray: &Ray,
-        hint: &mut EntryHint,
-    ) -> Result<Start, TraceOutcome> {
-        if !self.walks_tets() {
-            // Traced from its origin; `Start::Tet` is ignored.
-            return Ok(Start::Tet(0));
-        }
-        entry.start_with::<crate::walk::DuffF32>(self.mesh(), ray, hint)
-    }
-
-    /// False for a tracer that does not walk the tets (a BVH, a brute
-    /// force): it traces every ray from its origin, so a ray from outside
-    /// the mesh needs no entry face ([`Tracer::start_outside`]).
-    fn walks_tets(&self) -> bool {
-        true
-    }
-
-    /// A shadow ray: [`Tracer::trace`], except that a tet walk reports
-    /// [`TraceOutcome::Miss`] as soon as it enters a tet of `stop` (sorted;
-    /// the light's tets, see [`crate::secondary::LightTarget`]), start tet
-    /// included. The default ignores `stop`, which is right for tracers
-    /// without tets (a BVH): the ray then runs to its `t_max`, the light's
-    /// distance. The tet kernels override it so that a render's shadow rays
-    /// are walked by the kernel being measured.
-    fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
-        let _ = stop;
-        self.trace(ray, start)
-    }
-}
 
 /// A projected-walk kernel: layout `L` (a [`Topology`]) walked with
 /// projection `P`. The kernel modules ([`crate::tet20`], ...) name the
@@ -139,43 +66,29 @@ impl<L: Topology, P: BatchWalk> Tracer for WalkTracer<'_, L, P> {
     fn mesh(&self) -> &TetMesh {
         self.mesh
     }
+    /// The walk, or where it reached the step cap (lost in a tet thinner
+    /// than its rounding), the exact walk ([`crate::lost`]).
     #[inline]
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
-        trace::<P, L>(self.mesh, &self.layout, ray, start, self.cap)
+        let out = trace::<P, L>(self.mesh, &self.layout, ray, start, self.cap);
+        exact_if_lost(self.mesh, self.cap, ray, start, out)
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
-        P::trace_batch(
-            self.mesh,
-            &self.layout,
-            rays,
-            Starts::Same(start),
-            self.cap,
-            out,
-        )
+        self.trace_batch_from(rays, Starts::Same(start), out)
     }
     fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
         let mut n = rays.len().min(out.len());
         if let Starts::Each(s) = starts {
             n = n.min(s.len());
         }
-        P::trace_batch(
-            self.mesh,
-            &self.layout,
-            &rays[..n],
-            starts,
-            self.cap,
-            &mut out[..n],
-        )
+        let (rays, out) = (&rays[..n], &mut out[..n]);
+        P::trace_batch(self.mesh, &self.layout, rays, starts, self.cap, out);
+        exact_where_lost(self.mesh, self.cap, rays, starts, out);
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
-        trace_until::<P, L>(
-            self.mesh,
-            &self.layout,
-            ray,
-            start,
-            stop,
-            step_cap(self.mesh),
-        )
+        let cap = step_cap(self.mesh);
+        let out = trace_until::<P, L>(self.mesh, &self.layout, ray, start, stop, cap);
+        exact_if_lost(self.mesh, cap, ray, start, out)
     }
     fn start_outside(
         &self,
@@ -205,7 +118,9 @@ impl<L: Topology, P: BatchWalk> Tracer for Interleaved<'_, '_, L, P> {
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
         let w = self.0;
-        trace_interleaved::<P, L, LANES>(w.mesh, &w.layout, rays, Starts::Same(start), w.cap, out)
+        let starts = Starts::Same(start);
+        trace_interleaved::<P, L, LANES>(w.mesh, &w.layout, rays, starts, w.cap, out);
+        exact_where_lost(w.mesh, w.cap, rays, starts, out);
     }
 }
 

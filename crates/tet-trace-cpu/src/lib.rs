@@ -48,6 +48,7 @@ pub mod iso;
 pub mod kernel;
 pub mod locate;
 pub mod lockstep;
+mod lost;
 pub mod ray;
 pub mod reference;
 pub mod render;
@@ -58,6 +59,7 @@ pub mod tet16;
 pub mod tet20;
 pub mod tet32;
 pub mod tet80;
+pub mod tracer;
 pub mod walk;
 
 pub use batch::BatchWalk;

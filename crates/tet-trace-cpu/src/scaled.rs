@@ -1,4 +1,4 @@
-//! The scaled basis of Aman et al. (seed 000 §4.1, Eq. 1–3), specialised at
+//! The scaled basis of Aman et al. (2022, §4.1, Eq. 1–3), specialised at
 //! compile time.
 //!
 //! With `n` the ray direction, `min`/`max` the indices of its smallest and
@@ -30,6 +30,7 @@ use tet_core::TetMesh;
 use tet_core::layout::LayoutError;
 
 use crate::kernel::{LANES, Tracer, WalkTracer};
+use crate::lost::{exact_if_lost, exact_where_lost};
 use crate::ray::{Failure, Ray, TraceOutcome};
 use crate::walk::{DuffF32, Projection, Start, Starts, Topology, trace, trace_interleaved};
 
@@ -231,7 +232,8 @@ impl<L: Topology> Tracer for ScaledTracer<'_, L> {
             };
         };
         let w = &self.inner;
-        with_case!(case, P, trace::<P, L>(w.mesh, &w.layout, ray, start, w.cap))
+        let out = with_case!(case, P, trace::<P, L>(w.mesh, &w.layout, ray, start, w.cap));
+        exact_if_lost(w.mesh, w.cap, ray, start, out)
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
         let w = &self.inner;
@@ -262,6 +264,13 @@ impl<L: Topology> Tracer for ScaledTracer<'_, L> {
             );
             i = j;
         }
+        exact_where_lost(
+            w.mesh,
+            w.cap,
+            &rays[..n],
+            Starts::Same(start),
+            &mut out[..n],
+        );
     }
 }
 

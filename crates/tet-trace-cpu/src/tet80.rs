@@ -1,4 +1,4 @@
-//! Tet80 kernel: the Plücker traversal of Maria, Horna & Aveneau (seed 001
+//! Tet80 kernel: the Plücker traversal of Maria, Horna & Aveneau (2017,
 //! §3–4).
 //!
 //! Layout: [`tet_core::layout::Tet80`] = four vertex positions inline + four
@@ -111,6 +111,7 @@ use crate::kernel::Tracer;
 use crate::lockstep::batch_width as lockstep_width;
 use crate::lockstep::plucker::{Begun, PluckerWalk};
 use crate::lockstep::{self, Width};
+use crate::lost::{exact_if_lost, exact_where_lost};
 use crate::ray::{Failure, Hit, Ray, TraceOutcome};
 use crate::secondary::{ShadowTracer, stops_at};
 use crate::walk::{
@@ -442,7 +443,7 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
                 Starts::Outside(entry) => self.start_outside(entry, r, &mut hint),
             };
             *o = match start {
-                Ok(s) => self.trace(r, s),
+                Ok(s) => self.trace_with(r, s, None, |_| false),
                 Err(done) => done,
             };
         }
@@ -646,8 +647,11 @@ impl<const CONSISTENT: bool> Tracer for Tet80Tracer<'_, CONSISTENT> {
     fn mesh(&self) -> &TetMesh {
         self.mesh
     }
+    /// The walk, or where it reached the step cap, the exact walk
+    /// ([`crate::lost`]); likewise the batches.
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
-        self.trace_with(ray, start, None, |_| false)
+        let out = self.trace_with(ray, start, None, |_| false);
+        exact_if_lost(self.mesh, self.cap, ray, start, out)
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
         ShadowTracer::trace_until(self, ray, start, stop)
@@ -662,6 +666,7 @@ impl<const CONSISTENT: bool> Tracer for Tet80Tracer<'_, CONSISTENT> {
         if !done {
             self.trace_batch_scalar(rays, start, out);
         }
+        exact_where_lost(self.mesh, self.cap, rays, Starts::Same(start), out);
     }
     /// As [`Tracer::trace_batch`]: in lockstep where the CPU has AVX2 or
     /// AVX-512F, else ray after ray.
@@ -671,6 +676,7 @@ impl<const CONSISTENT: bool> Tracer for Tet80Tracer<'_, CONSISTENT> {
         if !done {
             self.trace_batch_from_scalar(rays, starts, out);
         }
+        exact_where_lost(self.mesh, self.cap, rays, starts, out);
     }
 }
 
@@ -679,6 +685,7 @@ impl<const CONSISTENT: bool> ShadowTracer for Tet80Tracer<'_, CONSISTENT> {
         self.mesh
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
-        self.trace_with(ray, start, None, |t| stops_at(stop, t))
+        let out = self.trace_with(ray, start, None, |t| stops_at(stop, t));
+        exact_if_lost(self.mesh, self.cap, ray, start, out)
     }
 }

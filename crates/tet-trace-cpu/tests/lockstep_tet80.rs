@@ -18,7 +18,7 @@ use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::lockstep::Width;
 use tet_trace_cpu::reference::{Aim, random_point_inside, ray_from_feature};
 use tet_trace_cpu::tet80::Tet80Tracer;
-use tet_trace_cpu::{Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint, locate};
+use tet_trace_cpu::{Failure, Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint, locate};
 
 mod common;
 use common::{adversarial_rays, batch, bits, grid};
@@ -34,17 +34,38 @@ fn fresh(n: usize) -> Vec<TraceOutcome> {
 }
 
 /// Every batch path of `t` on `rays` from `starts` equals the scalar
-/// single-ray walk `want` bit for bit: the lockstep walk at each width (it
-/// must run exactly where the CPU has the width), the dispatching
-/// `trace_batch_from` (and `trace_batch` for one start), and the scalar
-/// batch walks. Returns the widths that ran.
+/// single-ray walk bit for bit: the lockstep walk at each width (it must
+/// run exactly where the CPU has the width) and the scalar batch walks
+/// equal the scalar walk itself (`trace_batch_from_scalar`); the
+/// dispatching `trace_batch_from` (and `trace_batch` for one start) equal
+/// the tracer's single rays `want`, which differ from the walk only where
+/// it lost its way (step cap or no start: the exact walk takes over, see
+/// `tet_trace_cpu::lost`). Returns the widths that ran.
 fn check<const C: bool>(
     t: &Tet80Tracer<'_, C>,
     rays: &[Ray],
     starts: Starts<'_>,
     want: &[TraceOutcome],
 ) -> Vec<Width> {
-    let mut runs: Vec<(String, Vec<TraceOutcome>)> = Vec::new();
+    let mut raw = fresh(rays.len());
+    t.trace_batch_from_scalar(rays, starts, &mut raw);
+    for (i, r) in rays.iter().enumerate() {
+        let lost = matches!(
+            raw[i],
+            TraceOutcome::Failed {
+                failure: Failure::StepCap | Failure::Lost,
+                ..
+            }
+        );
+        if !lost {
+            assert_eq!(
+                bits(&raw[i]),
+                bits(&want[i]),
+                "only lost walks change: {r:?}"
+            );
+        }
+    }
+    let mut runs: Vec<(String, Vec<TraceOutcome>, &[TraceOutcome])> = Vec::new();
     let mut ran = Vec::new();
     for width in Width::ALL {
         let mut got = fresh(rays.len());
@@ -52,24 +73,21 @@ fn check<const C: bool>(
         assert_eq!(did, width.available(), "{}: {width:?} ran {did}", t.name());
         if did {
             ran.push(width);
-            runs.push((format!("lockstep {width:?}"), got));
+            runs.push((format!("lockstep {width:?}"), got, &raw));
         }
     }
     let mut got = fresh(rays.len());
     t.trace_batch_from(rays, starts, &mut got);
-    runs.push(("trace_batch_from".into(), got));
-    let mut got = fresh(rays.len());
-    t.trace_batch_from_scalar(rays, starts, &mut got);
-    runs.push(("trace_batch_from_scalar".into(), got));
+    runs.push(("trace_batch_from".into(), got, want));
     if let Starts::Same(s) = starts {
         let mut got = fresh(rays.len());
         t.trace_batch(rays, s, &mut got);
-        runs.push(("trace_batch".into(), got));
+        runs.push(("trace_batch".into(), got, want));
         let mut got = fresh(rays.len());
         t.trace_batch_scalar(rays, s, &mut got);
-        runs.push(("trace_batch_scalar".into(), got));
+        runs.push(("trace_batch_scalar".into(), got, &raw));
     }
-    for (name, got) in &runs {
+    for (name, got, want) in &runs {
         for (i, r) in rays.iter().enumerate() {
             assert_eq!(
                 bits(&got[i]),

@@ -87,19 +87,27 @@
 //!
 //! The moved mesh has three more consequences:
 //!
-//! * the start: the moved mesh can leave an origin on a face (the ray in
-//!   the face's plane) just outside the tets around it, so when none of
-//!   them has a counter-clockwise exit face, the tets next to them are
-//!   tried (`start::next_to_star`) before the last-resort guess;
+//! * the start: the moved mesh can leave an origin on or within rounding
+//!   of a face or edge (the ray in a face's plane) just outside the tets
+//!   around it, so when none of them has a counter-clockwise exit face,
+//!   the tets within two faces of them are tried (`start::next_to_star`),
+//!   the one the origin lies nearest outside of first (rounding moved the
+//!   origin across the faces it lies within rounding of; the nearest
+//!   centroid along the ray, the earlier rule, could start across the
+//!   constrained face the ray was about to hit, and miss it), before the
+//!   last-resort guess;
 //! * the entry from outside: coplanar boundary faces moved by rounding make
 //!   the boundary slightly non-convex, so a ray running in their plane may
 //!   enter through several; the one nearest along the ray is taken
 //!   ([`BoundaryEntry`]), whatever the search met first;
 //! * tets thinner than the rounding (slivers between nearly coplanar
-//!   constrained faces of a plane f32 cannot hold exactly, e.g. a tilted
-//!   CAD cap): a moved tet may be inverted, and there the walk may still
-//!   circle to the step cap (reported as a failure; the f64 walk and the
-//!   exact walk of [`crate::exact`] decide such rays).
+//!   faces of a plane f32 cannot hold exactly, e.g. a tilted CAD cap, or
+//!   TetGen's near-flat tets once rounded to f32): a moved tet may be
+//!   inverted, and there the walk may still circle. The step cap proves it
+//!   (more tets than any line's walk), and the tracers then walk that ray
+//!   again with the exact walk of [`crate::exact`] (`crate::lost`), so a
+//!   default-capped walk never reports `StepCap` for such a ray; the GPU
+//!   kernels, which have no exact walk, still report it.
 //!
 //! # Interleaving and the hot loop
 //!

@@ -172,10 +172,12 @@ fn boundary_face_at(mesh: &TetMesh, p: Vec3, around: &[u32]) -> Option<(u32, usi
 }
 
 /// When rounding left no tet around the origin with a counter-clockwise
-/// exit face: a tet next to them ([`next_to_star`]), else, as a last
+/// exit face: a tet near them ([`next_to_star`]), else, as a last
 /// resort, the face of `tet` whose smallest f64 edge function
 /// `d · (qa × qb)` is largest (the face the line leaves through, up to
-/// rounding).
+/// rounding). The CPU walks report `Lost` instead of guessing (their
+/// tracers then take the exact walk); this is for the GPU kernels' start,
+/// which has no exact walk to fall back on.
 fn start_fallback<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) -> State<P> {
     next_to_star(mesh, proj, ray, tet).unwrap_or_else(|| best_exit_guess(mesh, proj, ray, tet))
 }
@@ -183,27 +185,92 @@ fn start_fallback<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) 
 /// The walk's decisions are those of a line through the mesh with each
 /// vertex moved by its projection's rounding (see the module docs, "Why
 /// the walk ends"), and that moved mesh can leave the origin just outside
-/// the tets around it (an origin on or within rounding of a face, the ray
-/// running in the face's plane): the moved line then starts in a tet next
-/// to them, across a constrained face or not. Of the tets sharing a face
-/// with the origin's star that have a counter-clockwise exit face (the
-/// moved line passes through them, so a walk from one is a line's walk),
-/// the one whose centroid lies nearest the origin along the ray.
+/// the tets around it (an origin on or within rounding of a face or edge,
+/// the ray running in a face's plane): the moved line then starts in a tet
+/// near them, across a constrained face or not. Of the tets within
+/// [`NEAR_LAYERS`] faces of the origin's star that have a
+/// counter-clockwise exit face (the moved line passes through them, so a
+/// walk from one is a line's walk) and that the origin lies outside of by
+/// no more than rounding can move it ([`NEAR`] of its distance to the
+/// start tet's vertices; [`outside_by`]), the one it lies nearest
+/// outside of. (The nearest centroid along the ray, the earlier rule,
+/// could pick the tet across the constrained face the ray was about to
+/// hit, and so skip it; face neighbours alone missed a line moved across
+/// an edge the origin lies near.) Ties, as between tets around an edge or
+/// vertex the origin lies on, go to the centroid nearest the origin along
+/// the ray. `None` when no tet is that near.
 fn next_to_star<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) -> Option<State<P>> {
-    let around = star(mesh, ray.origin, tet, STAR_FIRST);
+    let mut seen = star(mesh, ray.origin, tet, STAR_FIRST);
     let (o, d) = (ray.origin.as_dvec3(), ray.direction.as_dvec3());
+    let reach = mesh
+        .tet_points(tet)
+        .iter()
+        .map(|p| (p.as_dvec3() - o).length())
+        .fold(0.0, f64::max)
+        * NEAR;
     let along = |t: u32| {
         let c = mesh.tet_points(t).map(|x| x.as_dvec3());
         ((c[0] + c[1] + c[2] + c[3]) * 0.25 - o).dot(d).abs()
     };
-    around
-        .iter()
-        .flat_map(|&t| (0..4).filter_map(move |k| mesh.across(t, k)))
-        .map(|side| side.tet)
-        .filter(|n| !around.contains(n))
-        .filter_map(|n| start_in_tet(mesh, proj, n).map(|s| (along(n), s)))
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .map(|(_, s)| s)
+    let mut layer = seen.clone();
+    let mut best: Option<((f64, f64), State<P>)> = None;
+    for _ in 0..NEAR_LAYERS {
+        let mut next = Vec::new();
+        for n in layer
+            .iter()
+            .flat_map(|&t| (0..4).filter_map(move |k| mesh.across(t, k)))
+        {
+            if seen.contains(&n.tet) || next.contains(&n.tet) {
+                continue;
+            }
+            next.push(n.tet);
+            let outside = outside_by(mesh, n.tet, o);
+            if outside > reach {
+                continue;
+            }
+            if let Some(s) = start_in_tet(mesh, proj, n.tet) {
+                let key = (outside, along(n.tet));
+                let better = |b: &(f64, f64)| key.0.total_cmp(&b.0).then(key.1.total_cmp(&b.1));
+                if best.as_ref().is_none_or(|(b, _)| better(b).is_lt()) {
+                    best = Some((key, s));
+                }
+            }
+        }
+        seen.extend_from_slice(&next);
+        layer = next;
+    }
+    best.map(|(_, s)| s)
+}
+
+/// How far outside a tet, relative to its distance from the start tet's
+/// vertices, rounding can move a ray origin ([`next_to_star`]): a few
+/// hundred f32 ulps, far above the few ulps the projection rounds by and
+/// far below any tet a line's walk would not pass near the origin.
+const NEAR: f64 = 1e-5;
+
+/// Face layers around the origin's star that [`next_to_star`] searches
+/// (its face neighbours, theirs, and theirs: enough for a line moved
+/// across an edge or vertex the origin lies near).
+const NEAR_LAYERS: usize = 3;
+
+/// How far `p` lies outside `tet`: the largest distance to the plane of a
+/// face it lies beyond (0 inside), in f64.
+fn outside_by(mesh: &TetMesh, tet: u32, p: glam::DVec3) -> f64 {
+    let v = mesh.tet_points(tet).map(|x| x.as_dvec3());
+    (0..4)
+        .map(|k| {
+            let [a, b, c] = FACE_VERTICES[k].map(|s| v[s]);
+            let n = (b - a).cross(c - a);
+            let len = n.length();
+            // Outward: away from the vertex opposite the face.
+            let s = if n.dot(v[k] - a) > 0.0 { -1.0 } else { 1.0 };
+            if len > 0.0 {
+                s * n.dot(p - a) / len
+            } else {
+                0.0
+            }
+        })
+        .fold(0.0, f64::max)
 }
 
 /// The face of `tet` whose smallest f64 edge function `d · (qa × qb)` is
@@ -327,8 +394,21 @@ pub(crate) fn begin_with<P: Projection>(
                 None => {
                     // The origin is on the start tet's boundary and the ray
                     // leaves it at once: try the other tets around the origin.
-                    search_star(mesh, &proj, ray.origin, t)
-                        .unwrap_or_else(|| start_fallback(mesh, &proj, ray, t))
+                    // Where rounding moved the line off all of them, the
+                    // tets near them; where none is near enough, the walk
+                    // reports `Lost` and the tracers take the exact walk
+                    // (`crate::lost`) rather than a guess.
+                    match search_star(mesh, &proj, ray.origin, t)
+                        .or_else(|| next_to_star(mesh, &proj, ray, t))
+                    {
+                        Some(s) => s,
+                        None => {
+                            return Err(TraceOutcome::Failed {
+                                failure: Failure::Lost,
+                                tets_visited: 0,
+                            });
+                        }
+                    }
                 }
             }
         }

@@ -1,0 +1,84 @@
+//! The [`Tracer`] trait: one ray-traversal method over one mesh, what
+//! every kernel, the exact walk and the BVH baselines implement, so that
+//! the renderer and the measurements take any of them.
+
+use tet_core::TetMesh;
+
+use crate::ray::{Ray, TraceOutcome};
+use crate::walk::{BoundaryEntry, EntryHint, Start, Starts};
+
+/// A ray-traversal method over one mesh.
+pub trait Tracer: Sync {
+    /// Method name for reports (`"tet20/f32"`, ...).
+    fn name(&self) -> String;
+    /// The canonical mesh (cold data: points, constrained faces, attributes).
+    fn mesh(&self) -> &TetMesh;
+    /// Traces one ray from `start` (see [`Start`]).
+    fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome;
+
+    /// Traces many rays from one start into `out` (same length), e.g. the
+    /// primary rays of a tile. Kernels may interleave walks; the results
+    /// equal [`Tracer::trace`] ray by ray.
+    fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
+        for (r, o) in rays.iter().zip(out.iter_mut()) {
+            *o = self.trace(r, start);
+        }
+    }
+
+    /// Traces many rays into `out` (same length) from `starts`: one start
+    /// for all, one per ray, or each ray's entry into the mesh from outside
+    /// ([`Starts::Outside`], [`crate::entry`]; the entry decided by
+    /// [`Tracer::start_outside`]). Kernels may interleave walks; the results
+    /// equal [`Tracer::trace`] ray by ray.
+    fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
+        let mut hint = EntryHint::default();
+        for (i, (r, o)) in rays.iter().zip(out.iter_mut()).enumerate() {
+            let start = match starts {
+                Starts::Same(s) => Ok(s),
+                Starts::Each(s) => Ok(s[i]),
+                Starts::Outside(entry) => self.start_outside(entry, r, &mut hint),
+            };
+            *o = match start {
+                Ok(s) => self.trace(r, s),
+                Err(done) => done,
+            };
+        }
+    }
+
+    /// How a ray whose origin lies outside the mesh begins (see
+    /// [`BoundaryEntry::start_with`]): the entering boundary face decided
+    /// with this tracer's own edge test, so that entry and walk agree on
+    /// every boundary edge. The default decides with [`crate::DuffF32`],
+    /// the projection of the f32 kernels.
+    fn start_outside(
+        &self,
+        entry: &BoundaryEntry,
+        ray: &Ray,
+        hint: &mut EntryHint,
+    ) -> Result<Start, TraceOutcome> {
+        if !self.walks_tets() {
+            // Traced from its origin; `Start::Tet` is ignored.
+            return Ok(Start::Tet(0));
+        }
+        entry.start_with::<crate::walk::DuffF32>(self.mesh(), ray, hint)
+    }
+
+    /// False for a tracer that does not walk the tets (a BVH, a brute
+    /// force): it traces every ray from its origin, so a ray from outside
+    /// the mesh needs no entry face ([`Tracer::start_outside`]).
+    fn walks_tets(&self) -> bool {
+        true
+    }
+
+    /// A shadow ray: [`Tracer::trace`], except that a tet walk reports
+    /// [`TraceOutcome::Miss`] as soon as it enters a tet of `stop` (sorted;
+    /// the light's tets, see [`crate::secondary::LightTarget`]), start tet
+    /// included. The default ignores `stop`, which is right for tracers
+    /// without tets (a BVH): the ray then runs to its `t_max`, the light's
+    /// distance. The tet kernels override it so that a render's shadow rays
+    /// are walked by the kernel being measured.
+    fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
+        let _ = stop;
+        self.trace(ray, start)
+    }
+}
