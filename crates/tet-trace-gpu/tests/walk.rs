@@ -137,8 +137,29 @@ fn check(
     let mut grazing = 0;
     let mut differ = 0;
     let mut bits_differ = 0;
+    let cap = tet_trace_cpu::walk::step_cap(mesh);
+    let mut exact = 0;
     for (i, ((ray, g), c)) in rays.iter().zip(gpu).zip(cpu).enumerate() {
         let graze = grazes_an_edge(mesh, ray, GRAZE);
+        // Where the CPU walk lost its way (the step cap) its tracer took
+        // the exact walk (`tet_trace_cpu::lost`), which the GPU has not: the
+        // GPU walk must then have reached the cap as well, or the ray
+        // grazes an edge (where the walks may differ).
+        if c.tets_visited() >= cap {
+            assert!(
+                matches!(
+                    g,
+                    TraceOutcome::Failed {
+                        failure: Failure::StepCap,
+                        ..
+                    }
+                ) || graze,
+                "{layout:?} ray {i} {ray:?}: the CPU walk was capped, the GPU gave {g:?}"
+            );
+            exact += 1;
+            wrong += 1;
+            continue;
+        }
         let tet80_as_cpu = layout == GpuLayout::Tet80 && same_walk(g, c);
         assert!(
             !g.is_failure() || graze || tet80_as_cpu,
@@ -195,7 +216,8 @@ fn check(
     eprintln!(
         "{layout:?}: {} rays: {grazing} grazing, {differ} walks differ from the CPU (all \
          grazing), {bits_differ} same walks with different t/barycentric bits, {wrong} \
-         non-grazing rays disagree with the brute force or fail (CPU and GPU alike)",
+         non-grazing rays disagree with the brute force or fail (CPU and GPU alike; \
+         {exact} capped, where the CPU took the exact walk)",
         rays.len()
     );
     differ
@@ -323,7 +345,24 @@ fn random_faces_case(ctx: &GpuContext, mesh: &TetMesh, layout: GpuLayout) {
     let (out2, _) = gpu.trace_batch(&rays2, &starts2).unwrap();
     let cpu2 = cpu_trace(mesh, layout, &rays2, &starts2, None);
     let mut differ = 0;
+    let cap = tet_trace_cpu::walk::step_cap(mesh);
     for (i, (g, c)) in out2.iter().zip(&cpu2).enumerate() {
+        if c.tets_visited() >= cap {
+            // The CPU walk was capped and its tracer took the exact walk
+            // (`tet_trace_cpu::lost`); the GPU has none: it must be capped
+            // too, or the ray grazes an edge (where the walks may differ).
+            assert!(
+                matches!(
+                    g,
+                    TraceOutcome::Failed {
+                        failure: Failure::StepCap,
+                        ..
+                    }
+                ) || grazes_an_edge(mesh, &rays2[i], GRAZE),
+                "secondary ray {i}: the CPU walk was capped, the GPU gave {g:?}"
+            );
+            continue;
+        }
         assert!(
             !g.is_failure()
                 || grazes_an_edge(mesh, &rays2[i], GRAZE)
