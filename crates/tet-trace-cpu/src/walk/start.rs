@@ -121,12 +121,8 @@ const STAR_LIMIT: usize = 1 << 20;
 /// the origin ([`start_in_tet`]), else a boundary face through the origin
 /// ([`boundary_face_at`]); `None` when neither exists (rounding), where the
 /// caller falls back.
-fn search_star<P: Projection>(
-    mesh: &TetMesh,
-    proj: &P,
-    origin: Vec3,
-    tet: u32,
-) -> Option<State<P>> {
+fn search_star<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32) -> Option<State<P>> {
+    let (origin, direction) = (ray.origin, ray.direction);
     let mut searched = 1;
     for limit in [STAR_FIRST, STAR_LIMIT] {
         let around = star(mesh, origin, tet, limit);
@@ -139,7 +135,7 @@ fn search_star<P: Projection>(
         // A boundary face only once the whole star is known to hold no
         // tet the line passes through.
         if around.len() < limit || limit == STAR_LIMIT {
-            return boundary_face_at(mesh, origin, &around)
+            return boundary_face_at(mesh, origin, direction, &around)
                 .map(|(c, k)| exit_state(mesh, proj, c, k));
         }
         searched = around.len();
@@ -148,8 +144,9 @@ fn search_star<P: Projection>(
 }
 
 /// A face on the mesh boundary (no tet behind it, constrained or not) that
-/// contains `p` (exact), among the faces of the tets `around` (each
-/// containing `p`): `(tet, face)`.
+/// contains `p` (exact) and that direction `d` does not point into the
+/// mesh from (f64), among the faces of the tets `around` (each containing
+/// `p`): `(tet, face)`.
 ///
 /// Where no tet around the origin has a counter-clockwise exit face, the
 /// ray's (perturbed) line passes through none of them. Inside the mesh that
@@ -157,15 +154,24 @@ fn search_star<P: Projection>(
 /// it is the ray leaving the mesh at once (a ray from a hull vertex or edge
 /// pointing outward), so the walk leaves through this face: a miss, or the
 /// constrained face the origin lies on at `t = 0`. Guessing an exit there
-/// instead sent the walk round an edge until the step cap.
-fn boundary_face_at(mesh: &TetMesh, p: Vec3, around: &[u32]) -> Option<(u32, usize)> {
-    let q = p.as_dvec3();
+/// instead sent the walk round an edge until the step cap. A ray from the
+/// boundary pointing into the mesh is not leaving, though: rounding moved
+/// its line off the tets around the origin, and the tets near them
+/// ([`next_to_star`]) hold it (taking the boundary face there missed a
+/// hit inside).
+fn boundary_face_at(mesh: &TetMesh, p: Vec3, d: Vec3, around: &[u32]) -> Option<(u32, usize)> {
+    let (q, d) = (p.as_dvec3(), d.as_dvec3());
     around.iter().find_map(|&t| {
         let v = mesh.tet_points(t).map(|x| x.as_dvec3());
         (0..4)
             .find(|&k| {
                 let [a, b, c] = FACE_VERTICES[k];
-                mesh.across(t, k).is_none() && orient3d(v[a], v[b], v[c], q) == 0.0
+                let n = (v[b] - v[a]).cross(v[c] - v[a]);
+                // Outward: away from the vertex opposite the face.
+                let out = if n.dot(v[k] - v[a]) > 0.0 { -n } else { n };
+                mesh.across(t, k).is_none()
+                    && orient3d(v[a], v[b], v[c], q) == 0.0
+                    && out.dot(d) >= 0.0
             })
             .map(|k| (t, k))
     })
@@ -297,7 +303,7 @@ fn best_exit_guess<P: Projection>(mesh: &TetMesh, proj: &P, ray: &Ray, tet: u32)
 pub fn start_exit_face<P: Projection>(mesh: &TetMesh, ray: &Ray, tet: u32) -> Option<(u32, usize)> {
     let proj = P::setup_scaled(ray, tet_scale(mesh, ray, tet));
     let s = start_in_tet(mesh, &proj, tet)
-        .or_else(|| search_star(mesh, &proj, ray.origin, tet))
+        .or_else(|| search_star(mesh, &proj, ray, tet))
         .unwrap_or_else(|| start_fallback(mesh, &proj, ray, tet));
     let f = (0..4).find(|&k| {
         mesh.neighbors[s.tet as usize][k].0 == s.link && {
@@ -398,7 +404,7 @@ pub(crate) fn begin_with<P: Projection>(
                     // tets near them; where none is near enough, the walk
                     // reports `Lost` and the tracers take the exact walk
                     // (`crate::lost`) rather than a guess.
-                    match search_star(mesh, &proj, ray.origin, t)
+                    match search_star(mesh, &proj, ray, t)
                         .or_else(|| next_to_star(mesh, &proj, ray, t))
                     {
                         Some(s) => s,
