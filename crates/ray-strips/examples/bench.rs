@@ -15,7 +15,11 @@ use ray_strips::{BuildOptions, Ray, RayStrips};
 
 mod common;
 use common::{cpu_seconds, framing, load_obj};
-const BUNNY: &str = "/work/shared/scenes/stanford-bunny.obj";
+/// The Stanford bunny of the repository's `scenes/`.
+const BUNNY: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../scenes/stanford-bunny.obj"
+);
 
 /// The Torus Knots scene: a copy of `tet_build::procedural::torus_knot` on
 /// its grid, kept here so that this crate does not depend on the tet crates.

@@ -18,7 +18,11 @@ use common::{cpu_seconds, framing, load_obj};
 const RES: usize = 512;
 /// Timed runs per measurement (the best counts).
 const RUNS: usize = 5;
-const BUNNY: &str = "/work/shared/scenes/stanford-bunny.obj";
+/// The Stanford bunny of the repository's `scenes/`.
+const BUNNY: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../scenes/stanford-bunny.obj"
+);
 
 fn bumpy_sphere(rings: u32, segments: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let point = |theta: f32, phi: f32| {

@@ -1,5 +1,5 @@
 //! Ray-Strips: Lauterbach, Yoon and Manocha, "Ray-Strips: A Compact Mesh
-//! Representation for Interactive Ray Tracing" (IEEE RT 2007; seed 002).
+//! Representation for Interactive Ray Tracing" (IEEE Symposium on Interactive Ray Tracing 2007).
 //!
 //! A two-level structure (paper §3.3): a high-level BVH built with the
 //! surface-area heuristic down to chunks of at most

@@ -1,4 +1,4 @@
-//! Accuracy at scale: Maria et al.'s failure rates (seed 001 Table 4) over
+//! Accuracy at scale: Maria et al.'s failure rates (2017, Table 4) over
 //! 10⁸ rays and more, which no one batch holds in memory. The rays come in
 //! batches of [`BATCH_RAYS`] — the first with the camera's 1024² image,
 //! each with random interior rays and as many adversarial rays

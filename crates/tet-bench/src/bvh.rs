@@ -11,9 +11,9 @@
 //! over the *same* BVH that walks its `Bvh2` nodes with our own copy of
 //! obvhs's stack traversal ([`BvhTracer::count_trace`]: same child order,
 //! same pruning by the closest hit so far) and reports the number of nodes
-//! whose bounding box was tested (root included) as `tets_visited`: seed
-//! 000 Table 5's "visited node count per pixel" (pbrt counts a node when
-//! it tests its bounds). Timed renders use obvhs's own traversal; the
+//! whose bounding box was tested (root included) as `tets_visited`: the
+//! "visited node count per pixel" of Aman et al. (2022) Table 5 (pbrt
+//! counts a node when it tests its bounds). Timed renders use obvhs's own traversal; the
 //! counting one is run once, untimed, and checked to return the same hits.
 
 use std::time::Duration;

@@ -22,14 +22,19 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Build a tetrahedral mesh from a scene and write it to a mesh file.
+    #[command(after_help = procedural_scenes_help())]
     Build(BuildArgs),
     /// Counts and exact bytes per layout of a scene or mesh file.
+    #[command(after_help = procedural_scenes_help())]
     Info(InfoArgs),
     /// Render a scene with one traversal method and report timings.
+    #[command(after_help = procedural_scenes_help())]
     Render(RenderArgs),
     /// Compare every method against an f64 brute-force reference.
+    #[command(after_help = procedural_scenes_help())]
     Accuracy(AccuracyArgs),
     /// Run the whole reproduction and write Markdown, CSV and JSON tables.
+    #[command(after_help = procedural_scenes_help())]
     Tables(TablesArgs),
     /// Trace isosurfaces of a tetrahedral volume (a VTK, TetGen or mesh
     /// file with point scalars, or a synthetic volume's name).
@@ -53,6 +58,23 @@ pub enum Command {
     /// Internal: serve one TetGen request on stdin/stdout (isolated builds).
     #[command(hide = true)]
     TetgenWorker,
+}
+
+/// The help's list of the procedural scenes a `SCENE` argument may name,
+/// one line each, printed from [`tet_build::procedural::SCENES`]: the list
+/// the names are parsed against.
+pub fn procedural_scenes_help() -> String {
+    let scenes = tet_build::procedural::SCENES;
+    let width = scenes.iter().map(|p| p.name.len()).max().unwrap_or(0);
+    let mut help = String::from(
+        "SCENE is an OBJ file (scenes/stanford-bunny.obj), a scene of a scenes.json \
+         (scenes/scenes.json#Armadillo; the file alone lists its scenes), or a procedural \
+         scene (N: a count, with an optional k or m suffix):\n",
+    );
+    for p in scenes {
+        help.push_str(&format!("  {:width$}  {}\n", p.name, p.about));
+    }
+    help
 }
 
 /// How to build a mesh from a scene.
@@ -155,13 +177,14 @@ impl Walls {
 /// `build` arguments.
 #[derive(Debug, Args)]
 pub struct BuildArgs {
-    /// Scene: a procedural name (`torus-knots`, …), an OBJ path, or `FILE.json#Name`.
+    /// Scene: a procedural name (`torus-knots`, …; listed below), an OBJ
+    /// path, or `FILE.json#Name` (`scenes/scenes.json#Armadillo`).
     pub scene: String,
     /// Output mesh file (required unless `--predict-memory` or `--plan`).
     #[arg(short, long, required_unless_present_any = ["predict_memory", "plan"])]
     pub output: Option<PathBuf>,
     /// Print TetGen's predicted peak memory for this scene (the memory
-    /// model of Erkoç et al., seed 003 §3.2) and exit without building.
+    /// model of Erkoç et al. 2021, §3.2) and exit without building.
     #[arg(long)]
     pub predict_memory: bool,
     /// Keep this process and its TetGen workers together under this size
@@ -306,7 +329,8 @@ pub fn parse_mem_per_part(s: &str) -> Result<MemPerPart, String> {
 /// `info` arguments.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Scene (built on the fly) or mesh file (`.tmesh`).
+    /// Scene (built on the fly; procedural names listed below) or mesh
+    /// file (`.tmesh`).
     pub scene: String,
     /// Also report the bytes left after pruning the regions that neither the
     /// camera nor a light is in (no ray can reach them).
@@ -321,22 +345,22 @@ pub struct InfoArgs {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, ValueEnum, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
-    /// Lagae & Dutré scalar triple products (32-byte baseline layout).
+    /// Scalar triple products (Lagae & Dutré 2008; 32-byte baseline layout).
     Sctp,
-    /// Maria et al. Plücker traversal (Tet80 layout).
+    /// Plücker traversal (Maria et al. 2017; Tet80 layout).
     Tet80,
     /// Tet80 with consistent side products: one per edge, the same in
     /// every tet around it (canonical edge orientation, one rule for zero).
     Tet80Consistent,
-    /// Aman et al. 2-D projected traversal on Tet32.
+    /// 2-D projected traversal of Aman et al. (2022) on Tet32.
     Tet32,
-    /// Aman et al. on Tet20.
+    /// 2-D projected traversal of Aman et al. (2022) on Tet20.
     Tet20,
-    /// Aman et al. on Tet16.
+    /// 2-D projected traversal of Aman et al. (2022) on Tet16.
     Tet16,
     /// BVH baseline (obvhs, BVH2).
     Obvhs,
-    /// Ray-Strips (Lauterbach et al.): strip hierarchies under an SAH BVH,
+    /// Ray-Strips (Lauterbach et al. 2007): strip hierarchies under an SAH BVH,
     /// one ray at a time.
     Strips,
     /// Ray-Strips with 2×2 ray packets (groups of four consecutive rays).
@@ -396,7 +420,8 @@ impl Method {
 /// `render` arguments.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Scene or mesh file.
+    /// Scene (procedural names listed below; an OBJ path; `FILE.json#Name`)
+    /// or mesh file (`.tmesh`).
     pub scene: String,
     /// Traversal method.
     #[arg(long, value_enum, default_value_t = Method::Tet20)]
@@ -490,7 +515,8 @@ pub enum Precision {
 /// `accuracy` arguments.
 #[derive(Debug, Args)]
 pub struct AccuracyArgs {
-    /// Scene or mesh file.
+    /// Scene (procedural names listed below; an OBJ path; `FILE.json#Name`)
+    /// or mesh file (`.tmesh`).
     pub scene: String,
     /// Methods to check (comma separated) or `all`.
     #[arg(long, default_value = "all")]
@@ -499,7 +525,7 @@ pub struct AccuracyArgs {
     #[arg(long, default_value_t = 100_000)]
     pub rays: usize,
     /// Side of the square camera image whose primary rays are checked
-    /// (Maria et al. count failures per 1024² image).
+    /// (Maria et al. 2017 count failures per 1024² image).
     #[arg(long, default_value_t = 1024)]
     pub image: u32,
     /// Random seed.
@@ -532,7 +558,8 @@ pub struct AccuracyArgs {
 /// `tables` arguments.
 #[derive(Debug, Args)]
 pub struct TablesArgs {
-    /// A scenes.json whose scenes to include (default: the procedural Torus Knots scenes).
+    /// A scenes.json whose scenes to include, e.g. `scenes/scenes.json`
+    /// (default: the procedural Torus Knots scenes and Flat Parts).
     #[arg(long)]
     pub scenes: Option<PathBuf>,
     /// Smaller images and fewer frames: finishes in minutes on 2 cores.
@@ -544,8 +571,9 @@ pub struct TablesArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Measure this scene (repeatable; any SCENE as for `render`). Replaces
-    /// the default Torus Knots scenes; added to those of `--scenes`.
+    /// Measure this scene (repeatable; any SCENE as for `render`, the
+    /// procedural ones listed below). Replaces the default Torus Knots
+    /// scenes; added to those of `--scenes`.
     #[arg(long = "scene", value_name = "SCENE")]
     pub scene: Vec<String>,
     /// Directory of the SVG figures (default: the `--out` directory).
@@ -775,7 +803,7 @@ pub struct IsoArgs {
     /// comparisons; the hits are the same).
     #[arg(long)]
     pub no_regions: bool,
-    /// `buckycube` only: `N` bucky balls per axis, N³ in all (seed 004
+    /// `buckycube` only: `N` bucky balls per axis, N³ in all (Wald et al. 2007,
     /// Table 3; 1 to 8, default 2).
     #[arg(long, value_name = "N")]
     pub replications: Option<u32>,

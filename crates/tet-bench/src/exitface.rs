@@ -1,4 +1,4 @@
-//! Exit-face search cost (seed 001 Table 5): the time to choose the exit
+//! Exit-face search cost (Maria et al. 2017, Table 5): the time to choose the exit
 //! face of a tet a ray has entered, per method, single-threaded.
 //!
 //! Maria et al. time "16,384 random rays stabbing 10,000 random
@@ -13,7 +13,7 @@
 //!   (Aman et al.) projecting the new vertex `d` and the three edge signs
 //!   ([`Projection::left_mask`] + [`EXIT_SLOT`]), for scalar triple
 //!   products (Lagae & Dutré, [`TripleF32`]) the same with 3-D products,
-//!   for the Plücker method of seed 001 ([`tet80`](tet_trace_cpu::tet80))
+//!   for the Plücker method of Maria et al. (2017) ([`tet80`](tet_trace_cpu::tet80))
 //!   `m = d × (V_e − o)` and two side products looked up in
 //!   [`tet_trace_cpu::tet80::EXIT`] (its walk loop is private; the same
 //!   formulas are written here and checked against the f64 exit face).
@@ -24,11 +24,11 @@
 //!   interior points of the grid walked to their first constrained face
 //!   by every CPU kernel (layout, memory and all), time per tet visited.
 //!
-//! | seed 001 Table 5 | here |
+//! | Maria et al. (2017) Table 5 | here |
 //! |---|---|
 //! | Ours (two Plücker side products) | `plucker (tet80)` |
 //! | STP | `triple products (sctp)` |
-//! | — (seed 000) | `2-D projection` rows |
+//! | — (Aman et al. 2022) | `2-D projection` rows |
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -43,7 +43,7 @@ use tet_trace_cpu::reference::{Aim, random_direction, random_ray};
 use tet_trace_cpu::walk::{EXIT_SLOT, Projection, Start};
 use tet_trace_cpu::{DuffF32, DuffF64, OriginF32, TripleF32};
 
-/// Seed 001 Table 5, CPU single thread: ms for 10,000 tets × 16,384 rays.
+/// Maria et al. (2017) Table 5, CPU single thread: ms for 10,000 tets × 16,384 rays.
 pub const PAPER_TABLE5_CPU_MS: [(&str, f64); 5] = [
     ("Ray/plane", 15_623.0),
     ("Plücker (Lagae & Dutré)", 10_101.0),
@@ -52,7 +52,7 @@ pub const PAPER_TABLE5_CPU_MS: [(&str, f64); 5] = [
     ("Ours (Maria et al.)", 2_663.0),
 ];
 
-/// Stabs in seed 001 Table 5.
+/// Stabs in Maria et al. (2017) Table 5.
 pub const PAPER_STABS: f64 = 10_000.0 * 16_384.0;
 
 /// Sizes of the exit-face harness.
@@ -105,7 +105,7 @@ pub struct StabRow {
     pub operations: String,
     /// Decisions that differ from the f64 exit face (0 expected).
     pub wrong: u64,
-    /// Seed 001's ns per stab for the same method, when it has one.
+    /// The ns per stab of Maria et al. (2017) for the same method, when it has one.
     pub paper_ns_per_stab: Option<f64>,
 }
 
@@ -278,8 +278,8 @@ fn second_slot(e: usize, left_of_a: bool) -> usize {
     if left_of_a { c } else { b }
 }
 
-/// Times the Plücker decision of seed 001 (as in the Tet80 kernel: two
-/// side products in the frame of the vertex opposite the entry face).
+/// Times the Plücker decision of Maria et al. (2017), as in the Tet80 kernel:
+/// two side products in the frame of the vertex opposite the entry face.
 fn time_plucker(mesh: &TetMesh, stabs: &[Stab], reps: u32) -> (f64, u64) {
     // The Tet80 record holds the four positions inline.
     let records: Vec<[Vec3; 4]> = stabs
@@ -321,7 +321,7 @@ fn best_of(reps: u32, mut f: impl FnMut() -> u32) -> f64 {
     best
 }
 
-/// The paper's ns per stab for a row of seed 001 Table 5.
+/// The paper's ns per stab for a row of Maria et al. (2017) Table 5.
 fn paper_ns(name: &str) -> Option<f64> {
     PAPER_TABLE5_CPU_MS
         .iter()
@@ -371,7 +371,7 @@ pub fn stab_rows(mesh: &TetMesh, stabs: &[Stab], reps: u32) -> Vec<StabRow> {
             paper_ns("STP"),
         ),
         row(
-            "Plücker side products, f32 (seed 001)",
+            "Plücker side products, f32 (Maria et al. 2017)",
             "tet80",
             time_plucker(mesh, stabs, reps),
             "m: 3 sub + 6 mul + 3 sub; 2 × (3 sub + 3 mul + 2 add); 2 cmp + table (paper: 28)",

@@ -1,4 +1,4 @@
-//! Isosurfaces of tetrahedral volumes (Wald et al., seed 004): one volume
+//! Isosurfaces of tetrahedral volumes (Wald et al. 2007): one volume
 //! (a VTK, TetGen or mesh file with a scalar field, or a synthetic stand-in
 //! of `tet_build::volume`), one method, timed frames of primary rays, and
 //! the paper's Table 4 counters per ray. The `iso` command and the

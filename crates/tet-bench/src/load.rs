@@ -296,7 +296,7 @@ pub fn build_scene_in(
 
 /// `--walls`: a scene built as parts with exact walls between them, in
 /// memory, even when it would fit one TetGen run. The out-of-core
-/// builder's recursive planes (Erkoç et al., seed 003) cut the enclosing
+/// builder's recursive planes (Erkoç et al. 2021) cut the enclosing
 /// box ([`crate::cli::Walls`] says how finely), each part is tetrahedralized by its own
 /// TetGen worker (as many at once as there are cores), and the parts merge
 /// exactly. Why: an unrefined `-pY` CDT fills empty space with long fans

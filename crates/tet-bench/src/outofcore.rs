@@ -1,4 +1,4 @@
-//! Building under a memory limit (Erkoç et al., seed 003): `build --predict-memory`,
+//! Building under a memory limit (Erkoç et al. 2021): `build --predict-memory`,
 //! `build --memory-limit`, and the out-of-core table of `tables`.
 //!
 //! The prediction is `tet_build`'s memory model

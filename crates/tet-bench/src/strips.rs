@@ -1,4 +1,4 @@
-//! The Ray-Strips method (Lauterbach et al., seed 002; the `ray-strips`
+//! The Ray-Strips method (Lauterbach et al. 2007; the `ray-strips`
 //! crate) behind the same [`Tracer`] interface as the tet walks and the
 //! BVH: the structure is built over the mesh's input triangles (its
 //! constrained faces merged back into the scene's triangles:

@@ -528,7 +528,7 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
             .contains("--quick")
     );
     let md = std::fs::read_to_string(out.join("tables.md")).unwrap();
-    assert!(md.contains("Exit-face search (seed 001 Table 5)"));
+    assert!(md.contains("Exit-face search (Maria et al. 2017, Table 5)"));
     assert!(md.contains("skipped in --quick"));
 
     // Figures: well-formed SVG with one mark per data point.
@@ -592,7 +592,7 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
         bpt(0),
         bpt(1)
     );
-    assert!(md.contains("Large models (seed 002 §6)"));
+    assert!(md.contains("Large models (Lauterbach et al. 2007, §6)"));
     // One mark per structure with bytes and a render: tet20, tet16, tet32,
     // Ray-Strips and obvhs per scene, plus the large model's three.
     assert_eq!(
@@ -966,7 +966,7 @@ fn iso_methods_agree() {
     ]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("time step 3"));
-    // The bucky cube grows by whole balls (seed 004 Table 3): 1 ball is
+    // The bucky cube grows by whole balls (Wald et al. 2007, Table 3): 1 ball is
     // one 27×33×33 grid in six, 8 balls eight of them.
     for (n, tets) in [("1", 6 * 27 * 33 * 33), ("2", 8 * 6 * 27 * 33 * 33)] {
         let d = json(&[

@@ -8,7 +8,13 @@
 //!   unless its first lines say why (a line starting `//! Long file:`);
 //! * no project issue numbers in user-facing text (README, module docs,
 //!   comments, CLI help): users do not know what they are, so the text names
-//!   the paper and section instead.
+//!   the paper and section instead;
+//! * a README of at most [`MAX_README_LINES`] lines: the rest lives in
+//!   `docs/`;
+//! * no paper named by an internal number (the word "seed" and 000 … 004)
+//!   in the README, `docs/` or the crates' sources (doc comments, comments,
+//!   string literals: table headings, figure titles, CLI help): papers are
+//!   named by their authors and year.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -16,6 +22,10 @@ use std::path::{Path, PathBuf};
 
 /// Longest source file, in lines before its `#[cfg(test)] mod tests`.
 const MAX_LINES: usize = 800;
+
+/// Longest README, in lines: what the project is, the two commands, the
+/// crates, one results table and where everything else is.
+const MAX_README_LINES: usize = 250;
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -30,6 +40,24 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
         if p.is_dir() {
             rust_files(&p, out);
         } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// Every file under `dir` whose name ends with one of `exts`.
+fn files_ending(dir: &Path, exts: &[&str], out: &mut Vec<PathBuf>) {
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            files_ending(&p, exts, out);
+        } else if exts
+            .iter()
+            .any(|x| p.to_string_lossy().ends_with(&format!(".{x}")))
+        {
             out.push(p);
         }
     }
@@ -375,4 +403,100 @@ fn no_issue_numbers_in_user_facing_text() {
     assert!(issue_number_at("the memory model of issue 8").is_some());
     assert!(issue_number_at("see Issue #12.").is_some());
     assert!(issue_number_at("no issues here; tissue 3").is_none());
+}
+
+#[test]
+fn readme_is_short() {
+    let text = fs::read_to_string(workspace().join("README.md")).expect("README.md");
+    let lines = text.lines().count();
+    assert!(
+        lines <= MAX_README_LINES,
+        "README.md has {lines} lines, more than {MAX_README_LINES}: move the detail to docs/"
+    );
+}
+
+/// Files that still name papers by number because they are being edited
+/// elsewhere: being edited, to be cleared (then remove them from this list).
+const SEED_ALLOWED: [&str; 4] = [
+    "crates/tet-trace-cpu/src/exact.rs",
+    "crates/tet-trace-cpu/src/lib.rs",
+    "crates/tet-trace-cpu/src/walk/mod.rs",
+    "crates/tet-trace-cpu/src/walk/projection.rs",
+];
+
+/// The lines of `text` without their indentation and comment markers
+/// (`//!`, `///`, `//`, a block comment's `*`), joined by single spaces and
+/// lower-cased, so that a phrase wrapped across comment lines reads as one.
+fn flowing(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        let t = line.trim_start();
+        let t = ["//!", "///", "//", "*"]
+            .iter()
+            .find_map(|m| t.strip_prefix(m))
+            .unwrap_or(t);
+        for word in t.split_whitespace() {
+            out.push_str(&word.to_lowercase());
+            out.push(' ');
+        }
+    }
+    out
+}
+
+/// Where `text` (as [`flowing`] gives it) names a paper by its internal
+/// number: "seed" or "seeds", a space or hyphen, then "00".
+fn seed_number_at(flowing: &str) -> Option<usize> {
+    let mut from = 0;
+    while let Some(i) = flowing[from..].find("seed") {
+        let at = from + i;
+        from = at + 4;
+        if flowing[..at].ends_with(|c: char| c.is_ascii_alphanumeric()) {
+            continue;
+        }
+        let rest = flowing[from..]
+            .strip_prefix('s')
+            .unwrap_or(&flowing[from..]);
+        if let Some(rest) = rest.strip_prefix([' ', '-'])
+            && rest.starts_with("00")
+        {
+            return Some(at);
+        }
+    }
+    None
+}
+
+#[test]
+fn papers_are_named_by_authors_not_numbers() {
+    let root = workspace();
+    let mut files = vec![root.join("README.md"), root.join("fuzz/README.md")];
+    files_ending(&root.join("docs"), &["md"], &mut files);
+    for src in crate_src_dirs() {
+        files_ending(&src, &["rs", "wgsl"], &mut files);
+    }
+    let mut hits = Vec::new();
+    for file in files {
+        let rel = file.strip_prefix(&root).unwrap_or(&file);
+        let rel = rel.to_string_lossy().replace('\\', "/");
+        if SEED_ALLOWED.contains(&rel.as_str()) {
+            continue;
+        }
+        let text = fs::read_to_string(&file).expect("readable text");
+        let text = flowing(&text);
+        if let Some(at) = seed_number_at(&text) {
+            let end = (at + 60).min(text.len());
+            let end = (end..=text.len())
+                .find(|&e| text.is_char_boundary(e))
+                .unwrap_or(text.len());
+            hits.push(format!("{rel}: …{}…", &text[at..end]));
+        }
+    }
+    assert!(
+        hits.is_empty(),
+        "papers named by number (write e.g. \"Aman et al. (2022)\"):\n{}",
+        hits.join("\n")
+    );
+    assert!(seed_number_at(&flowing("(Aman et al., seed\n//! 000 §5)")).is_some());
+    assert!(seed_number_at(&flowing("Seeds 001 and 002")).is_some());
+    assert!(seed_number_at(&flowing("/// Seed 004 Table 3")).is_some());
+    assert!(seed_number_at(&flowing("--seed 7; XXH64, seed 0; fuzz/seeds/")).is_none());
 }

@@ -224,13 +224,15 @@ fn sampled_planning(args: &[&str]) -> (Vec<u8>, u64, u64) {
     (output, tree, planning)
 }
 
-/// `file` in the shared scenes' directory (`../shared/scenes/` beside the project
-/// root, or `TET_SHARED_SCENES`), if it is there.
+/// `file` (`FILE` or `FILE#Scene`) in the scenes' directory, if it is
+/// there: `TET_SHARED_SCENES` when set (a copy of the whole data set, the
+/// files the repository leaves out included), else the repository's
+/// `scenes/` (see its README).
 fn shared_scene(file: &str) -> Option<String> {
     let dir = std::env::var_os("TET_SHARED_SCENES")
         .map(std::path::PathBuf::from)
         .unwrap_or_else(|| {
-            std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes")
+            std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
         });
     let path = dir.join(file.split('#').next().unwrap_or(file));
     path.is_file().then(|| dir.join(file).display().to_string())
@@ -258,7 +260,7 @@ fn planned_build(scene: &str, limit: &str) -> (Value, u64, u64) {
 /// planning peak, measured from outside until the first TetGen worker
 /// starts, and is within [`WITHIN`] of it; the whole tree stays under the
 /// limit. At the lowest limits that build: Torus Knots in a Box at
-/// 56 MiB and, where the shared scenes are, the Stanford bunny at 64 MiB
+/// 56 MiB and the Stanford bunny of `scenes/` at 64 MiB
 /// (refused before the model was fitted: it set 45 MiB aside where the
 /// builder peaks at 26).
 #[test]
@@ -266,7 +268,7 @@ fn the_builders_share_models_its_planning_peak() {
     let mut cases = vec![("torus-knots-box".to_string(), "56M")];
     match shared_scene("stanford-bunny.obj") {
         Some(bunny) => cases.push((bunny, "64M")),
-        None => eprintln!("shared scenes not found: the bunny is skipped"),
+        None => eprintln!("scenes/stanford-bunny.obj not found: the bunny is skipped"),
     }
     for (scene, limit) in cases {
         let (doc, tree, planning) = planned_build(&scene, limit);
@@ -294,16 +296,18 @@ fn the_builders_share_models_its_planning_peak() {
 /// them into `BUILDER_BASE_BYTES` and `BUILDER_BYTES_PER_TRIANGLE`): the
 /// larger of the job planner's peak (`build --plan`, a limit where the
 /// tree fits) and the local builder's before its first worker (at the
-/// scene's lowest limit). Needs the shared scenes; run in release:
+/// scene's lowest limit). Needs `box.obj` and the Neptune mesh, which the
+/// repository leaves out (`scenes/README.md` says how to get them); run in
+/// release:
 /// `cargo test -p tet-bench --release --test tree_limit -- --ignored --nocapture measure_builder_model`
 /// (about 5 minutes on 2 cores).
 ///
 /// [`BuilderModel::fit`]: tet_build::outofcore::admission::BuilderModel::fit
 #[test]
-#[ignore = "minutes; needs the shared scenes"]
+#[ignore = "minutes; needs box.obj and the Neptune mesh, which the repository leaves out"]
 fn measure_builder_model() {
     use tet_build::outofcore::admission::{BuilderModel, BuilderSample, builder_bytes};
-    let bunny = shared_scene("stanford-bunny.obj").expect("the shared scenes");
+    let bunny = shared_scene("stanford-bunny.obj").expect("scenes/stanford-bunny.obj");
     let armadillo = shared_scene("scenes.json#Armadillo in a Box").unwrap();
     let mix = shared_scene("scenes.json#Mix in a Box").unwrap();
     let scenes = [

@@ -31,11 +31,11 @@
 //!   [`tetgen_files`], [`vtk`]: TetGen's and ParaView's (VTK) file formats,
 //!   VTK with per-point scalar fields.
 //! * [`volume`]: tetrahedral volumes with scalar fields for isosurface
-//!   tracing (Wald et al., seed 004): split grids, analytic fields, named
+//!   tracing (Wald et al. 2007): split grids, analytic fields, named
 //!   stand-ins for the paper's data sets.
 //! * [`pipeline`]: the in-core build, stage by stage.
 //! * [`outofcore`]: the build under a memory limit, part by part (Erkoç et
-//!   al., seed 003).
+//!   al. 2021).
 
 #![deny(missing_docs)]
 

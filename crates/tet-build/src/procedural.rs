@@ -34,59 +34,115 @@ use tet_core::scene::{Camera, PointLight};
 
 use crate::scene::{MeshData, ObjectPlacement, Scene, Transform, orbit_camera};
 
-/// Names accepted by [`by_name`].
-pub const NAMES: &[&str] = &[
-    "torus-knot",
-    "torus-knots",
-    "torus-knots-box",
-    "cube",
-    "tetrahedron",
-    "sphere",
-    "two-quads",
-    "thin-slab",
-    "gear",
-    "flat-parts",
-];
-
-/// Parameterised names accepted by [`by_name`] besides [`NAMES`]:
-/// `dense-knots:N` is "Torus Knots" with about `N` triangles
-/// ([`dense_torus_knots`]; `N` may end in `k` or `m`).
-/// `fan-sphere:N` is a bumpy UV sphere of about `N` triangles whose poles
-/// are fans of about `√N` long thin triangles ([`fan_sphere_by_count`]).
-pub const PATTERNS: &[&str] = &["dense-knots:N", "fan-sphere:N"];
-
-/// Build a procedural scene by name (see [`NAMES`] and [`PATTERNS`]).
-pub fn by_name(name: &str) -> Option<Scene> {
-    let single = |n: &str, mesh: MeshData| single_object_scene(n, &mesh);
-    Some(match name {
-        "torus-knot" => single("torus-knot", torus_knot(&TorusKnotParams::default())),
-        "torus-knots" => torus_knots(false),
-        "torus-knots-box" => torus_knots(true),
-        "cube" => single("cube", cube(1.0)),
-        "tetrahedron" => single("tetrahedron", tetrahedron()),
-        "sphere" => single("sphere", icosphere(2)),
-        "two-quads" => single("two-quads", two_quads(0.5)),
-        "thin-slab" => single("thin-slab", thin_slab(0.01)),
-        "gear" => single("gear", crate::flat::gear(12, 0.3, 0.3)),
-        "flat-parts" => crate::flat::flat_parts(),
-        _ => return by_pattern(name),
-    })
+/// A procedural scene: the name [`by_name`] and the command line take,
+/// what it is, and how it is built. [`SCENES`] is the one list of them:
+/// [`by_name`] looks names up in it and the command line's help prints it.
+#[derive(Clone, Copy)]
+pub struct Procedural {
+    /// The name; one ending in `:N` takes a count for `N` (as
+    /// [`parse_count`] reads it: `dense-knots:10m`).
+    pub name: &'static str,
+    /// What it is, in one line.
+    pub about: &'static str,
+    /// Builds it from the name as given and the count (0 without `:N`).
+    build: fn(&str, u64) -> Scene,
 }
 
-/// The scenes of [`PATTERNS`]: `dense-knots:N` ([`dense_torus_knots`]) and
-/// `fan-sphere:N` ([`fan_sphere_by_count`]), `N` a count as
-/// [`parse_count`] reads it, e.g. `dense-knots:10m`.
-fn by_pattern(name: &str) -> Option<Scene> {
-    let (pattern, count) = name.split_once(':')?;
-    let n = parse_count(count)?;
-    match pattern {
-        "dense-knots" => Some(dense_torus_knots(n)),
-        "fan-sphere" => Some(single_object_scene(
-            name,
-            &fan_sphere(&fan_sphere_by_count(n)),
-        )),
-        _ => None,
+impl Procedural {
+    /// The name without its `:N` for a parameterised scene (`dense-knots`),
+    /// else `None`.
+    pub fn pattern(&self) -> Option<&'static str> {
+        self.name.strip_suffix(":N")
     }
+}
+
+impl std::fmt::Debug for Procedural {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Procedural")
+            .field("name", &self.name)
+            .field("about", &self.about)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Every procedural scene, in the order the help lists them.
+pub const SCENES: &[Procedural] = &[
+    Procedural {
+        name: "torus-knot",
+        about: "one torus knot: the authors' torus_knot.obj rebuilt (2,880 triangles)",
+        build: |name, _| single_object_scene(name, &torus_knot(&TorusKnotParams::default())),
+    },
+    Procedural {
+        name: "torus-knots",
+        about: "\"Torus Knots\" of Aman et al. (2022): 27 knots, the paper's camera and light (77,760 triangles)",
+        build: |_, _| torus_knots(false),
+    },
+    Procedural {
+        name: "torus-knots-box",
+        about: "\"Torus Knots in a Box\": the 27 knots inside the mirrored box (77,772 triangles)",
+        build: |_, _| torus_knots(true),
+    },
+    Procedural {
+        name: "cube",
+        about: "the cube [-1,1]³ (12 triangles)",
+        build: |name, _| single_object_scene(name, &cube(1.0)),
+    },
+    Procedural {
+        name: "tetrahedron",
+        about: "the tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1) (4 triangles)",
+        build: |name, _| single_object_scene(name, &tetrahedron()),
+    },
+    Procedural {
+        name: "sphere",
+        about: "a unit icosphere (320 triangles)",
+        build: |name, _| single_object_scene(name, &icosphere(2)),
+    },
+    Procedural {
+        name: "two-quads",
+        about: "two parallel unit squares 0.5 apart, both facing +z (4 triangles)",
+        build: |name, _| single_object_scene(name, &two_quads(0.5)),
+    },
+    Procedural {
+        name: "thin-slab",
+        about: "a closed slab [-1,1]² × [-0.005,0.005] (12 triangles)",
+        build: |name, _| single_object_scene(name, &thin_slab(0.01)),
+    },
+    Procedural {
+        name: "gear",
+        about: "a 12-tooth gear with a bore, caps of long thin triangles as CAD exporters write them",
+        build: |name, _| single_object_scene(name, &crate::flat::gear(12, 0.3, 0.3)),
+    },
+    Procedural {
+        name: "flat-parts",
+        about: "\"Flat Parts\": flat-faced CAD-like solids on one shared plane (about 2,200 triangles)",
+        build: |_, _| crate::flat::flat_parts(),
+    },
+    Procedural {
+        name: "dense-knots:N",
+        about: "\"Torus Knots\" tessellated to about N triangles, at least 77,760 (dense-knots:10m)",
+        build: |_, n| dense_torus_knots(n),
+    },
+    Procedural {
+        name: "fan-sphere:N",
+        about: "a bumpy sphere of about N triangles whose poles are fans of about √N long thin triangles (fan-sphere:1m)",
+        build: |name, n| single_object_scene(name, &fan_sphere(&fan_sphere_by_count(n))),
+    },
+];
+
+/// Build a procedural scene by name: a name of [`SCENES`], or the `name`
+/// of one ending in `:N` with a count for `N` ([`parse_count`], e.g.
+/// `dense-knots:10m`: [`dense_torus_knots`]; `fan-sphere:N`:
+/// [`fan_sphere_by_count`]).
+pub fn by_name(name: &str) -> Option<Scene> {
+    if let Some(p) = SCENES
+        .iter()
+        .find(|p| p.pattern().is_none() && p.name == name)
+    {
+        return Some((p.build)(name, 0));
+    }
+    let (pattern, count) = name.split_once(':')?;
+    let p = SCENES.iter().find(|p| p.pattern() == Some(pattern))?;
+    Some((p.build)(name, parse_count(count)?))
 }
 
 /// A count written as digits with an optional `k` or `m` suffix
@@ -106,7 +162,7 @@ pub fn parse_count(text: &str) -> Option<u64> {
 /// each knot's tube subdivided by a factor `s` in both directions
 /// (`⌈120·s⌉` segments of `⌈12·s⌉` sides) so that the scene has about
 /// `triangles` triangles (never fewer than the original 77,760). It is the
-/// large model of the Ray-Strips comparison (Lauterbach et al., seed 002
+/// large model of the Ray-Strips comparison (Lauterbach et al. 2007,
 /// §6: Ray-Strips against a BVH as the model outgrows memory): the same
 /// view and shape at every size, only the tessellation grows.
 pub fn dense_torus_knots(triangles: u64) -> Scene {

@@ -1,4 +1,4 @@
-//! Tetrahedron quality metrics, in f64, as reported by Erkoç et al. (seed 003,
+//! Tetrahedron quality metrics, in f64, as reported by Erkoç et al. (2021,
 //! Table 3).
 //!
 //! | paper              | code                           | definition                                   |

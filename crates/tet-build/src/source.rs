@@ -15,7 +15,7 @@ pub fn load_scene_spec(spec: &str) -> Result<Scene, SceneError> {
 
 impl Scene {
     /// Load from a spec string: `file.obj`, `scenes.json#Scene Name`, or a
-    /// procedural name (see [`procedural::NAMES`]).
+    /// procedural name (see [`procedural::SCENES`]).
     pub fn load(spec: &str) -> Result<Scene, SceneError> {
         if let Some((path, name)) = spec.rsplit_once('#') {
             return scenes_json::load_scene(Path::new(path), name);
@@ -29,7 +29,8 @@ impl Scene {
             });
         }
         if spec.to_ascii_lowercase().ends_with(".obj") {
-            return Scene::load_obj(Path::new(spec));
+            return Scene::load_obj(Path::new(spec))
+                .map_err(|e| scenes_json::with_obtain_from(e, Path::new(spec)));
         }
         if let Some(scene) = procedural::by_name(spec) {
             return Ok(scene);
@@ -38,10 +39,9 @@ impl Scene {
             spec: spec.into(),
             message: format!(
                 "expected an .obj path, `scenes.json#Scene Name`, or one of the procedural scenes: {}",
-                procedural::NAMES
+                procedural::SCENES
                     .iter()
-                    .chain(procedural::PATTERNS)
-                    .copied()
+                    .map(|p| p.name)
                     .collect::<Vec<_>>()
                     .join(", ")
             ),

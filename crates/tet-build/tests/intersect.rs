@@ -147,8 +147,14 @@ proptest! {
     }
 }
 
+/// `file` in the scenes' directory, loaded, if it is there: `TET_SHARED_SCENES`
+/// when set (a copy of the whole data set, the files the repository leaves
+/// out included; see `scenes/README.md`), else the repository's `scenes/`.
 fn shared_scene(file: &str) -> Option<Scene> {
-    let p = Path::new("/work/shared/scenes").join(file);
+    let dir = std::env::var_os("TET_SHARED_SCENES")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes"));
+    let p = dir.join(file);
     if !p.exists() {
         eprintln!("skipping: {} not present", p.display());
         return None;

@@ -1,4 +1,4 @@
-//! Out-of-core construction (Erkoç et al., seed 003): memory model and split plan.
+//! Out-of-core construction (Erkoç et al. 2021): memory model and split plan.
 
 #![cfg(feature = "tetgen")]
 
@@ -825,7 +825,7 @@ fn tet20_mrays(mesh: &TetMesh, scene: &Scene) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Trade measurement (Erkoç et al., seed 003 §4): in-core TetGen vs the out-of-core
+/// Trade measurement (Erkoç et al. 2021, §4): in-core TetGen vs the out-of-core
 /// builders at 1/2, 1/3 and 1/4 of the in-core measured peak, 2 parts at a
 /// time, on Torus Knots in a Box and on a 125-knot grid: parallel slabs
 /// (`build_with_memory_limit`) and the paper's recursive tree with

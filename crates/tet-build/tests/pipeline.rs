@@ -497,7 +497,10 @@ fn measure_pipeline_against_bare_tetgen() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(3);
-    let bunny = "/work/shared/scenes/stanford-bunny.obj";
+    let bunny = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/stanford-bunny.obj"
+    );
     let mut cases: Vec<(String, Scene, Option<BoxSpec>)> = vec![(
         "Torus Knots in a Box".into(),
         tet_build::procedural::by_name("torus-knots-box").unwrap(),

@@ -1,5 +1,5 @@
 //! Per-point scalar fields: the data an isosurface is extracted from
-//! (Wald et al., seed 004: a scalar value at every vertex of a tetrahedral
+//! (Wald et al. 2007: a scalar value at every vertex of a tetrahedral
 //! volume, interpolated linearly inside each tet, possibly one array per
 //! time step).
 //!

@@ -1,4 +1,4 @@
-//! 3-D Hilbert curve keys for memory reordering (Aman et al., seed 000 §5).
+//! 3-D Hilbert curve keys for memory reordering (Aman et al. 2022, §5).
 //!
 //! The paper sorts points by position and tets by centroid along a Hilbert
 //! curve so that elements close in space are close in memory. Here a position

@@ -13,7 +13,7 @@
 //!   fuzzing and benchmarks).
 //! * [`fields`]: an optional per-point scalar field with one or more time
 //!   steps ([`Attributes::scalars`]), the data isosurfaces are traced in
-//!   (Wald et al., seed 004); stored in the mesh file's scalar block.
+//!   (Wald et al. 2007); stored in the mesh file's scalar block.
 //!
 //! Conventions (used by every layout and kernel):
 //! * tet `t` has vertices `tets[t] = [v0, v1, v2, v3]`, positively oriented:

@@ -1,6 +1,6 @@
 //! The 32-bit neighbour reference stored in every layout.
 //!
-//! Aman et al. (seed 000 §3) store a constrained-face flag in the neighbour
+//! Aman et al. (2022, §3) store a constrained-face flag in the neighbour
 //! field so that the hot traversal loop needs only one load to know whether
 //! it must stop. The encoding here:
 //!

@@ -1,5 +1,5 @@
 //! Exact memory accounting of every layout, split into hot and cold data, so
-//! that Table 4 of seed 000 ("accelerator size") can be reproduced.
+//! that Table 4 of Aman et al. (2022) ("accelerator size") can be reproduced.
 //!
 //! * **hot**: what the traversal loop reads — the tet records and the point
 //!   array (Tet80 has its positions inline and no point array);
@@ -9,7 +9,7 @@
 //!   reconstruction-only data (point array and vertex ids, kept so it can be
 //!   decoded back to a [`TetMesh`]; the Plücker walk never reads them).
 //!
-//! Seed 000's Table 4 counts, for Tet32/20/16, the tets plus a per-scene
+//! Table 4 of Aman et al. (2022) counts, for Tet32/20/16, the tets plus a per-scene
 //! remainder equal across the three (points and constrained faces), and for
 //! Tet80 the tets alone; compare `hot()` (+ `constrained` for the xor
 //! layouts) with it.
@@ -169,7 +169,7 @@ impl MemoryReport {
 }
 
 impl fmt::Display for MemoryReport {
-    /// A plain table in MB (10⁶ bytes, as in seed 000 Table 4) and exact bytes.
+    /// A plain table in MB (10⁶ bytes, as in Aman et al. (2022) Table 4) and exact bytes.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,

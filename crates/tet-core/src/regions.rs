@@ -1,6 +1,6 @@
 //! Mesh regions, pruning of unreachable regions, and brute-force point location.
 //!
-//! Aman et al. (seed 000 §5) observe that a CDT splits into *regions*: sets of
+//! Aman et al. (2022, §5) observe that a CDT splits into *regions*: sets of
 //! tets enclosed by constrained faces (and the mesh boundary). A ray stops at
 //! the first constrained face, so one traversal never leaves the region it
 //! started in. Two uses follow:

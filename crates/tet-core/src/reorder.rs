@@ -1,5 +1,5 @@
-//! Memory reordering of a [`TetMesh`] for cache locality (Aman et al., seed
-//! 000 §5 "Reordering tetrahedral mesh data").
+//! Memory reordering of a [`TetMesh`] for cache locality (Aman et al.
+//! 2022, §5 "Reordering tetrahedral mesh data").
 //!
 //! The paper sorts points by position and tets by centre point along a
 //! Hilbert curve, and additionally stores the tets of one region together

@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 
-/// A pinhole camera (conventions of `../shared/scenes/scenes.json`: look-at,
-/// world up +y, image plane at distance 1, vertical field of view `vfov_deg`,
+/// A pinhole camera (conventions of the repository's `scenes/scenes.json`:
+/// look-at, world up +y, image plane at distance 1, vertical field of view `vfov_deg`,
 /// pixel `(i, j)` maps to `2i/W - 1`, `1 - 2j/H` without a half-pixel offset
 /// unless the renderer is asked for pixel centres).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,4 +1,4 @@
-//! Isosurface ray tracing throughput (seed 004): IBVH builds (BIH, SAH),
+//! Isosurface ray tracing throughput (Wald et al. 2007): IBVH builds (BIH, SAH),
 //! refit, single rays, 16 × 16 packets and the iso walks (Tet32, Tet20,
 //! Tet16) on a Kuhn grid with a sum-of-Gaussians field, primary rays of a
 //! camera framing the box. A plain timing harness (not criterion): each

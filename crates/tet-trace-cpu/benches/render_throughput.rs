@@ -73,7 +73,7 @@ fn main() {
         seed: 1,
         ..Default::default()
     });
-    // Memory order (seed 000 §5): TT_ORDER = hilbert (default), region, none.
+    // Memory order (Aman et al. 2022, §5): TT_ORDER = hilbert (default), region, none.
     let order = std::env::var("TT_ORDER").unwrap_or_else(|_| "hilbert".into());
     match order.as_str() {
         "hilbert" => {

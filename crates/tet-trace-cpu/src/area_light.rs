@@ -1,5 +1,5 @@
-//! Area lights and mesh lights sampled by shadow rays (Aman et al., seed
-//! 000 §6: "handling mesh lights is straightforward by using the proposed
+//! Area lights and mesh lights sampled by shadow rays (Aman et al.
+//! 2022, §6: "handling mesh lights is straightforward by using the proposed
 //! traversal methods").
 //!
 //! An [`AreaLight`] is a set of emitting pieces (parallelograms or

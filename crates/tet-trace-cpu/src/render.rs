@@ -3,7 +3,7 @@
 //! a heat map of tets visited per pixel, and per-frame statistics for the
 //! bench harness.
 //!
-//! Conventions (`../shared/scenes/scenes.json`, `conventions` block):
+//! Conventions (`scenes/scenes.json` in the repository, `conventions` block):
 //! `forward = normalize(target − position)`,
 //! `right = −normalize(up × forward)`, `cam_up = −(forward × right)`; image
 //! plane at distance 1 with half-height `tan(vfov/2)` (45° ⇒ `tan(π/8)`),
@@ -20,7 +20,7 @@
 //! its line crosses and a ray that misses the mesh visits no tet
 //! ([`crate::entry`]).
 //!
-//! Shadows (seed 000 §6): each point light is located once per frame, from
+//! Shadows (Aman et al. 2022, §6): each point light is located once per frame, from
 //! the camera's tet ([`LightTarget::locate_or_outside`]), and its shadow rays
 //! stop when they enter the light's tet (rule in [`crate::secondary`]).
 //! Area and mesh lights ([`crate::area_light`], passed through

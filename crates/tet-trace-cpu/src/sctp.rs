@@ -1,12 +1,12 @@
 //! ScTP kernel: scalar triple products on the 32-byte baseline layout
-//! (Lagae & Dutré 2008, as summarised in seed 000 §2 and seed 001 §2).
+//! (Lagae & Dutré 2008, as summarised in Aman et al. (2022) §2 and Maria et al. (2017) §2).
 //!
 //! Layout: [`tet_core::layout::Baseline32`] = four vertex ids + four links.
 //! The ray passes left of edge `a → b` when `d · ((Pa − o) × (Pb − o)) > 0`
 //! (a scalar triple product, [`TripleF32`]); Lagae & Dutré need 3–6 of them
 //! per tet without the entry face. Using the entry face (whose three edge
 //! signs are known from the previous tet), the exit face needs two
-//! (Algorithm 1 of seed 000 on the triple-product signs, the same decision
+//! (Algorithm 1 of Aman et al. (2022) on the triple-product signs, the same decision
 //! procedure as the 2-D walk; the engine evaluates a third one to stay
 //! branch-free, see [`crate::walk::exit_slot`]): per step one 12-byte point
 //! load, 3 subtractions, three triple products (each 6 mul + 3 sub for the

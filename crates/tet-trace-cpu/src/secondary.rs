@@ -1,4 +1,4 @@
-//! Secondary rays (Aman et al., seed 000 §6): shadow rays to point lights,
+//! Secondary rays (Aman et al. 2022, §6): shadow rays to point lights,
 //! reflection and refraction rays.
 //!
 //! A hit reports the constrained face and the tets on both of its sides

@@ -1,4 +1,4 @@
-//! Tet16 kernel (Aman et al., seed 000 §3–4, Algorithms 1, 6, 7).
+//! Tet16 kernel (Aman et al. 2022, §3–4, Algorithms 1, 6, 7).
 //!
 //! Layout: [`tet_core::layout::Tet16`] = `VX` + `NX_k = N_k ⊕ N_3` for the
 //! rank-ordered links (16 bytes). The link across the exit face is rebuilt

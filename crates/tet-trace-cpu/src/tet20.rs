@@ -1,4 +1,4 @@
-//! Tet20 kernel (Aman et al., seed 000 §3–4, Algorithms 1, 4, 5).
+//! Tet20 kernel (Aman et al. 2022, §3–4, Algorithms 1, 4, 5).
 //!
 //! Layout: [`tet_core::layout::Tet20`] = `VX` + four links in the order of the
 //! rank of their opposite vertex id (20 bytes). Per step (operation count of

@@ -1,4 +1,4 @@
-//! Tet32 kernel (Aman et al., seed 000 §3–4, Algorithms 1, 2, 3).
+//! Tet32 kernel (Aman et al. 2022, §3–4, Algorithms 1, 2, 3).
 //!
 //! Layout: [`tet_core::layout::Tet32`] = `V_0, V_1, V_2, VX, N_0..N_3`
 //! (32 bytes). The new vertex comes from the xor field like Tet20; the exit

@@ -1,4 +1,4 @@
-//! Robustness census (seed 001 Table 4 style): for each kernel, over many
+//! Robustness census (Maria et al. 2017, Table 4 style): for each kernel, over many
 //! adversarial rays (aimed at vertices, edge midpoints, face centroids,
 //! starting on vertices, axis-aligned on unjittered grids), count step-cap
 //! failures, escapes through closed shells, and disagreements with the f64

@@ -1,4 +1,4 @@
-//! Shadow rays that end at the light's tet (seed 000 §6) against an
+//! Shadow rays that end at the light's tet (Aman et al. 2022, §6) against an
 //! independent f64 brute force (the segment from the hit point to the light
 //! against every scene triangle), on random scenes, and on hand-built cases:
 //! lights on vertices, edges and faces of constrained planes, and lights

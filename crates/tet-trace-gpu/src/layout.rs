@@ -21,15 +21,15 @@ const TET80: &str = include_str!("tet80.wgsl");
 /// The compact layout a [`crate::GpuTracer`] uploads and walks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum GpuLayout {
-    /// Seed 000 Tet20: `VX` + four rank-ordered links (20 bytes, Algorithm 5).
+    /// Aman et al. (2022) Tet20: `VX` + four rank-ordered links (20 bytes, Algorithm 5).
     Tet20,
-    /// Seed 000 Tet32: three ids, `VX`, four slot-ordered links (32 bytes,
+    /// Aman et al. (2022) Tet32: three ids, `VX`, four slot-ordered links (32 bytes,
     /// Algorithm 3).
     Tet32,
-    /// Seed 000 Tet16: `VX` + three link xor-differences (16 bytes,
+    /// Aman et al. (2022) Tet16: `VX` + three link xor-differences (16 bytes,
     /// Algorithm 7; the entry link is carried along the walk).
     Tet16,
-    /// Seed 001 Tet80: four vertex positions + four faces (80 bytes), walked
+    /// Maria et al. (2017) Tet80: four vertex positions + four faces (80 bytes), walked
     /// with Plücker side products (not watertight by construction).
     Tet80,
 }
@@ -283,7 +283,7 @@ mod tests {
 
     #[test]
     fn packed_exit_slot_decodes_to_algorithm_1() {
-        // Algorithm 1 (seed 000) written out independently of the CPU table.
+        // Algorithm 1 (Aman et al. 2022) written out independently of the CPU table.
         let packed = exit_slot_table();
         for i in 0..8u32 {
             let (sa, sb, sc) = (i & 1 != 0, i & 2 != 0, i & 4 != 0);

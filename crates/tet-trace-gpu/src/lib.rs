@@ -16,7 +16,7 @@
 //! * results are [`tet_trace_cpu::TraceOutcome`]s (the CPU hit records, same
 //!   meaning field by field) plus [`DispatchStats`].
 //!
-//! ## The kernels: a port of the CPU walk (seed 000, Algorithms 1–7)
+//! ## The kernels: a port of the CPU walk (Aman et al. 2022, Algorithms 1–7)
 //!
 //! `src/walk.wgsl` is a statement-by-statement port of the CPU walk's step
 //! (`advance` in `tet-trace-cpu/src/walk/step.rs`) with the `DuffF32`
@@ -28,7 +28,7 @@
 //! Algorithm 7 xors the carried entry link with two `NX` differences).
 //!
 //! `src/tet80.wgsl` ports `tet_trace_cpu::tet80::Tet80Tracer`, the Plücker
-//! walk of Maria et al. (seed 001 §3–4): per tet the apex `V_e` opposite the
+//! walk of Maria et al. (2017, §3–4): per tet the apex `V_e` opposite the
 //! entry face `e`, `m = d × (V_e − o)`, two side products
 //! `(V_x − V_e) · m` and the CPU's `EXIT` table (packed into `u32` constants
 //! by the host, so the tables cannot drift apart). Like the CPU kernel it is
@@ -36,7 +36,7 @@
 //! side product in its own frame), and its products are sums a driver may
 //! contract into FMAs, so near-zero side products may differ from the CPU.
 //!
-//! | paper (seed 000) | CPU (`tet-trace-cpu`) | WGSL |
+//! | paper (Aman et al. 2022) | CPU (`tet-trace-cpu`) | WGSL |
 //! |---|---|---|
 //! | `idx_0..2`, `p_0..2` | `State::ids`, `State::p` | `s_ids`, `s_p` |
 //! | `VX^next`, `idx_3 = idx_0 ⊕ idx_1 ⊕ idx_2 ⊕ VX` | `Topology::vx` | `layout_vx`, `d` |

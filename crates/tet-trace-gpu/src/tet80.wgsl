@@ -1,4 +1,4 @@
-// Tet80: the Plücker walk of Maria, Horna & Aveneau (seed 001 §3-4) as a
+// Tet80: the Plücker walk of Maria, Horna & Aveneau (2017, §3-4) as a
 // WGSL compute kernel, a port of `tet_trace_cpu::tet80::Tet80Tracer`.
 // Record (20 words): four vertex positions (f32 bits, slot order of the
 // mesh) then four faces (occlusion = constrained-face index or 0xFFFFFFFF,

@@ -1,4 +1,4 @@
-// Projected walk (Aman et al., seed 000 Algorithms 1-7) as a WGSL compute
+// Projected walk (Aman et al. 2022, Algorithms 1-7) as a WGSL compute
 // kernel, one invocation per ray. A port of tet-trace-cpu's `walk::step`
 // with the `DuffF32` projection; see the Rust crate docs (`src/lib.rs`) for
 // the decisions, the tie rule and where the arithmetic may differ from the

@@ -1,4 +1,4 @@
-//! The memory model's prediction for a scene (Erkoç et al., seed 003
+//! The memory model's prediction for a scene (Erkoç et al. 2021,
 //! §3.2: TetGen's peak memory as a linear function of its input size).
 
 use anyhow::Result;

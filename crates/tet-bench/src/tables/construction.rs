@@ -1,4 +1,4 @@
-//! Construction (Aman et al., seed 000 Table 1, left half): triangles,
+//! Construction (Aman et al. 2022, Table 1, left half): triangles,
 //! points, tets, the self-intersections resolved and the time it took,
 //! TetGen and total build time, BVH build time, regions; beside the
 //! paper's triangles and Tet-mesh-20 build time for that scene.
@@ -24,7 +24,10 @@ pub fn measure(loaded: &Loaded) -> Result<(Info, f64)> {
 
 /// The table.
 pub fn markdown(m: &mut String, doc: &TablesDoc) {
-    let _ = writeln!(m, "\n## Construction (seed 000 Table 1, left half)\n");
+    let _ = writeln!(
+        m,
+        "\n## Construction (Aman et al. 2022, Table 1, left half)\n"
+    );
     let _ = writeln!(
         m,
         "| scene | triangles | points | tets | pairs resolved | resolve s | TetGen s | total build s | BVH build s | regions | paper triangles | paper build s | paper BVH s |"

@@ -59,9 +59,9 @@ pub struct SceneResult {
     pub wide_box_tet20: Option<RenderDoc>,
     /// Accuracy against the f64 reference.
     pub accuracy: Option<CaseAccuracy>,
-    /// Ray-Strips beside the BVH (seed 002 Tables 1, 3, 4, 5).
+    /// Ray-Strips beside the BVH (Lauterbach et al. 2007, Tables 1, 3, 4, 5).
     pub ray_strips: Option<StripsRow>,
-    /// GPU methods (seed 000 Table 3), when built with `--features gpu` and
+    /// GPU methods (Aman et al. 2022, Table 3), when built with `--features gpu` and
     /// an adapter is present.
     pub gpu_renders: Vec<RenderDoc>,
     /// Why there are no GPU rows, if there are none.
@@ -117,7 +117,7 @@ pub struct OutOfCoreRow {
     pub tets: usize,
     /// tet20 on the merged mesh.
     pub tet20: Option<RenderDoc>,
-    /// Tet quality of the in-core mesh (seed 003 Table 3).
+    /// Tet quality of the in-core mesh (Erkoç et al. 2021, Table 3).
     pub in_core_quality: Option<Quality>,
     /// Tet quality of the merged mesh.
     pub quality: Option<Quality>,
@@ -125,7 +125,7 @@ pub struct OutOfCoreRow {
     pub error: Option<String>,
 }
 
-/// Tet quality (seed 003 Table 3: aspect ratio = longest edge ÷ smallest
+/// Tet quality (Erkoç et al. 2021, Table 3: aspect ratio = longest edge ÷ smallest
 /// height; also the radius-edge ratio).
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Quality {
@@ -161,20 +161,20 @@ pub struct TablesDoc {
     pub setup: Setup,
     /// Per scene.
     pub scenes: Vec<SceneResult>,
-    /// Exit-face search (seed 001 Table 5), single thread.
+    /// Exit-face search (Maria et al. 2017, Table 5), single thread.
     pub exit_face: Option<ExitFaceTable>,
     /// Speed against accuracy per method and precision on the first scene,
     /// as given and at the extremes (scaled, translated, slivers).
     pub speed_accuracy: Option<SpeedAccuracy>,
-    /// Isosurfaces of tet volumes (seed 004 Tables 1, 2, 4), per synthetic
+    /// Isosurfaces of tet volumes (Wald et al. 2007, Tables 1, 2, 4), per synthetic
     /// volume.
     pub isosurfaces: Vec<IsoRow>,
     /// Isosurfaces as the model grows: the bucky cube replicated n³ times
-    /// (seed 004 Table 3).
+    /// (Wald et al. 2007, Table 3).
     pub iso_scaling: Vec<IsoScaleRow>,
     /// Why there is no out-of-core table, if there is none.
     pub out_of_core_note: Option<String>,
-    /// Large models (seed 002 §6): Ray-Strips, the BVH and Tet20 as the
+    /// Large models (Lauterbach et al. 2007, §6): Ray-Strips, the BVH and Tet20 as the
     /// Torus Knots' tessellation grows, one row per size.
     pub large_models: Vec<LargeModelRow>,
     /// Why there is no large-model table, if there is none.
@@ -207,7 +207,7 @@ pub const TABLE_FLAGS: BuildFlags = BuildFlags {
     walls: None,
 };
 
-/// Speed against accuracy (seed 001 Table 4 beside render speed): every CPU method in f32 and,
+/// Speed against accuracy (Maria et al. 2017, Table 4 beside render speed): every CPU method in f32 and,
 /// where it has one, f64, on the first scene as given and on its extreme
 /// cases ([`crate::extremes`]).
 #[derive(Clone, Debug, Serialize)]

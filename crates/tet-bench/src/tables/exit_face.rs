@@ -1,4 +1,4 @@
-//! Exit-face search (Maria et al., seed 001 Table 5): the cost of one
+//! Exit-face search (Maria et al. 2017, Table 5): the cost of one
 //! exit-face decision per method, and whole walks on the same grid
 //! (measured by [`crate::exitface`], single thread).
 
@@ -25,7 +25,7 @@ pub fn measure(quick: bool) -> Result<ExitFaceTable> {
 /// The table.
 pub fn markdown(m: &mut String, x: &ExitFaceTable) {
     let z = &x.sizes;
-    let _ = writeln!(m, "\n## Exit-face search (seed 001 Table 5)\n");
+    let _ = writeln!(m, "\n## Exit-face search (Maria et al. 2017, Table 5)\n");
     let _ = writeln!(
         m,
         "One thread. {} random tets of a jittered Kuhn grid ({} tets) × {} random lines through each (paper: 10,000 tets × 16,384 rays); a stab is one exit-face decision as a walk makes it after entering the tet (entry face and per-ray setup carried, not timed); best of {}. Decisions are checked against the exit face computed in f64. Paper ns = its CPU ms ÷ 163.84 M stabs (other CPU, other code: compare the ratios).\n",

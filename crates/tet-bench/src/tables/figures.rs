@@ -3,15 +3,15 @@
 //!
 //! * `speed_vs_accuracy.svg` — Mrays/s (render) against failures per 1024²
 //!   rays (accuracy), one circle per method and scene: Maria et al.'s
-//!   (seed 001) trade between speed and robustness in one picture;
-//! * `figure8_sorted_vs_unsorted.svg` — Aman et al. (seed 000) Figure 8:
+//!   (Maria et al. 2017) trade between speed and robustness in one picture;
+//! * `figure8_sorted_vs_unsorted.svg` — Aman et al. (2022) Figure 8:
 //!   tet20 Mrays/s on the Hilbert-sorted and the unsorted (TetGen order)
 //!   mesh, per scene;
 //! * `mrays_per_method.svg` — Mrays/s per method, grouped by scene;
 //! * `bytes_per_triangle_vs_mrays.svg` — bytes per scene triangle against
 //!   Mrays/s, one mark per structure (Tet20, Tet16, Tet32, Ray-Strips,
 //!   obvhs) and scene, large models included: the memory–speed trade of
-//!   the compact tet layouts and of Ray-Strips (seed 002) in one picture.
+//!   the compact tet layouts and of Ray-Strips (Lauterbach et al. 2007) in one picture.
 
 use anyhow::Result;
 
@@ -41,7 +41,7 @@ pub fn figures(doc: &TablesDoc) -> Result<Vec<(&'static str, String)>> {
     out.push((
         "speed_vs_accuracy.svg",
         scatter_svg(
-            "Speed vs accuracy (seed 001 Table 4 against render speed)",
+            "Speed vs accuracy (Maria et al. 2017, Table 4 against render speed)",
             "failures per 1024² rays (f32, against the f64 reference)",
             "Mrays/s (primary rays)",
             &points,
@@ -66,7 +66,7 @@ pub fn figures(doc: &TablesDoc) -> Result<Vec<(&'static str, String)>> {
     out.push((
         "figure8_sorted_vs_unsorted.svg",
         bars_svg(
-            "Hilbert-sorted vs unsorted mesh (seed 000 Figure 8)",
+            "Hilbert-sorted vs unsorted mesh (Aman et al. 2022, Figure 8)",
             "Mrays/s",
             &groups,
         )?,
@@ -88,7 +88,7 @@ pub fn figures(doc: &TablesDoc) -> Result<Vec<(&'static str, String)>> {
     out.push((
         "mrays_per_method.svg",
         bars_svg(
-            "Render speed per method (seed 000 Table 1)",
+            "Render speed per method (Aman et al. 2022, Table 1)",
             "Mrays/s",
             &groups,
         )?,
@@ -96,7 +96,7 @@ pub fn figures(doc: &TablesDoc) -> Result<Vec<(&'static str, String)>> {
     out.push((
         "bytes_per_triangle_vs_mrays.svg",
         scatter_svg(
-            "Memory against speed per structure (seed 000 Table 4, seed 002 Tables 1 and 3)",
+            "Memory against speed per structure (Aman et al. 2022, Table 4; Lauterbach et al. 2007, Tables 1 and 3)",
             "bytes per scene triangle (structure and vertices)",
             "Mrays/s (primary rays)",
             &bytes_vs_speed(doc),

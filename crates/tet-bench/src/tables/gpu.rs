@@ -1,4 +1,4 @@
-//! GPU methods (Aman et al., seed 000 Table 3): the tet walks as wgpu
+//! GPU methods (Aman et al. 2022, Table 3): the tet walks as wgpu
 //! compute shaders, when built with `--features gpu` and an adapter is
 //! present.
 
@@ -41,7 +41,7 @@ pub fn measure(
 
 /// The table.
 pub fn markdown(m: &mut String, doc: &TablesDoc) {
-    let _ = writeln!(m, "\n## GPU (seed 000 Table 3)\n");
+    let _ = writeln!(m, "\n## GPU (Aman et al. 2022, Table 3)\n");
     let _ = writeln!(
         m,
         "| scene | method (device) | best ms | Mrays/s | tets/ray | GPU bytes (tets + points) | failures | paper ms |"

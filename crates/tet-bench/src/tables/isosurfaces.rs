@@ -1,4 +1,4 @@
-//! Isosurfaces of tetrahedral volumes (Wald et al., seed 004 Tables 1–4)
+//! Isosurfaces of tetrahedral volumes (Wald et al. 2007, Tables 1–4)
 //! on the synthetic stand-ins for the paper's data sets (same tet counts;
 //! the originals are not public): IBVH build time BIH vs SAH and render
 //! speed, 16×16 packets, and the iso walk over our compact layouts beside
@@ -129,7 +129,7 @@ pub fn measure_all(quick: bool, pool: &rayon::ThreadPool) -> Vec<IsoRow> {
     rows
 }
 
-/// Seed 004 Table 3: balls, tets and fps at 1024² on four 2.4 GHz
+/// Wald et al. (2007) Table 3: balls, tets and fps at 1024² on four 2.4 GHz
 /// Opteron cores, per replication of the bucky ball.
 const PAPER_SCALING: [(u32, &str, f64); 5] = [
     (1, "177 k", 34.0),
@@ -139,7 +139,7 @@ const PAPER_SCALING: [(u32, &str, f64); 5] = [
     (4096, "724 M", 0.66),
 ];
 
-/// The bucky cube replicated n³ times (seed 004 Table 3), with the
+/// The bucky cube replicated n³ times (Wald et al. 2007, Table 3), with the
 /// paper's packets (`ibvh-packets`) and the iso walk (`walk-tet20`).
 /// 8³ (90 M tets) and beyond are left out: the volume alone would take
 /// several GB and most of a run's time here.

@@ -1,4 +1,4 @@
-//! Large models (Lauterbach et al., seed 002 §6: Ray-Strips pay off when a
+//! Large models (Lauterbach et al. 2007, §6: Ray-Strips pay off when a
 //! BVH no longer fits in memory): the same Torus Knots view with every
 //! knot tessellated more finely (`dense-knots:N`,
 //! [`tet_build::procedural::dense_torus_knots`]) at 1 M, 10 M and 30 M
@@ -271,11 +271,14 @@ pub fn measure_all(
 pub fn markdown(m: &mut String, doc: &TablesDoc) {
     if doc.large_models.is_empty() {
         if let Some(note) = &doc.large_models_note {
-            let _ = writeln!(m, "\n## Large models (seed 002 §6)\n\n{note}");
+            let _ = writeln!(
+                m,
+                "\n## Large models (Lauterbach et al. 2007, §6)\n\n{note}"
+            );
         }
         return;
     }
-    let _ = writeln!(m, "\n## Large models (seed 002 §6)\n");
+    let _ = writeln!(m, "\n## Large models (Lauterbach et al. 2007, §6)\n");
     let _ = writeln!(
         m,
         "Torus Knots with every knot tessellated more finely (`dense-knots:N`), same camera; Ray-Strips (default options) and obvhs over the triangles, Tet20 over the CDT where TetGen's predicted peak fits in half the free memory. Bytes include the vertices; build s for Tet20 is the whole pipeline. {}×{}, {} threads, best of {} frames. The paper's large models (Buddha 1.1 M, Thai 10 M, Lucy 28 M triangles) showed Ray-Strips fitting where the BVH did not.\n",

@@ -1,4 +1,4 @@
-//! Bytes per layout (Aman et al., seed 000 Table 4): hot and cold bytes of
+//! Bytes per layout (Aman et al. 2022, Table 4): hot and cold bytes of
 //! every layout per scene (measured with the construction table, by
 //! [`crate::layouts::info`]), beside the paper's numbers for that scene
 //! (their meshes are larger: compare bytes per tet, or the ratios between
@@ -16,14 +16,14 @@ fn mb(b: usize) -> String {
 
 /// The table.
 pub fn markdown(m: &mut String, doc: &TablesDoc) {
-    let _ = writeln!(m, "\n## Bytes per layout (seed 000 Table 4)\n");
+    let _ = writeln!(m, "\n## Bytes per layout (Aman et al. 2022, Table 4)\n");
     let _ = writeln!(
         m,
-        "Hot = tet records + point positions read by the walk; cold = constrained-face table, attributes, anchors; `ray-strips` (Lauterbach et al.) is the whole Ray-Strips structure over the same triangles, all hot. MB = 10⁶ bytes.\n"
+        "Hot = tet records + point positions read by the walk; cold = constrained-face table, attributes, anchors; `ray-strips` (Lauterbach et al. 2007) is the whole Ray-Strips structure over the same triangles, all hot. MB = 10⁶ bytes.\n"
     );
     let _ = writeln!(
         m,
-        "Paper: seed 000 Table 4 on the paper's (larger) mesh of the scene (xor layouts: total; Tet80: records only, compare with hot).\n"
+        "Paper: Aman et al. (2022) Table 4 on the paper's (larger) mesh of the scene (xor layouts: total; Tet80: records only, compare with hot).\n"
     );
     let _ = writeln!(
         m,

@@ -1,34 +1,34 @@
 //! `tet-bench tables`: the reproduction of the papers' tables, one module
 //! per table, each owning its measurement and its Markdown section:
 //!
-//! * Aman et al. (seed 000) Table 1 — construction time per structure
+//! * Aman et al. (2022) Table 1 — construction time per structure
 //!   ([`construction`]), render time per method per scene
 //!   ([`render_speed`], with the paper's CPU numbers as ratios to the BVH
 //!   measured in the same run, since absolute times are machine-bound);
-//! * seed 000 Table 4 — bytes per layout per scene ([`memory`]);
-//! * Lauterbach et al. (seed 002) Tables 1, 3, 4, 5 — Ray-Strips' bytes,
+//! * Aman et al. (2022) Table 4 — bytes per layout per scene ([`memory`]);
+//! * Lauterbach et al. (2007) Tables 1, 3, 4, 5 — Ray-Strips' bytes,
 //!   single-ray and packet speed and construction beside the BVH
 //!   ([`strips_vs_bvh`]);
-//! * seed 000 Table 5 — the Armadillo Zoom camera series, with `--scenes`
+//! * Aman et al. (2022) Table 5 — the Armadillo Zoom camera series, with `--scenes`
 //!   ([`zoom`]);
-//! * seed 000 Figure 8 — Hilbert-sorted vs unsorted mesh, tet20 ([`sorting`]);
+//! * Aman et al. (2022) Figure 8 — Hilbert-sorted vs unsorted mesh, tet20 ([`sorting`]);
 //! * entry through the boundary (tight box) vs camera inside (wide box),
 //!   tet20 ([`entry`]);
 //! * the build trade `-pY` vs `-pYq5`, full mode ([`quality`]);
-//! * seed 000 Table 3 — GPU methods, with `--features gpu` and an adapter
+//! * Aman et al. (2022) Table 3 — GPU methods, with `--features gpu` and an adapter
 //!   ([`gpu`]);
-//! * Maria et al. (seed 001) Table 4 — rays with a wrong result per 1024²
+//! * Maria et al. (2017) Table 4 — rays with a wrong result per 1024²
 //!   rays per method ([`robustness`]);
 //! * speed vs accuracy — Mrays/s beside the failure rate per method and
 //!   precision, as given and at the extremes ([`speed_accuracy`]);
-//! * seed 001 Table 5 — exit-face search cost per method ([`exit_face`]);
-//! * Wald et al. (seed 004) Tables 1–4 — isosurfaces of tet volumes:
+//! * Maria et al. (2017) Table 5 — exit-face search cost per method ([`exit_face`]);
+//! * Wald et al. (2007) Tables 1–4 — isosurfaces of tet volumes:
 //!   the implicit min-max BVH (BIH and SAH builds, single rays, 16×16
 //!   packets) beside the iso walk over our layouts ([`isosurfaces`]);
-//! * Lauterbach et al. (seed 002) §6 — large models: Ray-Strips, the BVH
+//! * Lauterbach et al. (2007) §6 — large models: Ray-Strips, the BVH
 //!   and Tet20 on Torus Knots tessellated to 1 M, 10 M and 30 M triangles,
 //!   full mode ([`large_models`]);
-//! * Erkoç et al. (seed 003) Tables 2–3 — out of core: build time, parts
+//! * Erkoç et al. (2021) Tables 2–3 — out of core: build time, parts
 //!   and peaks under limits of ½ and ⅓ of the in-core TetGen peak, full
 //!   mode ([`out_of_core`]); and a 1 M-triangle closed mesh built under a
 //!   sixteenth of its in-core peak, full mode ([`out_of_core_large`]).

@@ -1,4 +1,4 @@
-//! Out of core under a memory limit (Erkoç et al., seed 003 Tables 2–3):
+//! Out of core under a memory limit (Erkoç et al. 2021, Tables 2–3):
 //! each scene built in parts under the builder's own share plus ½ and ⅓
 //! of its in-core TetGen peak,
 //! with build time, parts, peaks, tet quality and tet20 speed (full mode,
@@ -161,7 +161,7 @@ mod measuring {
 pub fn markdown(m: &mut String, doc: &TablesDoc) {
     let _ = writeln!(
         m,
-        "\n## Out of core under a memory limit (Erkoç et al., seed 003 Tables 2–3)\n"
+        "\n## Out of core under a memory limit (Erkoç et al. 2021, Tables 2–3)\n"
     );
     if let Some(note) = &doc.out_of_core_note {
         let _ = writeln!(m, "Out-of-core table {note}.");
@@ -169,11 +169,11 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     }
     let _ = writeln!(
         m,
-        "Limits are on the whole process tree: the builder's own share (`build --predict-memory` prints it) plus ½ and ⅓ of the in-core TetGen worker's measured peak. Each limited build runs as `tet-bench build SCENE --memory-limit L` in a process of its own, which sets its share aside, splits the scene recursively (seed 003's planes, or slabs when no tree fits) until the parts' *predicted* peaks fit what is left, starts parallel workers only while they fit together, and streams the merged mesh (exact seams, each part Hilbert-sorted) to a file read back for tet20. Parts are given as count, workers at once, planner and depth. Part peaks are the workers' measured `VmHWM`; tree peak is the builder and its workers together (resident memory sampled every 2 ms), what the limit bounds; aspect ratio = longest edge ÷ smallest height (seed 003 Table 3); tets per ray of tet20 on the table's camera, beside the in-core mesh's (the seams' cost to every ray).\n"
+        "Limits are on the whole process tree: the builder's own share (`build --predict-memory` prints it) plus ½ and ⅓ of the in-core TetGen worker's measured peak. Each limited build runs as `tet-bench build SCENE --memory-limit L` in a process of its own, which sets its share aside, splits the scene recursively (the planes of Erkoç et al. 2021, or slabs when no tree fits) until the parts' *predicted* peaks fit what is left, starts parallel workers only while they fit together, and streams the merged mesh (exact seams, each part Hilbert-sorted) to a file read back for tet20. Parts are given as count, workers at once, planner and depth. Part peaks are the workers' measured `VmHWM`; tree peak is the builder and its workers together (resident memory sampled every 2 ms), what the limit bounds; aspect ratio = longest edge ÷ smallest height (Erkoç et al. 2021, Table 3); tets per ray of tet20 on the table's camera, beside the in-core mesh's (the seams' cost to every ray).\n"
     );
     let _ = writeln!(
         m,
-        "Paper (seed 003 Table 2, two parts, Xeon E5-2620): time 11.5× TetGen's (Armadillo), 6.9× (Armadillo in a box), 3.1×, 2.5×, 1.7× (larger scenes cut between objects) at 0.54–0.60× its memory; Table 3, mean aspect ratio TetGen → theirs: torus knot 7.52 → 22.20, Neptune 8.72 → 12.92, Armadillo 7.31 → 12.84.\n"
+        "Paper (Erkoç et al. 2021, Table 2, two parts, Xeon E5-2620): time 11.5× TetGen's (Armadillo), 6.9× (Armadillo in a box), 3.1×, 2.5×, 1.7× (larger scenes cut between objects) at 0.54–0.60× its memory; Table 3, mean aspect ratio TetGen → theirs: torus knot 7.52 → 22.20, Neptune 8.72 → 12.92, Armadillo 7.31 → 12.84.\n"
     );
     let _ = writeln!(
         m,

@@ -1,4 +1,4 @@
-//! Out of core where it matters (Erkoç et al., seed 003: the scenes that
+//! Out of core where it matters (Erkoç et al. 2021: the scenes that
 //! do not fit): `fan-sphere:N`, a closed bumpy sphere whose poles are fans
 //! of about √N long thin triangles (the mesh whose cuts once failed), built
 //! in parts under its builder's own share plus a sixteenth of its
@@ -125,7 +125,10 @@ pub fn measure_all(
 
 /// The table (or why there is none).
 pub fn markdown(m: &mut String, doc: &TablesDoc) {
-    let _ = writeln!(m, "\n## Out of core past one machine's share (seed 003)\n");
+    let _ = writeln!(
+        m,
+        "\n## Out of core past one machine's share (Erkoç et al. 2021)\n"
+    );
     if doc.large_out_of_core.is_empty() {
         let note = doc.large_out_of_core_note.as_deref().unwrap_or("no rows");
         let _ = writeln!(m, "Large out-of-core table {note}.");

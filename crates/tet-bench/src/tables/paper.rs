@@ -1,9 +1,9 @@
-//! The published figures of Aman et al. (seed 000) per scene, printed
+//! The published figures of Aman et al. (2022) per scene, printed
 //! beside ours: Table 1 (triangles, construction seconds, CPU render
 //! milliseconds), Table 3 (GPU kernel milliseconds) and Table 4 (megabytes
 //! per layout).
 //!
-//! Their scenes use larger meshes than the ones in `../shared/scenes/`
+//! Their scenes use larger meshes than the ones of `scenes/scenes.json`
 //! (e.g. Neptune: 448,896 triangles against 59,272 here; Mix 2.5 M against
 //! 548 k), so absolute times and sizes do not compare; ratios within a
 //! table (a method against the BVH of the same run) do.
@@ -92,7 +92,7 @@ const fn layouts(mb: [f64; 4]) -> Option<[(&'static str, f64); 4]> {
     ])
 }
 
-/// Seed 000 Tables 1, 3 and 4, transcribed.
+/// Aman et al. (2022) Tables 1, 3 and 4, transcribed.
 pub const PAPER_SCENES: [PaperScene; 10] = [
     PaperScene {
         name: "Torus Knots",
@@ -204,7 +204,7 @@ mod tests {
 
     #[test]
     fn scenes_are_found_by_spec() {
-        let p = paper_scene("../shared/scenes/scenes.json#Neptune").unwrap();
+        let p = paper_scene("scenes/scenes.json#Neptune").unwrap();
         assert_eq!(p.triangles, 448_896);
         assert_eq!(paper_scene("torus-knots").unwrap().name, "Torus Knots");
         assert!(paper_scene("teapot.obj").is_none());

@@ -1,4 +1,4 @@
-//! Robustness (Maria et al., seed 001 Table 4): rays with a wrong result
+//! Robustness (Maria et al. 2017, Table 4): rays with a wrong result
 //! per 1024² rays per method against the f64 reference, beside each
 //! method's render speed.
 
@@ -49,11 +49,11 @@ pub fn measure(
 pub fn markdown(m: &mut String, doc: &TablesDoc) {
     let _ = writeln!(
         m,
-        "\n## Robustness (seed 001 Table 4) and speed vs accuracy\n"
+        "\n## Robustness (Maria et al. 2017, Table 4) and speed vs accuracy\n"
     );
     let _ = writeln!(
         m,
-        "Failures = leaks + wrong triangle + false miss + false hit + step cap + lost + NaN, beyond the grazing tolerance, per 1024² rays, against an f64 reference. A leak is a ray that misses, or hits something farther along, where the reference hit grazes only closed edges (shared by two or more faces): it slipped through a watertight surface. Grazing rays (not failures) hit one of the triangles they graze, or graze an open edge. The paper column is seed 001 Table 4: rays with a wrong result per 1024² on its GPU, averaged over about 1,300 viewpoints, on Banana / Bunny / Armadillo (its STP is our `sctp`, its own Plücker method our `tet80`; the 2-D walks of seed 000 and the consistent Tet80 are not in it). Without `--quick` the first scene and the flat-faced Flat Parts are checked over 10⁸ rays each (`--robustness-rays`): the 1024² camera image, then random interior rays and adversarial rays (aimed at vertices, edges and faces of the tetrahedralization, along edges, started on faces, lying in the planes of faces) in equal parts; its Mrays/s column is the render's, the other scenes' 1024² + 100 k rays likewise.\n"
+        "Failures = leaks + wrong triangle + false miss + false hit + step cap + lost + NaN, beyond the grazing tolerance, per 1024² rays, against an f64 reference. A leak is a ray that misses, or hits something farther along, where the reference hit grazes only closed edges (shared by two or more faces): it slipped through a watertight surface. Grazing rays (not failures) hit one of the triangles they graze, or graze an open edge. The paper column is Maria et al. (2017) Table 4: rays with a wrong result per 1024² on its GPU, averaged over about 1,300 viewpoints, on Banana / Bunny / Armadillo (its STP is our `sctp`, its own Plücker method our `tet80`; the 2-D walks of Aman et al. (2022) and the consistent Tet80 are not in it). Without `--quick` the first scene and the flat-faced Flat Parts are checked over 10⁸ rays each (`--robustness-rays`): the 1024² camera image, then random interior rays and adversarial rays (aimed at vertices, edges and faces of the tetrahedralization, along edges, started on faces, lying in the planes of faces) in equal parts; its Mrays/s column is the render's, the other scenes' 1024² + 100 k rays likewise.\n"
     );
     let _ = writeln!(
         m,
@@ -95,7 +95,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     }
 }
 
-/// Seed 001 Table 4 for the method of tracer `name` (Banana / Bunny /
+/// Maria et al. (2017) Table 4 for the method of tracer `name` (Banana / Bunny /
 /// Armadillo, rays per 1024²): its STP is Lagae and Dutré's scalar triple
 /// products (`sctp`), "Ours" its Plücker walk (`tet80`).
 fn paper_table4(name: &str) -> Option<&'static str> {

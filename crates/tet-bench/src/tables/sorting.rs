@@ -1,4 +1,4 @@
-//! Hilbert-sorted vs unsorted mesh (Aman et al., seed 000 Figure 8):
+//! Hilbert-sorted vs unsorted mesh (Aman et al. 2022, Figure 8):
 //! tet20 on the mesh in TetGen's order against the sorted one.
 
 use std::fmt::Write as _;
@@ -37,7 +37,7 @@ pub fn measure(
 pub fn markdown(m: &mut String, doc: &TablesDoc) {
     let _ = writeln!(
         m,
-        "\n## Hilbert-sorted vs unsorted (seed 000 Figure 8), tet20\n"
+        "\n## Hilbert-sorted vs unsorted (Aman et al. 2022, Figure 8), tet20\n"
     );
     let _ = writeln!(
         m,

@@ -1,7 +1,7 @@
 //! Speed against accuracy: every CPU method in f32 and, where it has one,
 //! f64, on the first scene as given and on its extreme cases (scaled,
 //! translated, slivers: [`crate::extremes`]) — Maria et al.'s robustness
-//! (seed 001 Table 4) beside the speed it costs.
+//! (Maria et al. 2017, Table 4) beside the speed it costs.
 
 use std::fmt::Write as _;
 

@@ -1,4 +1,4 @@
-//! Ray-Strips (Lauterbach et al., seed 002 Tables 1, 3, 4 and 5) per
+//! Ray-Strips (Lauterbach et al. 2007, Tables 1, 3, 4 and 5) per
 //! scene: the structure's bytes split as Table 1 splits them beside the
 //! BVH baseline's, single rays (Table 3, from the render table's
 //! `strips` and `obvhs` rows of the same run) and 2×2 packets (Table 4) as
@@ -106,7 +106,10 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     if rows.is_empty() {
         return;
     }
-    let _ = writeln!(m, "\n## Ray-Strips (seed 002 Tables 1, 3, 4, 5)\n");
+    let _ = writeln!(
+        m,
+        "\n## Ray-Strips (Lauterbach et al. 2007, Tables 1, 3, 4, 5)\n"
+    );
     let _ = writeln!(
         m,
         "Ray-Strips (`ray-strips` crate, default options) and the obvhs BVH over the same triangles (the mesh's constrained faces). MB = 10⁶ bytes; the BVH's geometry is its precomputed intersection triangles and face ids (the paper's \"optimized\" representation). Paper columns: the paper's Bunny (67 k triangles) on the Stanford bunny only.\n"

@@ -1,4 +1,4 @@
-//! Camera approaching the surface (Aman et al., seed 000 Table 5): tet20
+//! Camera approaching the surface (Aman et al. 2022, Table 5): tet20
 //! against the BVH on the Armadillo Zoom series (scenes whose name holds
 //! "Zoom"; their renders come from the render-speed table).
 
@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use super::doc::{SceneResult, TablesDoc};
 use crate::cli::Method;
 
-/// Seed 000 Table 5 (Armadillo Zoom 0–5): Tet20 tets per pixel, BVH nodes
+/// Aman et al. (2022) Table 5 (Armadillo Zoom 0–5): Tet20 tets per pixel, BVH nodes
 /// per pixel, Tet20 ms, BVH ms.
 const PAPER_ZOOM: [(f64, f64, f64, f64); 6] = [
     (48.54, 27.23, 140.3, 87.4),
@@ -28,7 +28,7 @@ pub fn markdown(m: &mut String, doc: &TablesDoc) {
     if !zoom.is_empty() {
         let _ = writeln!(
             m,
-            "\n## Camera approaching the surface (seed 000 Table 5)\n"
+            "\n## Camera approaching the surface (Aman et al. 2022, Table 5)\n"
         );
         let _ = writeln!(
             m,

@@ -1,5 +1,5 @@
 //! Memory model: TetGen's peak resident memory as a linear function of its
-//! input size (Erkoç et al., seed 003, §3: `CALCULATE_EXPECTED_MEMORY`,
+//! input size (Erkoç et al. 2021, §3: `CALCULATE_EXPECTED_MEMORY`,
 //! their fit `y = 4.57e-3·X + 3.12` MB with `X` = input vertices).
 //!
 //! Our input size is `X = points + triangles` of the PLC given to TetGen

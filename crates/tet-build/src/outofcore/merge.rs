@@ -1,7 +1,7 @@
 //! What becomes of finished parts ([`Merge`]): kept and merged in memory
 //! ([`InMemory`]: exact point deduplication and [`tet_core::TetMesh::assemble`])
 //! or streamed through part files ([`super::stream::ToFile`]); the
-//! replacement of the paper's `MERGE` (Erkoç et al., seed 003 §3.3).
+//! replacement of the paper's `MERGE` (Erkoç et al. 2021, §3.3).
 
 use std::collections::HashMap;
 

@@ -1,5 +1,5 @@
 //! Out-of-core constrained tetrahedralization under a memory limit
-//! (Erkoç et al., seed 003).
+//! (Erkoç et al. 2021).
 //!
 //! The paper's `TETRA` procedure (§3, Algorithm 1) tetrahedralizes a part
 //! with TetGen when `CALCULATE_EXPECTED_MEMORY` fits the limit, and
@@ -72,7 +72,7 @@
 //!   process in any order ([`job::build_part`]), then the streamed merge
 //!   ([`job::merge_job`]).
 //!
-//! | paper (seed 003)                       | code                                   |
+//! | paper (Erkoç et al. 2021)                       | code                                   |
 //! |----------------------------------------|----------------------------------------|
 //! | `TETRA(vertices, faces)`               | [`tree::build_tree_with_memory_limit`] |
 //! | `CALCULATE_EXPECTED_MEMORY`            | [`memory_model::predict_peak_memory`]  |

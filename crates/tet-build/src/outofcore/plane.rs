@@ -1,7 +1,7 @@
 //! The geometry of cuts: an axis-aligned [`SplitPlane`], which side of it a
 //! triangle lies on, exact bits of a point (`key`) and the clipping of
 //! scene triangles by a plane, with crossing points rounded once to f32 and
-//! lying exactly on the plane (Erkoç et al., seed 003 §3.2 `CLIP`, made
+//! lying exactly on the plane (Erkoç et al. 2021, §3.2 `CLIP`, made
 //! exact).
 
 use glam::Vec3;

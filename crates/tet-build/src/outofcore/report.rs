@@ -1,4 +1,4 @@
-//! Quality near the seams (Erkoç et al., seed 003,
+//! Quality near the seams (Erkoç et al. 2021,
 //! Table 3 compares tet quality of the merged mesh with TetGen's in-core
 //! mesh, and notes it is worse near the cut).
 //!

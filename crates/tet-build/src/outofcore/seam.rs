@@ -1,7 +1,7 @@
 //! Exact seams: parallel cut planes, every slab tetrahedralized separately,
 //! and a merge by exact vertex triples (replaces the paper's
-//! `CLIP`/`MERGE` with its vertex/edge repairs and centroid hashing, seed
-//! 003 §3.2–3.3).
+//! `CLIP`/`MERGE` with its vertex/edge repairs and centroid hashing,
+//! Erkoç et al. 2021, §3.2–3.3).
 //!
 //! 1. **Cut** ([`clip_polygon`], [`cut_triangle`]): a scene triangle
 //!    (or the part of it left above the previous planes) crossing the plane

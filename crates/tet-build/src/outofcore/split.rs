@@ -1,4 +1,4 @@
-//! Recursive split plan (Erkoç et al., seed 003, §3 `CLIP`): while a part's
+//! Recursive split plan (Erkoç et al. 2021, §3 `CLIP`): while a part's
 //! predicted TetGen memory exceeds the limit, cut it by an axis-aligned
 //! plane through the mean of the axis of largest variance; among nearby
 //! planes prefer the one that cuts the fewest triangles (the paper's future

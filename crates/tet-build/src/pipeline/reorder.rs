@@ -1,5 +1,5 @@
 //! Stage 6, reordering ([`Reorder::Hilbert`](super::Reorder::Hilbert)):
-//! points and tets sorted along a Hilbert curve (Aman et al., seed 000 §5).
+//! points and tets sorted along a Hilbert curve (Aman et al. 2022, §5).
 //!
 //! The sort is tet-core's ([`tet_core::reorder::hilbert_reorder`]): the same
 //! keys ([`Quantizer::key`], [`reorder::tet_key`],

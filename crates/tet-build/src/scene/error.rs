@@ -93,9 +93,11 @@ pub enum SceneError {
         /// Scene names in the file.
         available: Vec<String>,
     },
-    /// An object's mesh is not part of the data set.
+    /// An object's mesh is not part of the data set (or not in the
+    /// directory of the json file).
     #[error(
-        "{path}: scene {scene:?} object {object} ({name:?}) needs mesh {mesh:?}, which is not available"
+        "{path}: scene {scene:?} object {object} ({name:?}) needs mesh {mesh:?}, which is not available{}",
+        obtain_from.as_deref().map(|h| format!(": {h}")).unwrap_or_default()
     )]
     MissingMesh {
         /// The json file.
@@ -108,6 +110,10 @@ pub enum SceneError {
         name: String,
         /// The missing mesh file.
         mesh: String,
+        /// Where to get it: the `obtain_from` of the mesh's entry in the
+        /// json file's `meshes`, when it has one (boxed: the error stays
+        /// small).
+        obtain_from: Option<Box<str>>,
     },
     /// A spec string is neither an OBJ path, a `json#scene` spec nor a
     /// procedural scene name.

@@ -1,5 +1,5 @@
-//! The scene list `../shared/scenes/scenes.json` (transcribed from the
-//! authors' renderer neptun): load any scene of it by name.
+//! The scene list `scenes/scenes.json` (in the repository root; transcribed
+//! from the authors' renderer neptun): load any scene of it by name.
 //!
 //! Format (documented in the file itself): top-level `conventions`, `meshes`
 //! (key → `file`, optional `pre_transform {scale, rotation_deg, translation}`)
@@ -10,6 +10,9 @@
 //! `scale`; objects with `mesh: null` and no `paper_mesh_file` are empty
 //! placeholders and are skipped, while a `paper_mesh_file` without a `file`
 //! means the mesh is not in the data set → [`SceneError::MissingMesh`]).
+//! OBJ files are looked up beside the json file; a mesh entry may say where
+//! to get a file that is not there (`in_repository: false`, `obtain_from`),
+//! and [`SceneError::MissingMesh`] then repeats it.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -157,6 +160,20 @@ impl ScenesFile {
         Ok(t)
     }
 
+    /// Where to get mesh file `file` when it is not beside the json file:
+    /// the `obtain_from` of the mesh entry `key`, else of any mesh entry
+    /// whose `file` is `file`.
+    pub fn obtain_from(&self, key: Option<&str>, file: &str) -> Option<String> {
+        let meshes = self.root.get("meshes")?.as_object()?;
+        let hint = |m: &Value| m.get("obtain_from")?.as_str().map(str::to_owned);
+        key.and_then(|k| meshes.get(k)).and_then(hint).or_else(|| {
+            meshes
+                .values()
+                .filter(|m| m.get("file").and_then(Value::as_str) == Some(file))
+                .find_map(hint)
+        })
+    }
+
     /// The orbit camera parameters of scene `name`.
     pub fn camera_spec(&self, name: &str) -> Result<OrbitSpec, SceneError> {
         let (i, s) = self.find(name)?;
@@ -244,6 +261,7 @@ impl ScenesFile {
                         object: oi,
                         name: oname,
                         mesh: paper.into(),
+                        obtain_from: None,
                     });
                 }
                 continue; // empty placeholder object
@@ -258,6 +276,9 @@ impl ScenesFile {
                         object: oi,
                         name: oname,
                         mesh: full.display().to_string(),
+                        obtain_from: self
+                            .obtain_from(mesh_key, &file)
+                            .map(String::into_boxed_str),
                     });
                 }
                 cache.insert(file.clone(), load_obj(&full)?);
@@ -276,5 +297,28 @@ impl ScenesFile {
         let mut scene = Scene::from_objects(name, &placed, Some(camera), lights)?;
         scene.name = name.into();
         Ok(scene)
+    }
+}
+
+/// `error` with, for an OBJ file that does not exist, where to get it when
+/// a `scenes.json` beside it says so (`obtain_from` of the mesh entry whose
+/// `file` is the file's name); any other error as it is.
+pub fn with_obtain_from(error: SceneError, obj: &Path) -> SceneError {
+    let SceneError::Io { path, message } = error else {
+        return error;
+    };
+    let hint = (!obj.exists())
+        .then(|| {
+            let json = obj.parent().unwrap_or(Path::new(".")).join("scenes.json");
+            let file = obj.file_name()?.to_str()?;
+            ScenesFile::open(&json).ok()?.obtain_from(None, file)
+        })
+        .flatten();
+    SceneError::Io {
+        path,
+        message: match hint {
+            Some(h) => format!("{message}; {h}"),
+            None => message,
+        },
     }
 }

@@ -1,7 +1,7 @@
 //! Object transforms and the orbit camera of `scenes.json`.
 //!
-//! Conventions (the `conventions` block of `../shared/scenes/scenes.json`,
-//! transcribed from the authors' renderer neptun):
+//! Conventions (the `conventions` block of the repository's
+//! `scenes/scenes.json`, transcribed from the authors' renderer neptun):
 //!
 //! * `world = T(translation) · R · S(scale) · local`, with
 //!   `R = Ry(rotation_deg.y) · Rx(rotation_deg.x) · Rz(rotation_deg.z)`

@@ -1,5 +1,5 @@
 //! Tetrahedral volumes with a per-point scalar field, to trace isosurfaces
-//! in (Wald et al., seed 004): structured grids split into tets
+//! in (Wald et al. 2007): structured grids split into tets
 //! ([`grid`]), analytic fields evaluated at the points ([`field`]), and
 //! named synthetic stand-ins for the paper's data sets with their sizes
 //! ([`named`]). The field of any [`TetMesh`] (a CDT, a VTK file) is set with

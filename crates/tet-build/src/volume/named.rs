@@ -1,4 +1,4 @@
-//! Named synthetic stand-ins for the data sets of Wald et al. (seed 004,
+//! Named synthetic stand-ins for the data sets of Wald et al. (2007,
 //! Table 1), with tet counts at or near the paper's, so isosurface tracing
 //! can be measured at the paper's sizes without the original data.
 //!
@@ -43,7 +43,7 @@ pub struct VolumeOptions {
     /// Number of time steps of a time-varying volume (default: its own);
     /// ignored by static volumes (always one step).
     pub steps: Option<usize>,
-    /// `buckycube`: `n` bucky balls along each axis, `n³` in all (seed 004
+    /// `buckycube`: `n` bucky balls along each axis, `n³` in all (Wald et al. 2007,
     /// Table 3 replicates the ball 1, 2³, 4³… times; 1 to 8, default 2, 4
     /// with `full`); ignored by the other volumes.
     pub replications: Option<u32>,
@@ -229,7 +229,7 @@ pub fn synthetic_volume_info(
                 tiled_bucky(lo, hi, n),
                 "c60",
                 0.5,
-                // Seed 004 Table 3: 177 k tets per ball, 1.4 M for 2³,
+                // Wald et al. (2007) Table 3: 177 k tets per ball, 1.4 M for 2³,
                 // 11.3 M for 4³ (the bucky cube of Table 1), 90.4 M for 8³.
                 match n {
                     1 => Some(177_000),

@@ -1,4 +1,4 @@
-//! `Baseline32`: the 32-byte tet of Lagae & Dutré (seed 000 §3, Figure 1),
+//! `Baseline32`: the 32-byte tet of Lagae & Dutré (2008; Aman et al. 2022, §3, Figure 1),
 //! used by the scalar-triple-product (ScTP) traversal kernel.
 //!
 //! | paper | field |

@@ -8,13 +8,13 @@
 //!
 //! | layout | record | bytes | paper | slot order kept |
 //! |---|---|---|---|---|
-//! | [`baseline32`] | [`Baseline32`] | 32 | Lagae & Dutré, seed 000 Fig. 1 | yes |
-//! | [`tet32`] | [`Tet32`] | 32 | seed 000 §3, Fig. 2 | yes |
-//! | [`tet20`] | [`Tet20`] | 20 | seed 000 §3, Fig. 3 | canonical (see below) |
-//! | [`tet16`] | [`Tet16`] | 16 | seed 000 §3, Fig. 4 | canonical (see below) |
-//! | [`tet80`] | [`Tet80`] | 80 | Maria et al., seed 001 §3.2 | yes |
+//! | [`baseline32`] | [`Baseline32`] | 32 | Lagae & Dutré 2008; Aman et al. (2022) Fig. 1 | yes |
+//! | [`tet32`] | [`Tet32`] | 32 | Aman et al. (2022) §3, Fig. 2 | yes |
+//! | [`tet20`] | [`Tet20`] | 20 | Aman et al. (2022) §3, Fig. 3 | canonical (see below) |
+//! | [`tet16`] | [`Tet16`] | 16 | Aman et al. (2022) §3, Fig. 4 | canonical (see below) |
+//! | [`tet80`] | [`Tet80`] | 80 | Maria et al. (2017) §3.2 | yes |
 //!
-//! ## Notation of seed 000 (Aman et al.) → code
+//! ## Notation of Aman et al. (2022) → code
 //!
 //! | paper | code |
 //! |---|---|

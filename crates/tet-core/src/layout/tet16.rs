@@ -1,4 +1,4 @@
-//! `Tet16` (seed 000 §3, Figure 4): the xor-sum and three xor-differences of
+//! `Tet16` (Aman et al. 2022, §3, Figure 4): the xor-sum and three xor-differences of
 //! the rank-ordered links, 16 bytes.
 //!
 //! | paper | field / helper |

@@ -1,4 +1,4 @@
-//! `Tet20` (seed 000 §3, Figure 3): the xor-sum and four links sorted by the
+//! `Tet20` (Aman et al. 2022, §3, Figure 3): the xor-sum and four links sorted by the
 //! global index of the vertex opposite them, 20 bytes.
 //!
 //! | paper | field / helper |

@@ -1,4 +1,4 @@
-//! `Tet32` (seed 000 §3, Figure 2): three vertex ids, the xor-sum and four
+//! `Tet32` (Aman et al. 2022, §3, Figure 2): three vertex ids, the xor-sum and four
 //! links, 32 bytes.
 //!
 //! | paper | field / helper |

@@ -1,4 +1,4 @@
-//! `Tet80`: the tetrahedron of Maria et al. (seed 001 §3.2), used by the
+//! `Tet80`: the tetrahedron of Maria et al. (2017, §3.2), used by the
 //! Plücker traversal kernel. 80 bytes: four vertex positions inline plus four
 //! 8-byte faces.
 //!

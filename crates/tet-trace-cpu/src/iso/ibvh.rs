@@ -1,4 +1,4 @@
-//! The implicit min-max BVH (seed 004 §5.1): a BVH over the tets whose
+//! The implicit min-max BVH (Wald et al. 2007, §5.1): a BVH over the tets whose
 //! nodes bound `{x, y, z, v}` in 4-D, so that traversal culls every subtree
 //! whose value range cannot hold the isovalue(s) ([`super::ibvh_trace`]).
 //!

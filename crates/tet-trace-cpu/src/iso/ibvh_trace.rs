@@ -1,4 +1,4 @@
-//! Single-ray traversal of the implicit BVH (seed 004 §5.2): a node is
+//! Single-ray traversal of the implicit BVH (Wald et al. 2007, §5.2): a node is
 //! culled when its value range holds no isovalue of the query (implicit
 //! culling, tested first: it is the cheapest), when the clip box excludes
 //! it, or when the ray misses its box before the nearest crossing found so

@@ -1,4 +1,4 @@
-//! Marching tetrahedra (seed 004 §3, Fig. 3): the isopolygon of one isotet
+//! Marching tetrahedra (Wald et al. 2007, §3, Fig. 3): the isopolygon of one isotet
 //! and the ray–isopolygon test.
 //!
 //! The four vertices are classified above (`≥ v`) or below the isovalue:

@@ -1,4 +1,4 @@
-//! Isosurface ray tracing of tetrahedral volumes (Wald et al., seed 004).
+//! Isosurface ray tracing of tetrahedral volumes (Wald et al. 2007).
 //!
 //! A scalar field is given by one value per mesh point (`values[i]` for
 //! `mesh.points[i]`) and is linear inside every tet; its isosurface

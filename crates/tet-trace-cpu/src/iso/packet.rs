@@ -1,4 +1,4 @@
-//! Packet traversal of the implicit BVH (seed 004 §5.2): packets of up to
+//! Packet traversal of the implicit BVH (Wald et al. 2007, §5.2): packets of up to
 //! [`PACKET`] rays (16 × 16) share one traversal with
 //!
 //! 1. implicit culling (value range, and clip box) first, once per packet;

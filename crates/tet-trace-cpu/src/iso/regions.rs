@@ -3,7 +3,7 @@
 //! may start their walk at the first such region.
 //!
 //! Most camera rays through a volume never meet its isosurface (about 90 %
-//! on the ell32p and blunt stand-ins of seed 004): the plain walk crosses
+//! on the ell32p and blunt stand-ins of Wald et al. 2007): the plain walk crosses
 //! the whole volume tet by tet to learn that, where the paper's packets
 //! reject them with a few box tests high in the implicit BVH. This tree
 //! gives the walk the same rejection at a fraction of the IBVH's memory:

@@ -5,7 +5,7 @@
 //! [`crate::entry`], the walk's own edge test, with the faces in a BVH:
 //! `iso::hull`) or starts in the tet around its origin
 //! ([`crate::locate()`]), then steps tet to neighbour across
-//! the exit face chosen by Algorithm 1 of seed 000 over the Tet32, Tet20 or
+//! the exit face chosen by Algorithm 1 of Aman et al. (2022) over the Tet32, Tet20 or
 //! Tet16 layout ([`WalkLayout`]; the exit rules of [`crate::tet32`],
 //! [`crate::tet20`], [`crate::tet16`]). Per tet visited:
 //!

@@ -1,4 +1,4 @@
-//! The Plücker walk of Maria et al. (seed 001 §3.4, the `tet80` and
+//! The Plücker walk of Maria et al. (2017, §3.4, the `tet80` and
 //! `tet80-consistent` kernels of [`crate::tet80`]) in SIMD lockstep: `W`
 //! rays of a batch walk side by side over the Tet80 records, one ray per
 //! lane, one tet per lane per round.

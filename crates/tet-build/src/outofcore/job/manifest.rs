@@ -173,7 +173,7 @@ impl TreeNode {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "planner", rename_all = "lowercase", deny_unknown_fields)]
 pub enum Partition {
-    /// The paper's recursive tree (Erkoç et al., seed 003).
+    /// The paper's recursive tree (Erkoç et al. 2021).
     Tree {
         /// The tree; leaves carry part indices.
         tree: TreeNode,

@@ -1,5 +1,5 @@
 //! The paper's recursive split with exact seams: perpendicular planes
-//! (Erkoç et al., seed 003, Algorithm 1 `TETRA`/`CLIP`/`MERGE`, §3.2–3.3).
+//! (Erkoç et al. 2021, Algorithm 1 `TETRA`/`CLIP`/`MERGE`, §3.2–3.3).
 //!
 //! A [`CutTree`] splits the enclosing box recursively; every leaf box is one
 //! TetGen run (`-pY`). Where seams meet, both sides must see the same
@@ -37,7 +37,7 @@
 //!    is exact: in memory (dedup + `assemble`, [`build_tree`]) or streamed
 //!    through part files ([`build_tree_to_file`], [`super::stream`]).
 //!
-//! | paper (seed 003)                       | code                              |
+//! | paper (Erkoç et al. 2021)                       | code                              |
 //! |----------------------------------------|-----------------------------------|
 //! | recursion of `TETRA`                   | [`CutTree`], [`build_tree`]       |
 //! | `CLIP` (clip triangles by the plane)   | tree-order clipping (item 1)      |
