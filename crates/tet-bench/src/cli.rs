@@ -408,6 +408,31 @@ impl Method {
         }
     }
 
+    /// The tet layout the method walks (a name of
+    /// `tet_core::memory::LAYOUT_NAMES`); `None` for the methods that walk
+    /// no layout (BVHs, Ray-Strips, brute force, the exact walk).
+    pub fn layout(self) -> Option<&'static str> {
+        match self {
+            Method::Sctp => Some("baseline32"),
+            Method::Tet80 | Method::Tet80Consistent | Method::GpuTet80 => Some("tet80"),
+            Method::Tet32 | Method::GpuTet32 => Some("tet32"),
+            Method::Tet20 | Method::GpuTet20 => Some("tet20"),
+            Method::Tet16 | Method::GpuTet16 => Some("tet16"),
+            Method::Obvhs
+            | Method::Strips
+            | Method::StripsPackets
+            | Method::Embree
+            | Method::Embree8
+            | Method::Brute
+            | Method::Exact => None,
+        }
+    }
+
+    /// True for the methods that walk tets (and so report tets per ray).
+    pub fn walks_tets(self) -> bool {
+        self.layout().is_some() || self == Method::Exact
+    }
+
     /// True for the GPU methods.
     pub fn is_gpu(self) -> bool {
         matches!(

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
+use tet_core::TetMesh;
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::render::{Frame, FrameStats, RenderOptions, render, render_into};
 
@@ -55,7 +56,10 @@ pub struct RenderDoc {
     pub shadow_rays: u64,
     /// Seconds to encode the layout or build the BVH.
     pub setup_s: f64,
-    /// Hot bytes of the method's structure (layout, or 0 for BVH).
+    /// Hot bytes of the method's structure: the tet records and points of
+    /// the layout it walks, the BVH's nodes and triangles (obvhs), the
+    /// whole Ray-Strips structure; 0 where the method does not report it
+    /// (Embree, the brute force, the exact walk).
     pub hot_bytes: usize,
     /// Compile-time CPU features the kernels were built with.
     pub target_features: Vec<&'static str>,
@@ -106,11 +110,7 @@ pub fn time_method(
     let setup = Instant::now();
     let t: Box<dyn Tracer + '_> = tracer(method, false, &loaded.mesh)?;
     let setup_s = setup.elapsed().as_secs_f64();
-    let hot_bytes = layout_bytes(&loaded.mesh)
-        .1
-        .iter()
-        .find(|l| l.name == method.name())
-        .map_or(0, |l| l.hot_bytes);
+    let hot_bytes = hot_bytes(method, &loaded.mesh)?;
     let run = || render(t.as_ref(), &loaded.camera, &loaded.lights, opts);
     let mut frame = pool.install(run).context("render failed")?;
     let mut stats: Vec<FrameStats> = Vec::new();
@@ -166,4 +166,24 @@ pub fn time_method(
         target_features: target_features(),
     };
     Ok((doc, frame))
+}
+
+/// [`RenderDoc::hot_bytes`] of `method` over `mesh` (the BVH and the strips
+/// are built again to be measured).
+fn hot_bytes(method: Method, mesh: &TetMesh) -> Result<usize> {
+    if let Some(name) = method.layout() {
+        let (_, layouts) = layout_bytes(mesh);
+        return Ok(layouts
+            .iter()
+            .find(|l| l.name == name)
+            .map_or(0, |l| l.hot_bytes));
+    }
+    Ok(match method {
+        Method::Obvhs => {
+            let (nodes, triangles) = BvhTracer::new(mesh).bytes();
+            nodes + triangles
+        }
+        Method::Strips | Method::StripsPackets => crate::layouts::strips_bytes(mesh)?.hot_bytes,
+        _ => 0,
+    })
 }

@@ -114,9 +114,20 @@ fn csv(doc: &TablesDoc) -> String {
                 .map_or(String::new(), |m| {
                     format!("{:.3}", m.failures_per_1024_squared)
                 });
+            // Tets per ray only for tet walks; bytes where measured.
+            let tets = if r.method.walks_tets() {
+                format!("{:.2}", r.tets_per_ray)
+            } else {
+                String::new()
+            };
+            let bytes = if r.hot_bytes > 0 {
+                r.hot_bytes.to_string()
+            } else {
+                String::new()
+            };
             let _ = writeln!(
                 s,
-                "{},{},{},{},{},{},{:.3},{:.3},{:.4},{:.2},{},{:.4},{},{}",
+                "{},{},{},{},{},{},{:.3},{:.3},{:.4},{tets},{bytes},{:.4},{},{}",
                 r.scene,
                 r.method.name(),
                 r.tracer,
@@ -126,8 +137,6 @@ fn csv(doc: &TablesDoc) -> String {
                 r.best_ms,
                 r.median_ms,
                 r.mrays_per_s,
-                r.tets_per_ray,
-                r.hot_bytes,
                 r.setup_s,
                 fails,
                 r.nodes_per_ray.map_or(String::new(), |n| format!("{n:.2}"))
