@@ -151,7 +151,7 @@ fn a_fan_of_rays_through_one_vertex_always_hits() {
 /// vertex from three directions, singles and packets (release: a few
 /// seconds; `cargo test --release -- --ignored`).
 #[test]
-#[ignore]
+#[ignore = "slow in debug: every vertex of an 82 k-triangle sphere; run with --release"]
 fn a_large_sphere_does_not_leak() {
     let centre = Vec3::new(3.7, 1.1, -0.4);
     let (positions, triangles) = common::icosphere(6, centre, 2.5);

@@ -109,7 +109,7 @@ impl Drop for Cluster {
 }
 
 #[test]
-#[ignore]
+#[ignore = "needs root: starts a single-node Slurm (installs munge and slurm-wlm when missing); .ci/run runs it"]
 fn a_job_runs_on_slurm_and_a_cancelled_part_is_rerun_alone() {
     let start = Instant::now();
     // No `sinfo` at all (Slurm not installed yet) is a cluster to start:

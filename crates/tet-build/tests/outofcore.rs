@@ -28,7 +28,7 @@ fn worker() -> Isolation {
 /// (copy the constants into `MemoryModel::FITTED`). Run in release:
 /// `cargo test -p tet-build --release --test outofcore -- --ignored --nocapture measure_memory_model`.
 #[test]
-#[ignore]
+#[ignore = "measurement: fits the TetGen memory model and prints it; run in release with --nocapture"]
 fn measure_memory_model() {
     let samples = measure_peak_memory(&measurement_scenes(), &worker()).unwrap();
     for s in &samples {
@@ -836,7 +836,7 @@ fn tet20_mrays(mesh: &TetMesh, scene: &Scene) -> f64 {
 /// `cargo test -p tet-build --release --test outofcore -- --ignored --nocapture trade_torus_knots`
 /// (`OOC_TRADE_SCENES=box` or `=grid` runs one scene only).
 #[test]
-#[ignore]
+#[ignore = "measurement: in-core vs out-of-core builds and tet20 speed (minutes); run in release with --nocapture"]
 fn trade_torus_knots() {
     use std::time::Instant;
     use tet_build::outofcore::seam::{SeamError, SeamReport, build_with_memory_limit};
@@ -1077,7 +1077,7 @@ fn cube_cut_along_its_edges_and_through_its_vertices() {
 /// (`MemoryModel::fit_parts`; copy it into `MemoryModel::FITTED`). Run in
 /// release: `cargo test -p tet-build --release --test outofcore -- --ignored --nocapture measure_part_memory_model`.
 #[test]
-#[ignore]
+#[ignore = "measurement: fits the seam-aware memory model and prints it; run in release with --nocapture"]
 fn measure_part_memory_model() {
     use tet_build::outofcore::memory_model::PartSample;
     use tet_build::outofcore::seam::build_with_memory_limit;
@@ -1392,7 +1392,7 @@ proptest::proptest! {
 /// minutes in release):
 /// `cargo test -p tet-build --release --test outofcore -- --ignored --nocapture million_triangle_fan_sphere`.
 #[test]
-#[ignore]
+#[ignore = "heavy: about 3 GB and a few minutes in release"]
 fn million_triangle_fan_sphere_matches_in_core() {
     use std::time::Instant;
     use tet_build::outofcore::tree::build_tree_with_memory_limit;

@@ -722,7 +722,7 @@ fn real_scene(name: &str, scene: tet_build::scene::Scene) {
 }
 
 #[test]
-#[ignore]
+#[ignore = "measurement: resolves the scene meshes in scenes/ (those present) and prints timings; run in release with --nocapture"]
 fn real_meshes() {
     for name in ["neptune_aimatshape_30k.obj", "teapot.obj", "beast.obj"] {
         let Some(path) = shared(name) else {
@@ -744,7 +744,7 @@ fn real_meshes() {
 /// (`cargo test --release -p tet-build --test resolve -- --ignored --nocapture stress`;
 /// `RESOLVE_STRESS_CASES` sets the cases per configuration).
 #[test]
-#[ignore]
+#[ignore = "stress: many random soups per configuration (minutes); run in release"]
 fn stress_random_soups() {
     let cases: usize = std::env::var("RESOLVE_STRESS_CASES")
         .ok()
@@ -804,7 +804,7 @@ fn stress_random_soups() {
 /// (`cargo test --release -p tet-build --test resolve -- --ignored --nocapture tetgen`).
 #[cfg(feature = "tetgen")]
 #[test]
-#[ignore]
+#[ignore = "needs the scene meshes in scenes/ and TetGen on them (minutes); run in release"]
 fn resolved_meshes_tetrahedralize() {
     use tet_build::pipeline::{BuildOptions, build};
     use tet_build::scene::Scene;

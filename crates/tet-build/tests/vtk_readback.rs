@@ -13,7 +13,7 @@
 //! Legacy files are read with their dataset-level field data (the
 //! `FIELD FieldData 1` block right after `DATASET`, which carries our
 //! triangle count) cut out: the VTK file format allows that block there
-//! and VTK's own writers put it there, but `vtkio` 0.6's legacy parser
+//! and VTK's own writers put it there, but `vtkio`'s legacy parser (0.6, 0.7)
 //! accepts no field data before `POINTS`. Everything else of the file,
 //! byte for byte, is what `vtkio` reads.
 

@@ -35,7 +35,7 @@ fn shadow_cost(name: &str, s: &dyn ShadowTracer, hits: &[Hit], light: &LightTarg
 }
 
 #[test]
-#[ignore]
+#[ignore = "measurement, not a check: prints timings; run in release with --nocapture"]
 fn measure_shadow_rays_and_tet80_start() {
     let m = kuhn_grid(&GridSpec {
         cells: [30, 30, 30],

@@ -180,7 +180,7 @@ mod tests {
     /// --nocapture stage_timing`; `TET_STAGE_OBJ=path.obj` times that scene,
     /// `TET_STAGE_REPS` sets the repetitions).
     #[test]
-    #[ignore]
+    #[ignore = "measurement, not a check: prints stage timings; run in release with --nocapture"]
     fn stage_timing() {
         let reps: usize = std::env::var("TET_STAGE_REPS")
             .ok()
