@@ -84,8 +84,7 @@ pub(crate) fn degenerate_crossing(t: f64, bary: &[f32; 3]) -> bool {
 /// near an edge, where the walk's tie rule took it across (see the walk's
 /// module docs, "Why the walk ends"). The hit is then the point of that
 /// segment at `t_min` if it holds it, else its end nearer `t_min`
-/// ([`along_face`]), so the hit lies on the face. So is a crossing of the
-/// plane that lies off the face ([`OFF_FACE`]).
+/// ([`along_face`]), so the hit lies on the face.
 pub fn face_hit(mesh: &TetMesh, ray: &Ray, ids: [u32; 3]) -> (f64, [f64; 3]) {
     let o = ray.origin.as_dvec3();
     let d = ray.direction.as_dvec3();
@@ -101,24 +100,11 @@ pub fn face_hit(mesh: &TetMesh, ray: &Ray, ids: [u32; 3]) -> (f64, [f64; 3]) {
     let n = (v[1] - v[0]).cross(v[2] - v[0]);
     if sum.abs() > PARALLEL * d.length() * n.length() && sum.is_finite() {
         let w = w.map(|x| x / sum);
-        if w.iter().all(|&x| x >= -OFF_FACE) {
-            let hit = q[0] * w[0] + q[1] * w[1] + q[2] * w[2];
-            return (hit.dot(d) / d.length_squared(), w);
-        }
+        let hit = q[0] * w[0] + q[1] * w[1] + q[2] * w[2];
+        return (hit.dot(d) / d.length_squared(), w);
     }
     along_face(o, d, v, ray.t_min as f64)
 }
-
-/// How far outside the face (in barycentrics) [`face_hit`] accepts the
-/// line's crossing with the face's plane. Past it, the walk took the line
-/// across the face near an edge or vertex it passes within rounding of, at
-/// an angle so grazing that the plane crossing lies far along the ray (a
-/// ray through a vertex where a cap meets a wall: 1e-4 of its length
-/// beyond the vertex, reported as a leak); the hit is then the point of
-/// the face nearest the line ([`along_face`]), where the walk crossed. (A
-/// crossing that rounding put just outside a face small beside its
-/// distance from the origin moves onto the face by as little.)
-const OFF_FACE: f64 = 1e-6;
 
 /// The sine of the angle between a ray and a face's plane below which
 /// [`face_hit`] takes the ray as running along the face: far below any
