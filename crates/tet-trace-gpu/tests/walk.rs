@@ -115,6 +115,19 @@ fn differences(
     (differ, along)
 }
 
+/// True when a walk stopped at its step cap: what the GPU must report where
+/// the CPU walk was capped and its tracer took the exact walk
+/// (`tet_trace_cpu::lost`), which the GPU has not.
+fn capped(o: &TraceOutcome) -> bool {
+    matches!(
+        o,
+        TraceOutcome::Failed {
+            failure: Failure::StepCap,
+            ..
+        }
+    )
+}
+
 fn triangle_of(o: &TraceOutcome) -> Option<u32> {
     o.hit().map(|h| h.triangle)
 }
@@ -147,13 +160,7 @@ fn check(
         // grazes an edge (where the walks may differ).
         if c.tets_visited() >= cap {
             assert!(
-                matches!(
-                    g,
-                    TraceOutcome::Failed {
-                        failure: Failure::StepCap,
-                        ..
-                    }
-                ) || graze,
+                capped(g) || graze,
                 "{layout:?} ray {i} {ray:?}: the CPU walk was capped, the GPU gave {g:?}"
             );
             exact += 1;
@@ -352,13 +359,7 @@ fn random_faces_case(ctx: &GpuContext, mesh: &TetMesh, layout: GpuLayout) {
             // (`tet_trace_cpu::lost`); the GPU has none: it must be capped
             // too, or the ray grazes an edge (where the walks may differ).
             assert!(
-                matches!(
-                    g,
-                    TraceOutcome::Failed {
-                        failure: Failure::StepCap,
-                        ..
-                    }
-                ) || grazes_an_edge(mesh, &rays2[i], GRAZE),
+                capped(g) || grazes_an_edge(mesh, &rays2[i], GRAZE),
                 "secondary ray {i}: the CPU walk was capped, the GPU gave {g:?}"
             );
             continue;
