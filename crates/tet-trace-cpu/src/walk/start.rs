@@ -166,12 +166,9 @@ fn boundary_face_at(mesh: &TetMesh, p: Vec3, d: Vec3, around: &[u32]) -> Option<
         (0..4)
             .find(|&k| {
                 let [a, b, c] = FACE_VERTICES[k];
-                let n = (v[b] - v[a]).cross(v[c] - v[a]);
-                // Outward: away from the vertex opposite the face.
-                let out = if n.dot(v[k] - v[a]) > 0.0 { -n } else { n };
                 mesh.across(t, k).is_none()
                     && orient3d(v[a], v[b], v[c], q) == 0.0
-                    && out.dot(d) >= 0.0
+                    && outward_normal(&v, k).dot(d) >= 0.0
             })
             .map(|k| (t, k))
     })
@@ -259,19 +256,24 @@ const NEAR: f64 = 1e-5;
 /// across an edge or vertex the origin lies near).
 const NEAR_LAYERS: usize = 3;
 
+/// The normal of face `k` of the tet with vertices `v` (not normalised),
+/// pointing away from the vertex opposite the face: out of the tet.
+fn outward_normal(v: &[glam::DVec3; 4], k: usize) -> glam::DVec3 {
+    let [a, b, c] = FACE_VERTICES[k].map(|s| v[s]);
+    let n = (b - a).cross(c - a);
+    if n.dot(v[k] - a) > 0.0 { -n } else { n }
+}
+
 /// How far `p` lies outside `tet`: the largest distance to the plane of a
 /// face it lies beyond (0 inside), in f64.
 fn outside_by(mesh: &TetMesh, tet: u32, p: glam::DVec3) -> f64 {
     let v = mesh.tet_points(tet).map(|x| x.as_dvec3());
     (0..4)
         .map(|k| {
-            let [a, b, c] = FACE_VERTICES[k].map(|s| v[s]);
-            let n = (b - a).cross(c - a);
+            let n = outward_normal(&v, k);
             let len = n.length();
-            // Outward: away from the vertex opposite the face.
-            let s = if n.dot(v[k] - a) > 0.0 { -1.0 } else { 1.0 };
             if len > 0.0 {
-                s * n.dot(p - a) / len
+                n.dot(p - v[FACE_VERTICES[k][0]]) / len
             } else {
                 0.0
             }
