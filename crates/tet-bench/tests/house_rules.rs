@@ -415,14 +415,6 @@ fn readme_is_short() {
     );
 }
 
-/// Files that still name papers by number because they are being edited
-/// elsewhere: being edited, to be cleared (then remove them from this list).
-const SEED_ALLOWED: [&str; 4] = [
-    "crates/tet-trace-cpu/src/exact.rs",
-    "crates/tet-trace-cpu/src/lib.rs",
-    "crates/tet-trace-cpu/src/walk/mod.rs",
-    "crates/tet-trace-cpu/src/walk/projection.rs",
-];
 
 /// The lines of `text` without their indentation and comment markers
 /// (`//!`, `///`, `//`, a block comment's `*`), joined by single spaces and
@@ -477,9 +469,6 @@ fn papers_are_named_by_authors_not_numbers() {
     for file in files {
         let rel = file.strip_prefix(&root).unwrap_or(&file);
         let rel = rel.to_string_lossy().replace('\\', "/");
-        if SEED_ALLOWED.contains(&rel.as_str()) {
-            continue;
-        }
         let text = fs::read_to_string(&file).expect("readable text");
         let text = flowing(&text);
         if let Some(at) = seed_number_at(&text) {
@@ -499,4 +488,40 @@ fn papers_are_named_by_authors_not_numbers() {
     assert!(seed_number_at(&flowing("Seeds 001 and 002")).is_some());
     assert!(seed_number_at(&flowing("/// Seed 004 Table 3")).is_some());
     assert!(seed_number_at(&flowing("--seed 7; XXH64, seed 0; fuzz/seeds/")).is_none());
+}
+
+/// The lockstep walk takes one request ([`tet_trace_cpu::lockstep::Batch`])
+/// through one entry: no function of `tet-trace-cpu/src/lockstep` spells
+/// out argument lists long enough to need `too_many_arguments`, and
+/// `TET_LOCKSTEP` is read in one place (`Width::Auto`) of the whole
+/// workspace.
+#[test]
+fn lockstep_takes_one_request_and_reads_its_width_once() {
+    let root = workspace();
+    let mut files = Vec::new();
+    rust_files(&root.join("crates/tet-trace-cpu/src/lockstep"), &mut files);
+    assert!(files.len() > 5, "lockstep sources: {files:?}");
+    let allows: Vec<String> = files
+        .iter()
+        .filter(|f| {
+            code(&fs::read_to_string(f).expect("readable source")).contains("too_many_arguments")
+        })
+        .map(|f| f.display().to_string())
+        .collect();
+    assert!(
+        allows.is_empty(),
+        "too_many_arguments in the lockstep module (pass a Batch):\n{}",
+        allows.join("\n")
+    );
+    let mut readers = Vec::new();
+    for src in crate_src_dirs() {
+        let mut files = Vec::new();
+        rust_files(&src, &mut files);
+        for f in files {
+            let text = code(&fs::read_to_string(&f).expect("readable source"));
+            let n = text.matches("\"TET_LOCKSTEP\"").count();
+            readers.extend(std::iter::repeat_n(f.display().to_string(), n));
+        }
+    }
+    assert_eq!(readers.len(), 1, "readers of TET_LOCKSTEP: {readers:?}");
 }

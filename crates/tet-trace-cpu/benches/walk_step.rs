@@ -21,7 +21,7 @@ use glam::Vec3;
 use tet_core::TetMesh;
 use tet_core::scene::{Camera, PointLight};
 use tet_trace_cpu::kernel::Interleaved;
-use tet_trace_cpu::lockstep::{Width, trace_lockstep_sctp};
+use tet_trace_cpu::lockstep::{self, NoGate, Triple, Width};
 use tet_trace_cpu::render::{Frame, RenderOptions, render};
 use tet_trace_cpu::sctp::SctpTracer;
 use tet_trace_cpu::tet16::Tet16Tracer;
@@ -82,17 +82,9 @@ impl Tracer for SctpAt<'_, '_> {
         self.trace_batch_from(rays, Starts::Same(start), out);
     }
     fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
-        let t = self.0;
-        let ran = trace_lockstep_sctp(
-            self.1,
-            t.mesh(),
-            t.layout(),
-            rays,
-            starts,
-            t.step_cap(),
-            out,
-        );
-        assert!(ran, "{:?} lockstep not available", self.1);
+        let batch = self.0.batch(rays, starts, out);
+        let ran = lockstep::trace::<Triple, _, _>(batch, self.1, &mut NoGate);
+        assert!(ran.is_ok(), "{:?} lockstep not available", self.1);
     }
 }
 

@@ -1,6 +1,6 @@
 //! The exact reference walk (`exact`): a tet walk whose every decision is
 //! exact and perturbed symbolically, the yardstick the accuracy
-//! measurement (seed 001 Table 4: failures per 1024² rays) holds the
+//! measurement (Maria et al. 2017, Table 4: failures per 1024² rays) holds the
 //! floating-point kernels against when an O(faces) brute force per ray is
 //! too slow.
 //!

@@ -11,13 +11,14 @@ use tet_core::layout::{LayoutError, LayoutMesh, LayoutRecord};
 use tet_core::link::Link;
 
 use crate::batch::BatchWalk;
+use crate::lockstep::exit::{ExitRule, RecordWords};
 use crate::lost::{exact_if_lost, exact_where_lost};
 use crate::ray::{Ray, TraceOutcome};
 pub use crate::tracer::Tracer;
 pub use crate::walk::LANES;
 use crate::walk::{
-    BoundaryEntry, EntryHint, ExitRule, Projection, RecordWords, Start, Starts, Topology,
-    prefetch_index, step_cap, trace, trace_interleaved, trace_until,
+    Batch, BoundaryEntry, EntryHint, Projection, Start, Starts, Topology, prefetch_index, step_cap,
+    trace, trace_interleaved, trace_until,
 };
 
 /// A projected-walk kernel: layout `L` (a [`Topology`]) walked with
@@ -57,6 +58,24 @@ impl<'m, L: Topology, P: Projection> WalkTracer<'m, L, P> {
     pub fn step_cap(&self) -> u32 {
         self.cap
     }
+
+    /// The batch of `rays` from `starts` into `out` over this tracer's
+    /// mesh, layout and step cap.
+    pub fn batch<'a>(
+        &'a self,
+        rays: &'a [Ray],
+        starts: Starts<'a>,
+        out: &'a mut [TraceOutcome],
+    ) -> Batch<'a, L> {
+        Batch {
+            mesh: self.mesh,
+            topo: &self.layout,
+            rays,
+            starts,
+            cap: self.cap,
+            out,
+        }
+    }
 }
 
 impl<L: Topology, P: BatchWalk> Tracer for WalkTracer<'_, L, P> {
@@ -82,7 +101,7 @@ impl<L: Topology, P: BatchWalk> Tracer for WalkTracer<'_, L, P> {
             n = n.min(s.len());
         }
         let (rays, out) = (&rays[..n], &mut out[..n]);
-        P::trace_batch(self.mesh, &self.layout, rays, starts, self.cap, out);
+        P::trace_batch(self.batch(rays, starts, out));
         exact_where_lost(self.mesh, self.cap, rays, starts, out);
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
@@ -119,7 +138,7 @@ impl<L: Topology, P: BatchWalk> Tracer for Interleaved<'_, '_, L, P> {
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
         let w = self.0;
         let starts = Starts::Same(start);
-        trace_interleaved::<P, L, LANES>(w.mesh, &w.layout, rays, starts, w.cap, out);
+        trace_interleaved::<P, L, LANES>(w.batch(rays, starts, out));
         exact_where_lost(w.mesh, w.cap, rays, starts, out);
     }
 }
@@ -138,13 +157,15 @@ pub trait WalkRecord: LayoutRecord + Sync {
     /// Raw link across the face opposite vertex `exiting`, see
     /// [`Topology::exit_link`].
     fn exit_link(&self, face: [u32; 3], d: u32, exiting: u32, entry_raw: u32) -> u32;
-    /// Where `VX` and the links sit in the record's 32-bit words, for the
-    /// gathers of the SIMD lockstep walk (see [`Topology::record_words`]);
-    /// `None`: the lockstep walk calls [`WalkRecord::exit_link`] per lane.
-    const WORDS: Option<(usize, ExitRule)> = None;
+    /// The same exit link in lanes, read from the record's 32-bit words by
+    /// the SIMD lockstep walk: the layout's zero-sized rule, defined beside
+    /// this impl ([`crate::lockstep::ByLane`]: the lockstep walk calls
+    /// [`WalkRecord::exit_link`] lane by lane).
+    type Exit: ExitRule;
 }
 
 impl<R: WalkRecord> Topology for LayoutMesh<R> {
+    type Exit = R::Exit;
     #[inline(always)]
     fn vx(&self, tet: u32) -> u32 {
         self.tets[tet as usize].vx()
@@ -161,12 +182,9 @@ impl<R: WalkRecord> Topology for LayoutMesh<R> {
     }
     #[inline(always)]
     fn record_words(&self) -> Option<RecordWords<'_>> {
-        let (vx, rule) = R::WORDS?;
         Some(RecordWords {
             words: bytemuck::cast_slice(&self.tets),
             stride: size_of::<R>() / 4,
-            vx,
-            rule,
         })
     }
 }

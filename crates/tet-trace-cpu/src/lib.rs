@@ -5,7 +5,7 @@
 //! crosses a constrained face (a scene triangle).
 //!
 //! * [`ray`]: [`Ray`], [`Hit`], [`TraceOutcome`] (hit / miss / reported failure);
-//! * [`mod@locate`]: exact point location (seed 000 §4.2);
+//! * [`mod@locate`]: exact point location (Aman et al. 2022, §4.2);
 //! * [`entry`]: rays from a viewpoint outside the mesh enter through its boundary;
 //! * [`walk`]: the watertight traversal engine and its projections;
 //! * [`lockstep`]: the SIMD lockstep batch walks, and [`batch`]: which
@@ -16,7 +16,7 @@
 //!   perturbation), the yardstick of the accuracy measurement;
 //! * [`mod@reference`]: f64 brute-force closest hit and ray generators for tests;
 //! * [`render`]: pinhole renderer, Lambert shading, PNG, heat maps, stats;
-//! * [`secondary`]: shadow, reflection and refraction rays (seed 000 §6).
+//! * [`secondary`]: shadow, reflection and refraction rays (Aman et al. 2022, §6).
 //!
 //! # Example
 //!
@@ -37,6 +37,35 @@
 //! let TraceOutcome::Hit(hit) = tracer.trace(&ray, start) else { panic!("no hit") };
 //! assert!(hit.t > 0.0 && hit.tets_visited > 0);
 //! ```
+//!
+//! # Adding a layout
+//!
+//! A layout is its layout file, its kernel file and one registry line:
+//!
+//! 1. **The layout file** (`tet-core`, a module of `tet_core::layout`):
+//!    the record, `#[repr(C)]` and [`bytemuck::Pod`] in 32-bit words, and
+//!    its encoding from a mesh and back (`tet_core::layout::LayoutRecord`),
+//!    so that `tet_core::layout::LayoutMesh` of it exists.
+//! 2. **The kernel file** (here, `src/tetNN.rs`, like [`tet20`]):
+//!    `impl WalkRecord for TetNN` ([`kernel::WalkRecord`]: the kernel's
+//!    name, `VX`, the scalar exit link the scalar walks read, and
+//!    `type Exit`); the exit rule as a zero-sized type `TetNNExit`
+//!    implementing [`lockstep::ExitRule`] (the words of a record it
+//!    reads, and the same exit link in SIMD lanes, which the lockstep walk
+//!    gathers; [`lockstep::ByLane`] instead makes the lockstep walk give
+//!    its batches to the scalar interleaved walk); and the tracer,
+//!    `pub type TetNNTracer<'m, P = DuffF32> = WalkTracer<'m, TetNNMesh, P>`.
+//!    [`WalkTracer::new`] then encodes a mesh in it, and every walk runs
+//!    over it: single rays, shadow rays, the interleaved batches and the
+//!    lockstep batches ([`lockstep::trace`] with [`lockstep::Planar`]) at
+//!    every width.
+//! 3. **One registry line**: `pub mod tetNN;` below (and, to run it from
+//!    the command line, its arm in `tet-bench`'s method registry).
+//!
+//! Nothing else names the layouts: no enum of rules, no dispatch table.
+//! To test it, add its tracer to the kernels of `tests/lockstep.rs` (every
+//! lockstep width against the scalar walk, bit for bit) and
+//! `tests/kernels.rs`.
 
 #![deny(missing_docs)]
 

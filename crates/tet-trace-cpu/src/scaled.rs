@@ -253,14 +253,7 @@ impl<L: Topology> Tracer for ScaledTracer<'_, L> {
             with_case!(
                 case,
                 P,
-                trace_interleaved::<P, L, LANES>(
-                    w.mesh,
-                    &w.layout,
-                    r,
-                    Starts::Same(start),
-                    w.cap,
-                    o
-                )
+                trace_interleaved::<P, L, LANES>(w.batch(r, Starts::Same(start), o))
             );
             i = j;
         }

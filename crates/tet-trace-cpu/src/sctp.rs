@@ -29,13 +29,14 @@
 use tet_core::layout::{Baseline32, Baseline32Mesh};
 
 use crate::kernel::{WalkRecord, WalkTracer, slot_exit_link};
-use crate::walk::{ExitRule, TripleF32};
+use crate::lockstep::exit::{ExitRule, Leaving, Record, slot_link};
+use crate::lockstep::lanes::Lanes;
+use crate::walk::TripleF32;
 
 impl WalkRecord for Baseline32 {
     const KERNEL: &'static str = "sctp";
     const PREFETCH: bool = false;
-    /// Ids at words 0..4, links at 4..8 (no `VX`: word 0 stands in).
-    const WORDS: Option<(usize, ExitRule)> = Some((0, ExitRule::Ids { ids: 0, links: 4 }));
+    type Exit = Baseline32Exit;
     #[inline(always)]
     fn vx(&self) -> u32 {
         let v = self.v;
@@ -44,6 +45,39 @@ impl WalkRecord for Baseline32 {
     #[inline(always)]
     fn exit_link(&self, _f: [u32; 3], _d: u32, exiting: u32, _entry: u32) -> u32 {
         slot_exit_link([self.v[0], self.v[1], self.v[2]], self.n, exiting)
+    }
+}
+
+/// The 32-byte baseline's exit rule in the lockstep walk's lanes: the
+/// four ids at words 0–3 of the record (no `VX`: the new vertex is the one
+/// not on the entry face, `v₀ ⊕ v₁ ⊕ v₂ ⊕ v₃ ⊕ idx₀ ⊕ idx₁ ⊕ idx₂`), the
+/// link at word `4 + k` for the slot `k` of the exiting vertex among the
+/// first three (3 when none of them, Algorithm 3).
+#[derive(Clone, Copy, Debug)]
+pub struct Baseline32Exit;
+
+impl ExitRule for Baseline32Exit {
+    const SPAN: usize = 8;
+    /// The ids of slots 0–2.
+    type Scratch<L: Lanes> = [L::I; 3];
+    #[inline(always)]
+    fn enter<L: Lanes>(l: L, rec: &Record<'_, L, Self>, ids: &[L::I; 3]) -> (L::I, [L::I; 3]) {
+        let face = l.xor_i(ids[0], ids[1]);
+        let v = [
+            rec.word::<0>(l),
+            rec.word::<1>(l),
+            rec.word::<2>(l),
+            rec.word::<3>(l),
+        ];
+        let d = l.xor_i(
+            l.xor_i(l.xor_i(v[0], v[1]), l.xor_i(v[2], v[3])),
+            l.xor_i(face, ids[2]),
+        );
+        (d, [v[0], v[1], v[2]])
+    }
+    #[inline(always)]
+    fn link<L: Lanes>(l: L, rec: &Record<'_, L, Self>, vid: [L::I; 3], x: &Leaving<L>) -> L::I {
+        slot_link::<L, Self, 4>(l, rec, vid, x.e)
     }
 }
 

@@ -69,6 +69,7 @@ use tet_core::{Link, NO_TET, TetMesh};
 
 use crate::kernel::{Tracer, WalkTracer};
 use crate::locate::{LocateError, locate, star};
+use crate::lockstep::exit::ByLane;
 use crate::ray::{Hit, Ray, TraceOutcome};
 use crate::walk::{DuffF32, Projection, Start, Topology, step_cap, trace_until};
 pub use crate::walk::{StopAt, stops_at};
@@ -237,6 +238,7 @@ impl LightTarget {
 pub struct MeshTopology<'m>(pub &'m TetMesh);
 
 impl Topology for MeshTopology<'_> {
+    type Exit = ByLane;
     #[inline(always)]
     fn vx(&self, tet: u32) -> u32 {
         self.0

@@ -12,12 +12,14 @@
 use tet_core::layout::{Tet16, Tet16Mesh, rank_of};
 
 use crate::kernel::{WalkRecord, WalkTracer};
-use crate::walk::{DuffF32, DuffF64, ExitRule};
+use crate::lockstep::exit::{ExitRule, Leaving, Record, decode, rank};
+use crate::lockstep::lanes::Lanes;
+use crate::walk::{DuffF32, DuffF64};
 
 impl WalkRecord for Tet16 {
     const KERNEL: &'static str = "tet16";
     const PREFETCH: bool = true;
-    const WORDS: Option<(usize, ExitRule)> = Some((0, ExitRule::RankXor { links: 1 }));
+    type Exit = Tet16Exit;
     #[inline(always)]
     fn vx(&self) -> u32 {
         self.vx
@@ -29,6 +31,41 @@ impl WalkRecord for Tet16 {
         // `NX_3 = 0` (Tet16::nx4) as a select: no stack array to index.
         let pick = |rank: usize| if rank < 3 { nx[rank] } else { 0 };
         entry ^ pick(rank_of(d, ids)) ^ pick(rank_of(exiting, ids))
+    }
+}
+
+/// Tet16's exit rule in the lockstep walk's lanes (Algorithm 7): `VX` at
+/// word 0 of the record, `NX_r` at word `1 + r` (`NX_3 = 0`), the link
+/// `entry ⊕ NX(rank(idx₃)) ⊕ NX(rank(exiting))`.
+#[derive(Clone, Copy, Debug)]
+pub struct Tet16Exit;
+
+impl Tet16Exit {
+    /// `NX_r` of the lanes' records, 0 for rank 3: those lanes read word 0
+    /// of the record (in range) and drop it.
+    #[inline(always)]
+    fn nx<L: Lanes>(l: L, rec: &Record<'_, L, Self>, r: L::I) -> L::I {
+        let m = l.gt_i(l.splat_i(3), r);
+        let k = l.select_i(m, l.add_i(l.splat_i(1), r), l.splat_i(0));
+        // SAFETY: `k ≤ 1 + 2 < SPAN`, or 0.
+        l.zero_unless(m, unsafe { rec.word_at(l, k) })
+    }
+}
+
+impl ExitRule for Tet16Exit {
+    const SPAN: usize = 4;
+    type Scratch<L: Lanes> = ();
+    #[inline(always)]
+    fn enter<L: Lanes>(l: L, rec: &Record<'_, L, Self>, ids: &[L::I; 3]) -> (L::I, ()) {
+        (decode(l, ids, rec.word::<0>(l)), ())
+    }
+    #[inline(always)]
+    fn link<L: Lanes>(l: L, rec: &Record<'_, L, Self>, _: (), x: &Leaving<L>) -> L::I {
+        // `rank(d)` among the entry face (d itself never counts).
+        let of = [x.ids[0], x.ids[1], x.ids[2], x.d];
+        let (rd, re) = (rank(l, x.d, of), rank(l, x.e, of));
+        let (nd, ne) = (Self::nx(l, rec, rd), Self::nx(l, rec, re));
+        l.xor_i(l.xor_i(x.entry, nd), ne)
     }
 }
 

@@ -20,12 +20,14 @@
 use tet_core::layout::{Tet20, Tet20Mesh, rank_of};
 
 use crate::kernel::{WalkRecord, WalkTracer};
-use crate::walk::{DuffF32, DuffF64, ExitRule};
+use crate::lockstep::exit::{ExitRule, Leaving, Record, decode, rank};
+use crate::lockstep::lanes::Lanes;
+use crate::walk::{DuffF32, DuffF64};
 
 impl WalkRecord for Tet20 {
     const KERNEL: &'static str = "tet20";
     const PREFETCH: bool = true;
-    const WORDS: Option<(usize, ExitRule)> = Some((0, ExitRule::Rank { links: 1 }));
+    type Exit = Tet20Exit;
     #[inline(always)]
     fn vx(&self) -> u32 {
         self.vx
@@ -34,6 +36,26 @@ impl WalkRecord for Tet20 {
     fn exit_link(&self, f: [u32; 3], d: u32, exiting: u32, _entry: u32) -> u32 {
         self.neighbor_by_rank(rank_of(exiting, [f[0], f[1], f[2], d]))
             .0
+    }
+}
+
+/// Tet20's exit rule in the lockstep walk's lanes (Algorithm 5): `VX` at
+/// word 0 of the record, the link at word `1 + rank(exiting)`.
+#[derive(Clone, Copy, Debug)]
+pub struct Tet20Exit;
+
+impl ExitRule for Tet20Exit {
+    const SPAN: usize = 5;
+    type Scratch<L: Lanes> = ();
+    #[inline(always)]
+    fn enter<L: Lanes>(l: L, rec: &Record<'_, L, Self>, ids: &[L::I; 3]) -> (L::I, ()) {
+        (decode(l, ids, rec.word::<0>(l)), ())
+    }
+    #[inline(always)]
+    fn link<L: Lanes>(l: L, rec: &Record<'_, L, Self>, _: (), x: &Leaving<L>) -> L::I {
+        let r = rank(l, x.e, [x.ids[0], x.ids[1], x.ids[2], x.d]);
+        // SAFETY: `r ≤ 3`, so `1 + r < SPAN`.
+        unsafe { rec.word_at(l, l.add_i(l.splat_i(1), r)) }
     }
 }
 

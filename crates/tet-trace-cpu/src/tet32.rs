@@ -10,12 +10,14 @@
 use tet_core::layout::{Tet32, Tet32Mesh};
 
 use crate::kernel::{WalkRecord, WalkTracer, slot_exit_link};
-use crate::walk::{DuffF32, DuffF64, ExitRule};
+use crate::lockstep::exit::{ExitRule, Leaving, Record, decode, slot_link};
+use crate::lockstep::lanes::Lanes;
+use crate::walk::{DuffF32, DuffF64};
 
 impl WalkRecord for Tet32 {
     const KERNEL: &'static str = "tet32";
     const PREFETCH: bool = true;
-    const WORDS: Option<(usize, ExitRule)> = Some((3, ExitRule::Slot { ids: 0, links: 4 }));
+    type Exit = Tet32Exit;
     #[inline(always)]
     fn vx(&self) -> u32 {
         self.vx
@@ -23,6 +25,26 @@ impl WalkRecord for Tet32 {
     #[inline(always)]
     fn exit_link(&self, _f: [u32; 3], _d: u32, exiting: u32, _entry: u32) -> u32 {
         slot_exit_link(self.v, self.n, exiting)
+    }
+}
+
+/// Tet32's exit rule in the lockstep walk's lanes (Algorithm 3): the ids
+/// `V_0..V_2` at words 0–2 of the record, `VX` at word 3, the link at word
+/// `4 + k` for the slot `k` of the exiting vertex (3 when none of them).
+#[derive(Clone, Copy, Debug)]
+pub struct Tet32Exit;
+
+impl ExitRule for Tet32Exit {
+    const SPAN: usize = 8;
+    type Scratch<L: Lanes> = ();
+    #[inline(always)]
+    fn enter<L: Lanes>(l: L, rec: &Record<'_, L, Self>, ids: &[L::I; 3]) -> (L::I, ()) {
+        (decode(l, ids, rec.word::<3>(l)), ())
+    }
+    #[inline(always)]
+    fn link<L: Lanes>(l: L, rec: &Record<'_, L, Self>, _: (), x: &Leaving<L>) -> L::I {
+        let vid = [rec.word::<0>(l), rec.word::<1>(l), rec.word::<2>(l)];
+        slot_link::<L, Self, 4>(l, rec, vid, x.e)
     }
 }
 

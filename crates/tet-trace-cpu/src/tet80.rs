@@ -86,15 +86,17 @@
 //! # Batches: the walk in SIMD lockstep
 //!
 //! [`Tracer::trace_batch`] and [`Tracer::trace_batch_from`] walk 16
-//! (AVX-512F) or 8 (AVX2) rays side by side, one per SIMD lane
-//! ([`crate::lockstep`]'s Plücker walk, `lockstep/plucker.rs`), for both
-//! side rules: the faithful product in the apex's frame is a formula per
-//! tet, not state that differs per tet, so it runs per lane as well as the
-//! consistent one. Each lane evaluates exactly this module's formulas and
-//! tables, takes this module's start ([`Tet80Tracer::trace_batch_lockstep`]
-//! calls the same `begin`), its crossing of occlusive and boundary faces and
-//! its tie rule, so every ray's outcome equals the scalar walk's bit for
-//! bit ([`Tet80Tracer::trace_batch_scalar`], kept as the reference and
+//! (AVX-512F) or 8 (AVX2) rays side by side, one per SIMD lane: the one
+//! lockstep entry with the Plücker geometry
+//! ([`lockstep::trace`] with [`Plucker`], `lockstep/plucker.rs`, the same
+//! driver as every other kernel's), for both side rules: the faithful
+//! product in the apex's frame is a formula per tet, not state that
+//! differs per tet, so it runs per lane as well as the consistent one.
+//! Each lane evaluates exactly this module's formulas and tables, takes
+//! this module's start (the same `begin`, through
+//! [`Tet80Tracer::batch`]), its crossing of occlusive and boundary faces
+//! and its tie rule, so every ray's outcome equals the scalar walk's bit
+//! for bit ([`Tet80Tracer::trace_batch_scalar`], kept as the reference and
 //! taken without AVX2 or with `TET_LOCKSTEP=scalar`).
 //!
 //! ScTP ([`crate::sctp`]) cannot be repaired the same way within its
@@ -108,14 +110,13 @@ use tet_core::predicates::orient3d;
 use tet_core::{FACE_VERTICES, NO_TET, TetMesh};
 
 use crate::kernel::Tracer;
-use crate::lockstep::batch_width as lockstep_width;
 use crate::lockstep::plucker::{Begun, PluckerWalk};
-use crate::lockstep::{self, Width};
+use crate::lockstep::{self, NoGate, Plucker, Width};
 use crate::lost::{exact_if_lost, exact_where_lost};
 use crate::ray::{Failure, Hit, Ray, TraceOutcome};
 use crate::secondary::{ShadowTracer, stops_at};
 use crate::walk::{
-    DuffF32, EntryHint, Projection, Start, Starts, TripleF32, degenerate_crossing, face_hit,
+    Batch, DuffF32, EntryHint, Projection, Start, Starts, TripleF32, degenerate_crossing, face_hit,
     left_f32, start_exit_face, start_scale, step_cap,
 };
 
@@ -199,6 +200,31 @@ impl<'m, const CONSISTENT: bool> Tet80Tracer<'m, CONSISTENT> {
         &self.layout
     }
 
+    /// The step cap.
+    pub fn step_cap(&self) -> u32 {
+        self.cap
+    }
+
+    /// The batch of `rays` from `starts` into `out` over this tracer, for
+    /// the lockstep walk ([`lockstep::trace`] with [`Plucker`]): `out[i]`
+    /// is then exactly the scalar walk's outcome of `rays[i]` from its
+    /// start, as [`Tet80Tracer::trace_batch_from_scalar`] gives it.
+    pub fn batch<'a>(
+        &'a self,
+        rays: &'a [Ray],
+        starts: Starts<'a>,
+        out: &'a mut [TraceOutcome],
+    ) -> Batch<'a, Self> {
+        Batch {
+            mesh: self.mesh,
+            topo: self,
+            rays,
+            starts,
+            cap: self.cap,
+            out,
+        }
+    }
+
     /// The walk from `tet`, entered through face `entry`. `stop(tet)` ends
     /// it as a [`TraceOutcome::Miss`] on entering `tet` (shadow rays;
     /// monomorphised away for primary rays).
@@ -237,6 +263,12 @@ impl<'m, const CONSISTENT: bool> Tet80Tracer<'m, CONSISTENT> {
                 Err(out) => return out,
             }
         }
+    }
+
+    /// The walk from `b` (a walk between two tets) to its end.
+    #[cfg(test)]
+    pub(crate) fn walk_from(&self, ray: &Ray, b: Begun) -> TraceOutcome {
+        self.walk(ray, b.tet, b.entry, b.visited, b.scale, |_| false)
     }
 
     /// Crosses face `f` of `tet`: `Ok(next tet, its entry face)` or the outcome.
@@ -416,7 +448,7 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
     }
 
     /// The scalar batch walk, one ray after the other (the reference of
-    /// the lockstep walk, [`Tet80Tracer::trace_batch_lockstep`]): rays
+    /// the lockstep walk, see [`Tet80Tracer::batch`]): rays
     /// sharing one origin share the start tet's interior test.
     pub fn trace_batch_scalar(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
         let inside = self.shared_inside(rays, start);
@@ -448,39 +480,6 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
             };
         }
     }
-
-    /// The batch in SIMD lockstep at `width` ([`crate::lockstep`]'s
-    /// Plücker walk): `out[i]` is exactly the scalar walk's outcome of
-    /// `rays[i]` from its start, as [`Tracer::trace_batch_from`] gives it.
-    /// False (nothing traced) when the CPU lacks the width.
-    pub fn trace_batch_lockstep(
-        &self,
-        width: Width,
-        rays: &[Ray],
-        starts: Starts<'_>,
-        out: &mut [TraceOutcome],
-    ) -> bool {
-        let mut n = rays.len().min(out.len());
-        if let Starts::Each(s) = starts {
-            n = n.min(s.len());
-        }
-        let rays = &rays[..n];
-        let inside = match starts {
-            Starts::Same(s) => self.shared_inside(rays, s),
-            _ => None,
-        };
-        let mut hint = EntryHint::default();
-        let begin = |i: usize| {
-            let r = &rays[i];
-            let start = match starts {
-                Starts::Same(s) => s,
-                Starts::Each(s) => s[i],
-                Starts::Outside(entry) => self.start_outside(entry, r, &mut hint)?,
-            };
-            self.begin(r, start, inside, &|_| false)
-        };
-        lockstep::plucker::trace(width, self, rays, begin, &mut out[..n])
-    }
 }
 
 impl<const CONSISTENT: bool> PluckerWalk for Tet80Tracer<'_, CONSISTENT> {
@@ -488,8 +487,27 @@ impl<const CONSISTENT: bool> PluckerWalk for Tet80Tracer<'_, CONSISTENT> {
     fn records(&self) -> &[Tet80] {
         &self.layout.tets
     }
-    fn cap(&self) -> u32 {
-        self.cap
+    /// This walk's own start of each ray: rays sharing one origin share the
+    /// start tet's interior test.
+    fn starts<'a>(
+        &'a self,
+        rays: &'a [Ray],
+        starts: Starts<'a>,
+    ) -> impl FnMut(usize) -> Result<Begun, TraceOutcome> + 'a {
+        let inside = match starts {
+            Starts::Same(s) => self.shared_inside(rays, s),
+            _ => None,
+        };
+        let mut hint = EntryHint::default();
+        move |i: usize| {
+            let r = &rays[i];
+            let start = match starts {
+                Starts::Same(s) => s,
+                Starts::Each(s) => s[i],
+                Starts::Outside(entry) => self.start_outside(entry, r, &mut hint)?,
+            };
+            self.begin(r, start, inside, &|_| false)
+        }
     }
     fn leave(
         &self,
@@ -656,24 +674,28 @@ impl<const CONSISTENT: bool> Tracer for Tet80Tracer<'_, CONSISTENT> {
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
         ShadowTracer::trace_until(self, ray, start, stop)
     }
-    /// In SIMD lockstep ([`Tet80Tracer::trace_batch_lockstep`]): 16 lanes
+    /// In SIMD lockstep ([`lockstep::trace`] at [`Width::Auto`]): 16 lanes
     /// with AVX-512F (unless `TET_LOCKSTEP=avx2`), else 8 with AVX2; else,
     /// or with `TET_LOCKSTEP=scalar`, the scalar walk
     /// ([`Tet80Tracer::trace_batch_scalar`]). The outcomes are the same.
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
-        let done = lockstep_width()
-            .is_some_and(|w| self.trace_batch_lockstep(w, rays, Starts::Same(start), out));
-        if !done {
+        let starts = Starts::Same(start);
+        let batch = self.batch(rays, starts, out);
+        if lockstep::trace::<Plucker, _, _>(batch, Width::Auto, &mut NoGate).is_err() {
             self.trace_batch_scalar(rays, start, out);
         }
-        exact_where_lost(self.mesh, self.cap, rays, Starts::Same(start), out);
+        exact_where_lost(self.mesh, self.cap, rays, starts, out);
     }
     /// As [`Tracer::trace_batch`]: in lockstep where the CPU has AVX2 or
     /// AVX-512F, else ray after ray.
     fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
-        let done =
-            lockstep_width().is_some_and(|w| self.trace_batch_lockstep(w, rays, starts, out));
-        if !done {
+        let mut n = rays.len().min(out.len());
+        if let Starts::Each(s) = starts {
+            n = n.min(s.len());
+        }
+        let (rays, out) = (&rays[..n], &mut out[..n]);
+        let batch = self.batch(rays, starts, out);
+        if lockstep::trace::<Plucker, _, _>(batch, Width::Auto, &mut NoGate).is_err() {
             self.trace_batch_from_scalar(rays, starts, out);
         }
         exact_where_lost(self.mesh, self.cap, rays, starts, out);

@@ -11,7 +11,7 @@ use glam::Vec3;
 use tet_core::TetMesh;
 use tet_core::scene::Camera;
 use tet_trace_cpu::kernel::{Interleaved, WalkTracer};
-use tet_trace_cpu::lockstep::{trace_lockstep_avx2, trace_lockstep_portable};
+use tet_trace_cpu::lockstep::{self, NoGate, Planar, Width};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Topology;
 use tet_trace_cpu::{BatchWalk, Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint};
@@ -59,16 +59,13 @@ fn batch_walks<L: Topology, P: BatchWalk>(
             Viewpoint::Inside(tet) => Starts::Same(Start::Tet(*tet)),
             Viewpoint::Outside(entry) => Starts::Outside(entry),
         };
-        let (mesh, topo, cap) = (t.mesh(), t.layout(), t.step_cap());
-        let mut out = unset(rays.len());
-        trace_lockstep_avx2(mesh, topo, rays, starts, cap, &mut out);
-        walks.push(("avx2 (portable 4 without AVX2)".to_string(), out));
-        let mut out = unset(rays.len());
-        trace_lockstep_portable::<L, 4>(mesh, topo, rays, starts, cap, &mut out);
-        walks.push(("portable/4".to_string(), out));
-        let mut out = unset(rays.len());
-        trace_lockstep_portable::<L, 8>(mesh, topo, rays, starts, cap, &mut out);
-        walks.push(("portable/8".to_string(), out));
+        for width in Width::ALL.into_iter().filter(|w| w.available()) {
+            let mut out = unset(rays.len());
+            let batch = t.batch(rays, starts, &mut out);
+            let ran = lockstep::trace::<Planar, _, _>(batch, width, &mut NoGate);
+            assert!(ran.is_ok(), "{width:?} did not run");
+            walks.push((format!("{width:?}"), out));
+        }
     }
     walks
 }

@@ -15,9 +15,7 @@ use tet_core::TetMesh;
 use tet_core::scene::Camera;
 use tet_core::synthetic::SplitMix64;
 use tet_trace_cpu::kernel::{Interleaved, WalkTracer};
-use tet_trace_cpu::lockstep::{
-    Width, trace_lockstep_at, trace_lockstep_avx2, trace_lockstep_portable, trace_lockstep_sctp,
-};
+use tet_trace_cpu::lockstep::{self, NoGate, Planar, Triple, Width};
 use tet_trace_cpu::reference::{Aim, random_point_inside, ray_from_feature};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::{Topology, start_scale};
@@ -28,8 +26,9 @@ use tet_trace_cpu::{
 mod common;
 use common::{batch, bits, grid};
 
-/// The lockstep batch (dispatching, and portable at 1, 3, 4 and 8 lanes)
-/// equals the scalar single-ray walk and the interleaved batch bit for bit.
+/// The lockstep batch (dispatching, and at every width the CPU runs)
+/// equals the scalar single-ray walk and the interleaved batch bit for bit
+/// (1, 3 and 5 portable lanes: the unit tests of `lockstep`).
 fn check_batch<L: Topology>(t: &WalkTracer<'_, L, DuffF32>, rays: &[Ray], start: Start) {
     let single: Vec<TraceOutcome> = rays.iter().map(|r| t.trace(r, start)).collect();
     let fresh = || {
@@ -51,16 +50,17 @@ fn check_batch<L: Topology>(t: &WalkTracer<'_, L, DuffF32>, rays: &[Ray], start:
     Interleaved(t).trace_batch(rays, start, &mut inter);
     let mut lock = fresh();
     t.trace_batch(rays, start, &mut lock);
-    let mut a2 = fresh();
-    trace_lockstep_avx2(mesh, topo, rays, Starts::Same(start), cap, &mut a2);
-    let mut p1 = fresh();
-    trace_lockstep_portable::<L, 1>(mesh, topo, rays, Starts::Same(start), cap, &mut p1);
-    let mut p3 = fresh();
-    trace_lockstep_portable::<L, 3>(mesh, topo, rays, Starts::Same(start), cap, &mut p3);
-    let mut p4 = fresh();
-    trace_lockstep_portable::<L, 4>(mesh, topo, rays, Starts::Same(start), cap, &mut p4);
-    let mut p8 = fresh();
-    trace_lockstep_portable::<L, 8>(mesh, topo, rays, Starts::Same(start), cap, &mut p8);
+    let mut runs = vec![("interleaved".to_string(), inter, &single)];
+    runs.push(("lockstep".to_string(), lock, &single));
+    for width in Width::ALL {
+        let mut got = fresh();
+        let batch = t.batch(rays, Starts::Same(start), &mut got);
+        let ran = lockstep::trace::<Planar, _, _>(batch, width, &mut NoGate).is_ok();
+        assert_eq!(ran, width.available(), "{width:?} ran {ran}");
+        if ran {
+            runs.push((format!("{width:?}"), got, &raw));
+        }
+    }
     for (i, r) in rays.iter().enumerate() {
         let lost = matches!(
             raw[i],
@@ -72,15 +72,7 @@ fn check_batch<L: Topology>(t: &WalkTracer<'_, L, DuffF32>, rays: &[Ray], start:
         if !lost {
             assert_eq!(bits(&single[i]), bits(&raw[i]), "only lost walks change");
         }
-        for (name, got, want) in [
-            ("interleaved", &inter, &single),
-            ("lockstep", &lock, &single),
-            ("avx2", &a2, &raw),
-            ("portable/1", &p1, &raw),
-            ("portable/3", &p3, &raw),
-            ("portable/4", &p4, &raw),
-            ("portable/8", &p8, &raw),
-        ] {
+        for (name, got, want) in &runs {
             assert_eq!(
                 bits(&got[i]),
                 bits(&want[i]),
@@ -331,9 +323,9 @@ fn check_all_widths(
         rays: &[Ray],
     ) -> (String, Vec<Width>) {
         let want = scalar(t, view, rays);
-        let (mesh, topo, cap) = (t.mesh(), t.layout(), t.step_cap());
         let ran = check_widths(&t.name(), rays, &want, |w, out| {
-            trace_lockstep_at(w, mesh, topo, rays, starts(view), cap, out)
+            let batch = t.batch(rays, starts(view), out);
+            lockstep::trace::<Planar, _, _>(batch, w, &mut NoGate).is_ok()
         });
         (t.name(), ran)
     }
@@ -357,9 +349,9 @@ fn check_all_widths(
         projected(&t32, view, rays),
     ];
     let want = scalar(&sctp, view, rays);
-    let (m, topo, c) = (sctp.mesh(), sctp.layout(), sctp.step_cap());
     let widths = check_widths("ScTP", rays, &want, |w, out| {
-        trace_lockstep_sctp(w, m, topo, rays, starts(view), c, out)
+        let batch = sctp.batch(rays, starts(view), out);
+        lockstep::trace::<Triple, _, _>(batch, w, &mut NoGate).is_ok()
     });
     ran.push(("ScTP".to_string(), widths));
     ran

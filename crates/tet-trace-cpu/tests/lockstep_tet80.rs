@@ -15,7 +15,7 @@ use glam::Vec3;
 use tet_core::TetMesh;
 use tet_core::predicates::orient3d_f32;
 use tet_core::synthetic::SplitMix64;
-use tet_trace_cpu::lockstep::Width;
+use tet_trace_cpu::lockstep::{self, NoGate, Plucker, Width};
 use tet_trace_cpu::reference::{Aim, random_point_inside, ray_from_feature};
 use tet_trace_cpu::tet80::Tet80Tracer;
 use tet_trace_cpu::{Failure, Ray, Start, Starts, TraceOutcome, Tracer, Viewpoint, locate};
@@ -69,7 +69,8 @@ fn check<const C: bool>(
     let mut ran = Vec::new();
     for width in Width::ALL {
         let mut got = fresh(rays.len());
-        let did = t.trace_batch_lockstep(width, rays, starts, &mut got);
+        let batch = t.batch(rays, starts, &mut got);
+        let did = lockstep::trace::<Plucker, _, _>(batch, width, &mut NoGate).is_ok();
         assert_eq!(did, width.available(), "{}: {width:?} ran {did}", t.name());
         if did {
             ran.push(width);

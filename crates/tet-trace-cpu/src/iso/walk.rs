@@ -424,7 +424,7 @@ impl<'m> IsoWalk<'m> {
     ) {
         // Lockstep where the CPU has AVX2 (measured there) unless
         // `TET_LOCKSTEP=scalar` asks for the interleaved walk.
-        let how = if crate::lockstep::batch_width().is_some() {
+        let how = if crate::lockstep::Width::Auto.available() {
             TileWalk::Lockstep
         } else {
             TileWalk::Interleaved

@@ -56,6 +56,7 @@ fn cold_avx2<R>(f: impl FnOnce() -> R) -> R {
 
 impl Lanes for Avx2 {
     const WIDTH: usize = 8;
+    const GATHERS: bool = true;
     type F = __m256;
     type I = __m256i;
     type M = __m256;

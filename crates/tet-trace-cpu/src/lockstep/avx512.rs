@@ -43,6 +43,7 @@ fn cold_avx512<R>(f: impl FnOnce() -> R) -> R {
 // an `Avx512` exists only where the CPU has AVX-512F.
 impl Lanes for Avx512 {
     const WIDTH: usize = 16;
+    const GATHERS: bool = true;
     type F = __m512;
     type I = __m512i;
     type M = __mmask16;

@@ -1,13 +1,174 @@
-//! How a round reads a layout ([`Records`]): the new vertex of the tet a
-//! lane enters and the link of the face it leaves through. Gathered from
-//! the record words ([`Gathered`], with the exit rules of Tet20, Tet16,
-//! Tet32 and ScTP, see [`ExitRule`]) or read lane by lane through
-//! [`Topology`] ([`PerLane`], the portable fallback).
+//! The exit rule as a type ([`ExitRule`]): how the lockstep walk finds, in
+//! a layout's records gathered as 32-bit words ([`RecordWords`]), the new
+//! vertex of the tet a lane enters and the link of the face it leaves
+//! through. Each layout's kernel module defines one zero-sized rule, which
+//! its record type names (`WalkRecord::Exit`, and so `Topology::Exit`):
+//! `Tet20Exit` (Algorithm 5, [`crate::tet20`]), `Tet16Exit` (Algorithm 7,
+//! [`crate::tet16`]), `Tet32Exit` (Algorithm 3, [`crate::tet32`]),
+//! `Baseline32Exit` (ScTP's four ids, [`crate::sctp`]); [`ByLane`] for
+//! layouts whose records are not gathered. [`Gathered`] makes a rule the
+//! walk's record reads ([`Records`]); the other reads go lane by lane
+//! through `Topology` (`PerLane`, in `projected`).
+
+use std::marker::PhantomData;
 
 use tet_core::TetMesh;
 
 use super::lanes::Lanes;
-use crate::walk::topology::{ExitRule, RecordWords, Topology};
+
+/// A layout's records as 32-bit words, for the gathers of the SIMD
+/// lockstep walk ([`crate::walk::Topology::record_words`]).
+#[derive(Clone, Copy, Debug)]
+pub struct RecordWords<'a> {
+    /// All records, word by word (`stride` words per tet).
+    pub words: &'a [u32],
+    /// Words per record.
+    pub stride: usize,
+}
+
+impl RecordWords<'_> {
+    /// True when every gather index the walk can form with rule `E` fits
+    /// in an `i32` and stays inside a record (`next` and the decoded
+    /// vertex are clamped to the arrays, the rule's words to its
+    /// [`ExitRule::SPAN`]).
+    pub(crate) fn gatherable<E: ExitRule>(&self, points: usize) -> bool {
+        let s = self.stride;
+        E::SPAN <= s
+            && s > 0
+            && self.words.len().is_multiple_of(s)
+            && !self.words.is_empty()
+            && self.words.len() <= i32::MAX as usize
+            && points > 0
+            && points <= i32::MAX as usize / 3
+    }
+}
+
+/// A layout's exit rule in lanes: the new vertex `idx₃` of the tet each
+/// lane enters, and the raw link across the face it leaves through, read
+/// from the words of its record (`Record`). One zero-sized type per
+/// layout, defined beside its scalar `exit_link` in its kernel module.
+pub trait ExitRule: Sized + 'static {
+    /// One past the last word of a record the rule reads: the stride of
+    /// the records must be at least this for the walk to gather them
+    /// (checked once per batch). `usize::MAX` for [`ByLane`]: never.
+    const SPAN: usize;
+    /// What [`ExitRule::link`] needs of [`ExitRule::enter`] (ScTP's ids).
+    type Scratch<L: Lanes>: Copy;
+    /// `idx₃` of the lanes' tets (`rec`), entered through the face `ids`
+    /// (unchecked: a corrupt record can give any value).
+    fn enter<L: Lanes>(
+        l: L,
+        rec: &Record<'_, L, Self>,
+        ids: &[L::I; 3],
+    ) -> (L::I, Self::Scratch<L>);
+    /// The raw link of the lanes' tets (`rec`) across the face opposite
+    /// the exiting vertex `x.e`.
+    fn link<L: Lanes>(l: L, rec: &Record<'_, L, Self>, s: Self::Scratch<L>, x: &Leaving<L>)
+    -> L::I;
+}
+
+/// What a lane's exit link depends on: the tet it leaves (`next`, the one
+/// it entered this round), the entry face's ids, the new vertex `d`, the
+/// exiting vertex `e` and the raw link it entered through.
+#[derive(Clone, Copy)]
+pub struct Leaving<L: Lanes> {
+    /// The tet left.
+    pub next: L::I,
+    /// The entry face's vertex ids.
+    pub ids: [L::I; 3],
+    /// The new vertex `idx₃`.
+    pub d: L::I,
+    /// The exiting vertex (one of `ids`).
+    pub e: L::I,
+    /// The raw link the tet was entered through.
+    pub entry: L::I,
+}
+
+/// The records of the tets the lanes are in, as rule `E` reads them.
+pub struct Record<'a, L: Lanes, E> {
+    geo: &'a Geo<'a>,
+    /// The first word of each lane's record.
+    base: L::I,
+    _rule: PhantomData<fn() -> E>,
+}
+
+impl<L: Lanes, E: ExitRule> Record<'_, L, E> {
+    /// Word `K` of each lane's record (`K < E::SPAN`, checked at compile
+    /// time).
+    #[inline(always)]
+    pub fn word<const K: u32>(&self, l: L) -> L::I {
+        const { assert!((K as usize) < E::SPAN, "a word past the rule's span") };
+        // SAFETY: `K < E::SPAN` in every lane.
+        unsafe { self.word_at(l, l.splat_i(K)) }
+    }
+
+    /// Word `k` of each lane's record.
+    ///
+    /// # Safety
+    ///
+    /// Every lane of `k` must be below `E::SPAN`.
+    #[inline(always)]
+    pub unsafe fn word_at(&self, l: L, k: L::I) -> L::I {
+        // SAFETY: `base = min(next, last_tet) · stride` and `k < E::SPAN ≤
+        // stride` (the caller's contract, `RecordWords::gatherable`), so
+        // each lane reads a word inside `words` (whose length is
+        // `(last_tet + 1) · stride < 2³¹`).
+        unsafe { l.gather_words(self.geo.words, l.add_i(self.base, k)) }
+    }
+}
+
+/// The new vertex of a layout that keeps `VX`: `idx₃ = idx₀ ⊕ idx₁ ⊕ idx₂
+/// ⊕ VX` (Tet20, Tet16, Tet32).
+#[inline(always)]
+pub fn decode<L: Lanes>(l: L, ids: &[L::I; 3], vx: L::I) -> L::I {
+    let face = l.xor_i(ids[0], ids[1]);
+    l.xor_i(face, l.xor_i(ids[2], vx))
+}
+
+/// `min(rank of x among of, 3)`. Ids are < 2³¹ (`gatherable`), so signed
+/// compares order them.
+#[inline(always)]
+pub fn rank<L: Lanes>(l: L, x: L::I, of: [L::I; 4]) -> L::I {
+    let mut r = l.splat_i(0);
+    for y in of {
+        r = l.inc(r, l.gt_i(x, y));
+    }
+    l.min_u(r, l.splat_i(3))
+}
+
+/// Algorithm 3 in lanes: the slot of `e` among the ids `vid` (3 when
+/// none), the link at word `LINKS + slot`.
+#[inline(always)]
+pub fn slot_link<L: Lanes, E: ExitRule, const LINKS: u32>(
+    l: L,
+    rec: &Record<'_, L, E>,
+    vid: [L::I; 3],
+    e: L::I,
+) -> L::I {
+    const { assert!(LINKS as usize + 3 < E::SPAN, "links past the rule's span") };
+    let mut slot = l.splat_i(3);
+    for k in (0..3).rev() {
+        slot = l.select_i(l.eq_i(e, vid[k]), l.splat_i(k as u32), slot);
+    }
+    // SAFETY: `slot ≤ 3`, so `LINKS + slot < E::SPAN`.
+    unsafe { rec.word_at(l, l.add_i(slot, l.splat_i(LINKS))) }
+}
+
+/// The exit rule of records the lockstep walk does not gather (a
+/// [`Topology`](crate::walk::Topology) that is not a layout of this crate:
+/// the mesh itself, a walk stopped at given tets): read lane by lane.
+pub enum ByLane {}
+
+impl ExitRule for ByLane {
+    const SPAN: usize = usize::MAX;
+    type Scratch<L: Lanes> = ();
+    fn enter<L: Lanes>(_: L, _: &Record<'_, L, Self>, _: &[L::I; 3]) -> (L::I, ()) {
+        unreachable!("no record has usize::MAX words: never gathered")
+    }
+    fn link<L: Lanes>(_: L, _: &Record<'_, L, Self>, _: (), _: &Leaving<L>) -> L::I {
+        unreachable!("no record has usize::MAX words: never gathered")
+    }
+}
 
 /// The record reads of a lockstep round over lanes `L`.
 pub(crate) trait Records<L: Lanes> {
@@ -16,19 +177,8 @@ pub(crate) trait Records<L: Lanes> {
     /// The new vertex `idx₃` of tet `next` (unchecked: a corrupt record can
     /// give any value), entered through the face `ids`.
     fn enter(&self, l: L, next: L::I, ids: &[L::I; 3]) -> (L::I, Self::Scratch);
-    /// The raw link of tet `next` across the face opposite `e`, the exiting
-    /// vertex (`d` the new vertex, `entry` the raw link entered through).
-    #[allow(clippy::too_many_arguments)]
-    fn link(
-        &self,
-        l: L,
-        s: Self::Scratch,
-        next: L::I,
-        ids: &[L::I; 3],
-        d: L::I,
-        e: L::I,
-        entry: L::I,
-    ) -> L::I;
+    /// The raw link of tet `x.next` across the face opposite `x.e`.
+    fn link(&self, l: L, s: Self::Scratch, x: &Leaving<L>) -> L::I;
     /// Hints that the records of the tets `link` (some out of range) will
     /// be read next round.
     #[inline(always)]
@@ -37,233 +187,68 @@ pub(crate) trait Records<L: Lanes> {
     }
 }
 
-/// Reads through [`Topology::vx`] and [`Topology::exit_link`] lane by lane.
-pub(crate) struct PerLane<'a, T>(pub(crate) &'a T);
-
-impl<L: Lanes, T: Topology> Records<L> for PerLane<'_, T> {
-    type Scratch = ();
-
-    #[inline(always)]
-    fn enter(&self, l: L, next: L::I, ids: &[L::I; 3]) -> (L::I, ()) {
-        let mut vx = L::i_lanes(next);
-        for v in vx.as_mut() {
-            *v = self.0.vx(*v);
-        }
-        let f = l.xor_i(l.xor_i(ids[0], ids[1]), ids[2]);
-        // The lanes of `vx` into a vector: `f ⊕ vx` lane by lane.
-        let mut d = L::i_lanes(f);
-        for (d, v) in d.as_mut().iter_mut().zip(vx.as_ref()) {
-            *d ^= v;
-        }
-        (from_lanes(l, d), ())
-    }
-    #[inline(always)]
-    fn link(
-        &self,
-        l: L,
-        _: (),
-        next: L::I,
-        ids: &[L::I; 3],
-        d: L::I,
-        e: L::I,
-        entry: L::I,
-    ) -> L::I {
-        let (next, d, e, entry) = (
-            L::i_lanes(next),
-            L::i_lanes(d),
-            L::i_lanes(e),
-            L::i_lanes(entry),
-        );
-        let ids = ids.map(L::i_lanes);
-        let mut raw = L::arr(0u32);
-        for (k, r) in raw.as_mut().iter_mut().enumerate() {
-            let face = [ids[0].as_ref()[k], ids[1].as_ref()[k], ids[2].as_ref()[k]];
-            let at = |x: &L::Arr<u32>| x.as_ref()[k];
-            *r = self
-                .0
-                .exit_link(at(&next), face, at(&d), at(&e), at(&entry));
-        }
-        from_lanes(l, raw)
-    }
-    #[inline(always)]
-    fn prefetch(&self, _: L, link: L::I) {
-        // A prefetch never faults: parked and stopped lanes prefetch harmlessly.
-        for &r in L::i_lanes(link).as_ref() {
-            self.0.prefetch(r);
-        }
-    }
-}
-
-/// The vector of the lanes `a`.
-#[inline(always)]
-fn from_lanes<L: Lanes>(l: L, a: L::Arr<u32>) -> L::I {
-    let mut x = l.splat_i(0);
-    for (k, &v) in a.as_ref().iter().enumerate() {
-        x = l.set_i(x, k, v);
-    }
-    x
-}
-
 /// Array bases and bounds of the gathers.
 #[derive(Clone, Copy)]
 pub(crate) struct Geo<'a> {
     words: &'a [u32],
     last_tet: u32,
     stride: u32,
-    vx: u32,
-    ids: u32,
-    links: u32,
 }
 
 impl<'a> Geo<'a> {
-    /// The gathers' view of `mesh`'s records `rw`, when they are
-    /// [`RecordWords::gatherable`] (the gathers' bounds rest on it).
-    pub(crate) fn new(mesh: &TetMesh, rw: &RecordWords<'a>) -> Option<Geo<'a>> {
-        if !rw.gatherable(mesh.points.len()) {
+    /// The gathers' view of `mesh`'s records `rw` read with rule `E`, when
+    /// they are [`RecordWords::gatherable`] (the gathers' bounds rest on it).
+    pub(crate) fn new<E: ExitRule>(mesh: &TetMesh, rw: &RecordWords<'a>) -> Option<Geo<'a>> {
+        if !rw.gatherable::<E>(mesh.points.len()) {
             return None;
         }
-        let (ids, links) = match rw.rule {
-            ExitRule::Rank { links } | ExitRule::RankXor { links } => (0, links),
-            ExitRule::Slot { ids, links } | ExitRule::Ids { ids, links } => (ids, links),
-        };
         Some(Geo {
             words: rw.words,
             last_tet: (rw.words.len() / rw.stride - 1) as u32,
             stride: rw.stride as u32,
-            vx: rw.vx as u32,
-            ids: ids as u32,
-            links: links as u32,
         })
     }
 
-    /// Word `k` of the records of tets `min(next, last_tet)` (`base`, see
-    /// [`Geo::base`]).
+    /// The records of tets `next` (clamped to the last).
     #[inline(always)]
-    fn word<L: Lanes>(&self, l: L, base: L::I, k: L::I) -> L::I {
-        // SAFETY: `base = min(next, last_tet) · stride` and every caller's
-        // `k < stride` (its offset plus a rank or slot ≤ 3, within the
-        // record by `RecordWords::gatherable`), so each lane reads a word
-        // inside `words` (whose length is `(last_tet + 1) · stride < 2³¹`).
-        unsafe { l.gather_words(self.words, l.add_i(base, k)) }
-    }
-
-    /// Tet16's `NX_r` (word `links + r`), 0 for rank 3: those lanes read
-    /// word 0 of the record (in range) and drop it.
-    #[inline(always)]
-    fn nx<L: Lanes>(&self, l: L, base: L::I, r: L::I) -> L::I {
-        let m = l.gt_i(l.splat_i(3), r);
-        let k = l.select_i(m, l.add_i(l.splat_i(self.links), r), l.splat_i(0));
-        l.zero_unless(m, self.word(l, base, k))
-    }
-
-    /// The first word of the records of tets `next` (clamped to the last).
-    #[inline(always)]
-    fn base<L: Lanes>(&self, l: L, next: L::I) -> L::I {
+    fn record<L: Lanes, E: ExitRule>(&self, l: L, next: L::I) -> Record<'_, L, E> {
         let tet = l.min_u(next, l.splat_i(self.last_tet));
-        l.mul_i(tet, l.splat_i(self.stride))
+        Record {
+            geo: self,
+            base: l.mul_i(tet, l.splat_i(self.stride)),
+            _rule: PhantomData,
+        }
     }
 }
 
-/// The gathered exit rules, the `RULE` of [`Gathered`].
-pub(crate) const RANK: u8 = 0;
-/// See [`RANK`].
-pub(crate) const RANK_XOR: u8 = 1;
-/// See [`RANK`].
-pub(crate) const SLOT: u8 = 2;
-/// See [`RANK`].
-pub(crate) const IDS: u8 = 3;
+/// Gathers from the record words with exit rule `E`.
+pub(crate) struct Gathered<'a, E>(pub(crate) Geo<'a>, pub(crate) PhantomData<fn() -> E>);
 
-/// Gathers from the record words with exit rule `RULE`: [`RANK`] (Tet20,
-/// Algorithm 5), [`RANK_XOR`] (Tet16, Algorithm 7), [`SLOT`] (Tet32,
-/// Algorithm 3), all three decoding `idx₃ = idx₀ ⊕ idx₁ ⊕ idx₂ ⊕ VX`; or
-/// [`IDS`] (ScTP's baseline records, no `VX`: the new vertex is
-/// `v₀ ⊕ v₁ ⊕ v₂ ⊕ v₃ ⊕ idx₀ ⊕ idx₁ ⊕ idx₂`, the link found by the slot of
-/// the exiting vertex among the gathered ids).
-pub(crate) struct Gathered<'a, const RULE: u8>(pub(crate) Geo<'a>);
-
-/// `min(rank of x among of, 3)`. Ids are < 2³¹ (`gatherable`), so signed
-/// compares order them.
-#[inline(always)]
-fn rank<L: Lanes>(l: L, x: L::I, of: [L::I; 4]) -> L::I {
-    let mut r = l.splat_i(0);
-    for y in of {
-        r = l.inc(r, l.gt_i(x, y));
+impl<E> Clone for Gathered<'_, E> {
+    fn clone(&self) -> Self {
+        *self
     }
-    l.min_u(r, l.splat_i(3))
 }
 
-/// The slot of `e` among `vid` (3 when none), the link at `links + slot`.
-#[inline(always)]
-fn slot_link<L: Lanes>(l: L, g: &Geo<'_>, base: L::I, vid: [L::I; 3], e: L::I) -> L::I {
-    let mut slot = l.splat_i(3);
-    for k in (0..3).rev() {
-        slot = l.select_i(l.eq_i(e, vid[k]), l.splat_i(k as u32), slot);
-    }
-    g.word(l, base, l.add_i(slot, l.splat_i(g.links)))
-}
+impl<E> Copy for Gathered<'_, E> {}
 
-impl<L: Lanes, const RULE: u8> Records<L> for Gathered<'_, RULE> {
-    /// The records' first words, and (for [`IDS`]) the first three ids.
-    type Scratch = (L::I, [L::I; 3]);
+impl<L: Lanes, E: ExitRule> Records<L> for Gathered<'_, E> {
+    /// The records' first words, and what the rule keeps.
+    type Scratch = (L::I, E::Scratch<L>);
 
     #[inline(always)]
     fn enter(&self, l: L, next: L::I, ids: &[L::I; 3]) -> (L::I, Self::Scratch) {
-        let g = &self.0;
-        let base = g.base(l, next);
-        let face = l.xor_i(ids[0], ids[1]);
-        if RULE == IDS {
-            let v = [
-                g.word(l, base, l.splat_i(g.ids)),
-                g.word(l, base, l.splat_i(g.ids + 1)),
-                g.word(l, base, l.splat_i(g.ids + 2)),
-                g.word(l, base, l.splat_i(g.ids + 3)),
-            ];
-            let d = l.xor_i(
-                l.xor_i(l.xor_i(v[0], v[1]), l.xor_i(v[2], v[3])),
-                l.xor_i(face, ids[2]),
-            );
-            (d, (base, [v[0], v[1], v[2]]))
-        } else {
-            let vx = g.word(l, base, l.splat_i(g.vx));
-            let d = l.xor_i(face, l.xor_i(ids[2], vx));
-            (d, (base, [base; 3]))
-        }
+        let rec = self.0.record::<L, E>(l, next);
+        let (d, s) = E::enter(l, &rec, ids);
+        (d, (rec.base, s))
     }
     #[inline(always)]
-    fn link(
-        &self,
-        l: L,
-        (base, vid): Self::Scratch,
-        _: L::I,
-        ids: &[L::I; 3],
-        d: L::I,
-        e: L::I,
-        entry: L::I,
-    ) -> L::I {
-        let g = &self.0;
-        let links = l.splat_i(g.links);
-        // (No closures over lane operations: see `walk`.)
-        match RULE {
-            RANK => {
-                let r = rank(l, e, [ids[0], ids[1], ids[2], d]);
-                g.word(l, base, l.add_i(links, r))
-            }
-            RANK_XOR => {
-                // `rank(d)` among the entry face (d itself never counts).
-                let rd = rank(l, d, [ids[0], ids[1], ids[2], d]);
-                let re = rank(l, e, [ids[0], ids[1], ids[2], d]);
-                let (nd, ne) = (g.nx(l, base, rd), g.nx(l, base, re));
-                l.xor_i(l.xor_i(entry, nd), ne)
-            }
-            SLOT => {
-                let vid = [
-                    g.word(l, base, l.splat_i(g.ids)),
-                    g.word(l, base, l.splat_i(g.ids + 1)),
-                    g.word(l, base, l.splat_i(g.ids + 2)),
-                ];
-                slot_link(l, g, base, vid, e)
-            }
-            _ => slot_link(l, g, base, vid, e),
-        }
+    fn link(&self, l: L, (base, s): Self::Scratch, x: &Leaving<L>) -> L::I {
+        let rec = Record {
+            geo: &self.0,
+            base,
+            _rule: PhantomData,
+        };
+        E::link(l, &rec, s, x)
     }
 }

@@ -1,4 +1,5 @@
-//! What a lane computes of the new vertex ([`Geometry`]): its projection
+//! What a lane of the projected walk computes of the new vertex
+//! ([`Projected`]): its projection
 //! and the three edge tests against the entry face, in lanes, as the
 //! scalar projection does — [`Planar`] for the 2-D projection
 //! [`DuffF32`] (Tet20, Tet16, Tet32), [`Triple`] for ScTP's scalar triple
@@ -12,7 +13,7 @@ use crate::walk::projection::{DuffF32, Face2, TripleF32};
 use crate::walk::start::Lane;
 
 /// The projection side of a lockstep walk over lanes `L`.
-pub(crate) trait Geometry<L: Lanes> {
+pub(crate) trait Projected<L: Lanes> {
     /// The scalar projection each lane evaluates.
     type Proj: Projection;
     /// The per-ray constants, in registers.
@@ -53,8 +54,10 @@ pub(crate) trait Geometry<L: Lanes> {
 }
 
 /// [`DuffF32`] in lanes: `p = (u·(P−o), v·(P−o))`, edge values
-/// `det(p₃, pᵢ) = p₃.x·yᵢ − p₃.y·xᵢ` (Algorithm 1).
-pub(crate) struct Planar;
+/// `det(p₃, pᵢ) = p₃.x·yᵢ − p₃.y·xᵢ` (Algorithm 1): the geometry of the
+/// Tet20, Tet16 and Tet32 kernels' lockstep walk.
+#[derive(Clone, Copy, Debug)]
+pub struct Planar;
 
 /// The Duff basis of a lane: origin `o` and the columns `c[axis] = (u, v)`
 /// of that axis.
@@ -78,7 +81,7 @@ impl<F: Copy> PlanarRay<F> {
     }
 }
 
-impl<L: Lanes> Geometry<L> for Planar {
+impl<L: Lanes> Projected<L> for Planar {
     type Proj = DuffF32;
     type Ray = PlanarRay<L::F>;
     type Vert = [L::F; 2];
@@ -172,8 +175,9 @@ fn triple<L: Lanes>(l: L, d: &[L::F; 3], q3: &[L::F; 3], qk: &[L::F; 3]) -> L::F
 /// [`TripleF32`] in lanes: `q = P − o`, edge values `d · (q₃ × qᵢ)` as
 /// glam's `cross` and `dot` compute them, operand for operand, so the
 /// antisymmetry that makes the walk watertight (`a × b = −(b × a)`
-/// componentwise) is kept.
-pub(crate) struct Triple;
+/// componentwise) is kept: the geometry of ScTP's lockstep walk.
+#[derive(Clone, Copy, Debug)]
+pub struct Triple;
 
 /// A lane's ray: origin and direction.
 #[derive(Clone, Copy)]
@@ -182,7 +186,7 @@ pub(crate) struct TripleRay<F> {
     dir: [F; 3],
 }
 
-impl<L: Lanes> Geometry<L> for Triple {
+impl<L: Lanes> Projected<L> for Triple {
     type Proj = TripleF32;
     type Ray = TripleRay<L::F>;
     type Vert = [L::F; 3];

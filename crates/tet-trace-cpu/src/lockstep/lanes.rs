@@ -15,9 +15,14 @@ use glam::Vec3;
 /// set. Comparisons of floats are ordered (false on NaN); arithmetic is
 /// exactly the IEEE operation of each lane (no fused multiply-add), so a
 /// lane computes what the scalar code computes.
-pub(crate) trait Lanes: Copy {
+pub trait Lanes: Copy {
     /// Lanes per vector.
     const WIDTH: usize;
+    /// True for the SIMD lanes, whose gathers load a word per lane in one
+    /// instruction: the projected walk gathers a layout's records with
+    /// them, and reads them through [`Topology`](crate::walk::Topology)
+    /// on the portable lanes, whose loads are lane by lane either way.
+    const GATHERS: bool;
     /// `WIDTH` f32 lanes.
     type F: Copy;
     /// `WIDTH` u32 lanes.

@@ -2,77 +2,98 @@
 //! SIMD lane, one tet per lane per round. This is the
 //! [`Tracer::trace_batch`](crate::Tracer::trace_batch) of every projected
 //! kernel with [`DuffF32`](crate::DuffF32) (Tet20, Tet16, Tet32), of ScTP
-//! (`sctp`) and of the Tet80 kernels (`plucker`, over the same lanes, see
-//! Dispatch); the scalar walks
-//! ([`crate::walk::trace`], [`crate::walk::trace_interleaved`], reachable as
-//! [`crate::kernel::Interleaved`]) stay as the reference.
+//! and of the Tet80 kernels; the scalar walks ([`crate::walk::trace`],
+//! [`crate::walk::trace_interleaved`], reachable as
+//! [`crate::kernel::Interleaved`], and the Tet80 tracers' own) stay as the
+//! reference and serve a batch the lockstep walk gives back.
 //!
-//! Each round every lane fetches `VX` of the tet it enters, decodes the new
-//! vertex `idx₃ = idx₀ ⊕ idx₁ ⊕ idx₂ ⊕ VX` and fetches its point; the
-//! projection of `idx₃` ([`DuffF32`](crate::DuffF32): `p = (u·(P−o), v·(P−o))`), the three
-//! edge determinants `det(p₃, pᵢ)` of Algorithm 1, the exit slot
-//! ([`crate::walk::EXIT_SLOT`]), the replacement of the exiting vertex and the
-//! exit link (rank of the exit vertex for Tet20 — Algorithm 5 —, two ranks
-//! and two xors for Tet16 — Algorithm 7 —, the slot compare for Tet32 —
-//! Algorithm 3 —, see [`ExitRule`]) run across the lanes as SIMD arithmetic,
-//! compares and blends: no branches and no variable-indexed stores. A lane
-//! that needs a rare path (a constrained face or the boundary, the step cap,
-//! a decoded vertex out of range) takes the scalar engine's cold path (the
-//! same ending, crossing and refill for every width); a finished lane is
-//! refilled at once from the batch, so lanes idle only at the batch's tail.
+//! # One request, one entry
 //!
-//! A *gated* walk (`walk::Gate`, `trace_lockstep_gated`) also stops a lane
-//! short before it enters a tet the gate names, handing its state to the
-//! caller, which walks on with the scalar walk: the iso walk gates on the
-//! range test, so the tets on no isovalue's side are walked in lockstep
-//! ([`crate::iso::IsoWalk::trace_tile`]). The plain walk's gate compiles
-//! away.
+//! A batch is one request ([`Batch`]: the mesh, the topology, the rays,
+//! their starts, the step cap and the outcomes), and [`trace`] the one
+//! entry: it takes the batch, the [`Width`]
+//! ([`Width::Auto`] picks the widest the CPU runs, and is where
+//! `TET_LOCKSTEP` is read) and a gate ([`NoGate`] for none), and walks it
+//! with a kernel's *geometry*, a type parameter ([`Geometry`]):
 //!
-//! # Dispatch
+//! * [`Planar`]: the projected walk with [`DuffF32`](crate::DuffF32)
+//!   (Tet20, Tet16, Tet32). Each round every lane fetches `VX` of the tet
+//!   it enters, decodes the new vertex `idx₃ = idx₀ ⊕ idx₁ ⊕ idx₂ ⊕ VX`
+//!   and fetches its point; the projection of `idx₃` (`p = (u·(P−o),
+//!   v·(P−o))`), the three edge determinants `det(p₃, pᵢ)` of Algorithm 1,
+//!   the exit slot ([`crate::walk::EXIT_SLOT`]), the replacement of the
+//!   exiting vertex and the exit link (the layout's [`ExitRule`]) run
+//!   across the lanes as SIMD arithmetic, compares and blends: no branches
+//!   and no variable-indexed stores;
+//! * [`Triple`]: the same walk with ScTP's scalar triple products
+//!   ([`TripleF32`](crate::TripleF32)) over the 32-byte baseline layout,
+//!   whose records keep the four ids and no `VX` (its exit rule decodes
+//!   `idx₃` from them); with 8 AVX2 lanes it traced 2.5 times the rays
+//!   per CPU-second of the interleaved walk (Torus Knots,
+//!   `benches/walk_step.rs`);
+//! * [`Plucker`]: Maria et al.'s Plücker walk over the Tet80 records, both
+//!   side rules (`plucker`, `side`), the topology being the Tet80 tracer.
 //!
-//! * x86-64 with AVX-512F (detected at run time) and a layout that exposes
-//!   its records as words: the same walk with 16 lanes, 512-bit vectors and
-//!   mask registers (`avx512`), two packs in flight, faster than the AVX2
-//!   walk. `TET_LOCKSTEP=avx2` in the environment keeps the AVX2 walk, for
-//!   same-machine comparisons;
-//! * x86-64 with AVX2 (detected at run time) and a layout that exposes its
-//!   records as words ([`crate::walk::Topology::record_words`]): 8-lane AVX2
-//!   intrinsics, all five loads of a step (`VX`, the point's x, y, z, the
-//!   link) as `vpgatherdd`/`vgatherdps`, two packs of 8 lanes in flight per
-//!   thread so that the core overlaps their gather chains;
-//! * x86-64 with AVX2, other layouts: the portable lanes (`portable`) compiled
-//!   for AVX2 (8 lanes, scalar loads through [`Topology`]);
-//! * otherwise: the portable lanes with 4 lanes on the baseline target
-//!   (SSE2 on x86-64), [`trace_lockstep_portable`].
+//! The three differ in their geometry only: the driver (`driver`: packs
+//! of lanes stepped in turn, refills, the gate), the entry, the width and
+//! the `#[target_feature]` entry points are the same. A lane that needs a
+//! rare path (a constrained face or the boundary, the step cap, a decoded
+//! vertex out of range) takes the scalar walk's cold path (the same
+//! ending, crossing and refill for every width); a finished lane is
+//! refilled at once from the batch, so lanes idle only at the batch's
+//! tail.
 //!
-//! The Tet80 kernels ([`crate::tet80`], both side rules) walk their own
-//! records in lockstep (`plucker`): AVX-512F (16 lanes) unless
-//! `TET_LOCKSTEP=avx2`, else AVX2 (8 lanes), both with gathers; without
-//! either, or with `TET_LOCKSTEP=scalar`, their scalar walk
-//! ([`crate::tet80::Tet80Tracer::trace_batch_scalar`]).
+//! A *gated* walk also stops a lane short before it enters a tet the gate
+//! names, handing its state to the caller, which walks on with the scalar
+//! walk: the iso walk gates on the range test, so the tets on no
+//! isovalue's side are walked in lockstep
+//! ([`crate::iso::IsoWalk::trace_tile`]). The plain walk's gate
+//! ([`NoGate`]) compiles away.
+//!
+//! # Widths
+//!
+//! * [`Width::Avx512`] (x86-64 with AVX-512F, detected at run time): 16
+//!   lanes, 512-bit vectors and mask registers (`avx512`), two packs in
+//!   flight, faster than the AVX2 walk; what [`Width::Auto`] takes where
+//!   the CPU has it, unless `TET_LOCKSTEP=avx2`;
+//! * [`Width::Avx2`] (x86-64 with AVX2): 8-lane AVX2 intrinsics, all five
+//!   loads of a step (`VX`, the point's x, y, z, the link) as
+//!   `vpgatherdd`/`vgatherdps`, two packs of 8 lanes in flight per thread
+//!   so that the core overlaps their gather chains;
+//! * [`Width::Portable4`], [`Width::Portable8`]: the portable lanes
+//!   (`portable`) on the baseline target, reading a projected layout's
+//!   records through [`Topology`](crate::walk::Topology); for tests and
+//!   machines without AVX2, where [`Width::Auto`] gives the batch back:
+//!   the portable lanes are no faster than the scalar interleaved walk
+//!   (see below).
+//!
+//! The SIMD widths gather the records of a layout that exposes them as
+//! words ([`crate::walk::Topology::record_words`]) with its
+//! [`ExitRule`]; a batch over other records is given back.
 //!
 //! # One walk, generic over lanes
 //!
-//! The walk (`walk`) is written once, like Embree's kernels over
-//! `vfloat<K>`, over three small traits: the lanes (`lanes::Lanes`: f32
-//! and u32 vectors, masks, splat, add/sub/mul, compares, selects, gathers;
-//! implemented by `avx512::Avx512`, 16 lanes with mask registers,
-//! `avx2::Avx2`, 8 lanes with masks as vectors, and
-//! `portable::Portable<W>`, arrays of `W` lanes), the projection
-//! (`geometry::Geometry`: `Planar` for [`DuffF32`](crate::DuffF32),
-//! `Triple` for ScTP's [`TripleF32`](crate::TripleF32)) and the record
-//! reads (`exit::Records`: `Gathered` with the exit rule as a const
-//! parameter, `PerLane` through [`Topology`]). Every function on the way
-//! is `#[inline(always)]` and the walk is instantiated inside a
-//! `#[target_feature]` entry point per instruction set, so it compiles to
-//! the same straight-line intrinsics as a hand-written kernel; its rare
-//! paths run out of line, compiled for the same instruction set
-//! (`Lanes::cold`). Each entry point is compiled for the whole feature set
-//! its CPUs have, not its vector extension alone: AVX2 with FMA, BMI1/2,
-//! LZCNT and POPCNT; AVX-512 F with VL, BW, DQ and the AVX2 set (the run-time
-//! check asks for all of them). With `avx512f` alone, Tet20 ran at 0.83–0.86×
-//! the speed of a `-C target-cpu=native` build of the same code (Torus
-//! Knots, 1920×1440, 2 threads, AMD EPYC with AVX-512); with the set, 0.96–1.0×.
+//! The walk is written once, like Embree's kernels over `vfloat<K>`, over
+//! small traits: the lanes (`lanes::Lanes`: f32 and u32 vectors, masks,
+//! splat, add/sub/mul, compares, selects, gathers; implemented by
+//! `avx512::Avx512`, 16 lanes with mask registers, `avx2::Avx2`, 8 lanes
+//! with masks as vectors, and `portable::Portable<W>`, arrays of `W`
+//! lanes), the geometry's rounds (`driver::Rounds`, run by
+//! `driver::run`), and below them the projection (`geometry::Projected`:
+//! `Planar`, `Triple`), the record reads (`exit::Records`: the layout's
+//! [`ExitRule`] gathered, or lane by lane through
+//! [`Topology`](crate::walk::Topology)) and the Plücker side rules
+//! (`side::Side`). Every function on the way is `#[inline(always)]` and
+//! the walk is instantiated inside a `#[target_feature]` entry point per
+//! instruction set, so it compiles to the same straight-line intrinsics as
+//! a hand-written kernel; its rare paths run out of line, compiled for the
+//! same instruction set (`Lanes::cold`). Each entry point is compiled for
+//! the whole feature set its CPUs have, not its vector extension alone:
+//! AVX2 with FMA, BMI1/2, LZCNT and POPCNT; AVX-512 F with VL, BW, DQ and
+//! the AVX2 set (the run-time check asks for all of them). With `avx512f`
+//! alone, Tet20 ran at 0.83–0.86× the speed of a `-C target-cpu=native`
+//! build of the same code (Torus Knots, 1920×1440, 2 threads, AMD EPYC
+//! with AVX-512); with the set, 0.96–1.0×.
 //!
 //! Why intrinsics and `unsafe`: the same lane loops left to the
 //! auto-vectoriser (the portable lanes compiled for AVX2, 8 lanes) run more
@@ -107,7 +128,7 @@
 //! # Tuning
 //!
 //! Two packs in flight per thread beat one and are not beaten by three or
-//! four (AVX2 and AVX-512 alike; the `PACKS` of `walk::run`); prefetching
+//! four (AVX2 and AVX-512 alike; the `PACKS` of `driver::run`); prefetching
 //! the next records, as the scalar walk does, gains nothing with gathers
 //! and is off there (`exit::Records::prefetch`). Rerun the instruction
 //! counts with `benches/walk_step.rs`.
@@ -116,71 +137,66 @@
 //!
 //! * `lanes`: the lane trait;
 //! * `avx512`, `avx2`, `portable`: its 16-, 8- and `W`-lane implementations;
+//! * `driver`: the driver and the gate, once for every geometry;
 //! * `geometry`: the projections in lanes (Duff's 2-D basis, ScTP's triple
 //!   products);
-//! * `exit`: the record reads (gathers with the exit rules, or lane by lane);
-//! * `walk`: the walk itself, once;
-//! * `sctp`: ScTP's batch path (16-lane AVX-512 lockstep);
-//! * `plucker`, `side`: the Tet80 walk (Maria et al.'s Plücker exit rule)
-//!   over the same lanes, with its two side rules in lanes (faithful and
-//!   consistent).
+//! * `exit`: the exit rule as a type, and the record reads (gathered with
+//!   a layout's exit rule);
+//! * `projected`: the projected walk's rounds (Tet20, Tet16, Tet32, ScTP);
+//! * `plucker`, `side`: the Plücker walk's rounds (Tet80) and its two side
+//!   rules in lanes (faithful and consistent);
+//! * `tests`: odd lane counts and gates, against the scalar walks.
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
-mod exit;
+mod driver;
+pub(crate) mod exit;
 mod geometry;
-mod lanes;
+pub(crate) mod lanes;
 pub(crate) mod plucker;
 mod portable;
-#[cfg(target_arch = "x86_64")]
-pub(crate) mod sctp;
+mod projected;
 mod side;
-mod walk;
 
-use walk::NoGate;
-pub(crate) use walk::{Gate, Handover};
+pub(crate) use driver::Gate;
+pub use driver::NoGate;
+pub use exit::{ByLane, ExitRule, RecordWords};
+pub use geometry::{Planar, Triple};
+pub use plucker::Plucker;
+pub(crate) use projected::Handover;
 
-use tet_core::TetMesh;
-
-use crate::ray::{Ray, TraceOutcome};
-use crate::walk::lanes::Starts;
-use crate::walk::topology::Topology;
-pub use crate::walk::topology::{ExitRule, RecordWords};
+pub use crate::walk::lanes::Batch;
 #[cfg(target_arch = "x86_64")]
 use avx2::Avx2;
 #[cfg(target_arch = "x86_64")]
 use avx512::Avx512;
-use exit::{Gathered, Geo, IDS, PerLane};
-#[cfg(target_arch = "x86_64")]
-use exit::{RANK, RANK_XOR, Records, SLOT};
-#[cfg(target_arch = "x86_64")]
-use geometry::Geometry;
-use geometry::{Planar, Triple};
+use lanes::Lanes;
 use portable::Portable;
 
-/// Lanes of the AVX2 lockstep walk (256-bit vectors of f32 / u32).
-pub const WIDE: usize = 8;
-/// Lanes of the portable lockstep walk (128-bit vectors).
-pub const NARROW: usize = 4;
-
-/// A lockstep walk's lanes, for running one width on purpose (tests,
-/// comparisons); [`trace_lockstep`] picks the widest the CPU runs.
+/// A lockstep walk's lanes: [`Width::Auto`], the widest the CPU runs, or
+/// one width on purpose (tests, comparisons).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Width {
-    /// The portable lanes, 4 wide ([`NARROW`]), baseline target.
+    /// AVX-512 where the CPU runs it, else AVX2; none (the callers' scalar
+    /// walks) without either. `TET_LOCKSTEP=avx2` in the environment keeps
+    /// AVX2 on a CPU with AVX-512, `TET_LOCKSTEP=scalar` keeps every batch
+    /// on its scalar walk (read once, here only; for same-machine
+    /// comparisons).
+    Auto,
+    /// The portable lanes, 4 wide, baseline target.
     Portable4,
     /// The portable lanes, 8 wide, baseline target.
     Portable8,
-    /// AVX2 intrinsics, 8 lanes ([`WIDE`]).
+    /// AVX2 intrinsics, 8 lanes.
     Avx2,
     /// AVX-512F intrinsics, 16 lanes.
     Avx512,
 }
 
 impl Width {
-    /// Every width, narrowest first.
+    /// Every fixed width, narrowest first.
     pub const ALL: [Width; 4] = [
         Width::Portable4,
         Width::Portable8,
@@ -188,9 +204,21 @@ impl Width {
         Width::Avx512,
     ];
 
-    /// True when this CPU runs the width (the portable ones always).
+    /// The fixed width this one walks at on this CPU: itself where the CPU
+    /// runs it (the portable ones always), [`Width::Auto`]'s choice, or
+    /// `None`.
+    pub fn resolve(self) -> Option<Width> {
+        match self {
+            Width::Auto => auto(),
+            w => w.available().then_some(w),
+        }
+    }
+
+    /// True when this CPU runs the width (the portable ones always;
+    /// [`Width::Auto`] when it resolves to one).
     pub fn available(self) -> bool {
         match self {
+            Width::Auto => auto().is_some(),
             Width::Portable4 | Width::Portable8 => true,
             #[cfg(target_arch = "x86_64")]
             Width::Avx2 => avx2::has_avx2_set(),
@@ -201,238 +229,21 @@ impl Width {
         }
     }
 
-    /// Lanes per pack.
+    /// Lanes per pack (0 for a [`Width::Auto`] that resolves to none).
     pub fn lanes(self) -> usize {
-        match self {
-            Width::Portable4 => NARROW,
-            Width::Portable8 | Width::Avx2 => WIDE,
+        match self.resolve().unwrap_or(self) {
+            Width::Auto => 0,
+            Width::Portable4 => 4,
+            Width::Portable8 | Width::Avx2 => 8,
             Width::Avx512 => 16,
         }
     }
 }
 
-/// Traces `rays` from `start` (at most `cap` tets each) with [`DuffF32`](crate::DuffF32)
-/// lanes in lockstep; `out[i]` is exactly
-/// [`crate::walk::trace`]`::<DuffF32, T>` of `rays[i]`. `out.len()` must
-/// equal `rays.len()` (the shorter length is used otherwise).
-pub fn trace_lockstep<T: Topology>(
-    mesh: &TetMesh,
-    topo: &T,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-) {
-    trace_lockstep_gated(mesh, topo, rays, start, cap, out, &mut NoGate);
-}
-
-/// [`trace_lockstep`] stopped short by `gate`: a walk about to enter a tet
-/// the gate names is handed to it instead (its `out` left unwritten), so
-/// that a caller walks on with the scalar walk from there (the iso walk
-/// does, from the first tet whose values straddle an isovalue).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn trace_lockstep_gated<T: Topology, GT: Gate>(
-    mesh: &TetMesh,
-    topo: &T,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-    gate: &mut GT,
-) {
-    #[cfg(target_arch = "x86_64")]
-    let wide = !avx2_only();
-    #[cfg(not(target_arch = "x86_64"))]
-    let wide = false;
-    dispatch(mesh, topo, rays, start, cap, out, wide, gate);
-}
-
-/// [`trace_lockstep`] without the AVX-512 walk (the AVX2 walk where the CPU
-/// has AVX2, else the portable one): public so that tests cover the AVX2
-/// walk on machines with AVX-512 too.
-pub fn trace_lockstep_avx2<T: Topology>(
-    mesh: &TetMesh,
-    topo: &T,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-) {
-    dispatch(mesh, topo, rays, start, cap, out, false, &mut NoGate);
-}
-
-/// [`trace_lockstep`] with `W` lanes compiled for the baseline target (no
-/// run-time dispatch; `0 < W ≤ 32`): the portable fallback, public so that
-/// tests cover it on machines with AVX2 too.
-pub fn trace_lockstep_portable<T: Topology, const W: usize>(
-    mesh: &TetMesh,
-    topo: &T,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-) {
-    const { assert!(W > 0 && W <= 32, "1 to 32 portable lanes") };
-    walk::run_plain::<Portable<W>, Planar, _, 1>(
-        Portable,
-        &PerLane(topo),
-        mesh,
-        rays,
-        start,
-        cap,
-        out,
-    );
-}
-
-/// [`trace_lockstep`] at `width` exactly: the portable widths read the
-/// records through [`Topology`]; the AVX2 and AVX-512 ones gather them and
-/// need [`Topology::record_words`] (a Tet20, Tet16 or Tet32 layout). False
-/// (nothing traced) when the CPU lacks the width or the layout its records.
-pub fn trace_lockstep_at<T: Topology>(
-    width: Width,
-    mesh: &TetMesh,
-    topo: &T,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-) -> bool {
-    match width {
-        Width::Portable4 => trace_lockstep_portable::<T, NARROW>(mesh, topo, rays, start, cap, out),
-        Width::Portable8 => trace_lockstep_portable::<T, WIDE>(mesh, topo, rays, start, cap, out),
-        #[cfg(target_arch = "x86_64")]
-        Width::Avx2 | Width::Avx512 => {
-            let Some((rule, g)) = projected_records(mesh, topo) else {
-                return false;
-            };
-            match (width, Avx2::detect(), Avx512::detect()) {
-                (Width::Avx512, _, Some(t)) => {
-                    gathered_avx512(t, rule, g, mesh, rays, start, cap, out, &mut NoGate)
-                }
-                (Width::Avx2, Some(t), _) => {
-                    gathered_avx2(t, rule, g, mesh, rays, start, cap, out, &mut NoGate)
-                }
-                _ => return false,
-            }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        Width::Avx2 | Width::Avx512 => return false,
-    }
-    true
-}
-
-/// ScTP ([`TripleF32`](crate::TripleF32)) in lockstep at `width` over the
-/// 32-byte baseline layout ([`ExitRule::Ids`] records, gathered at every
-/// width): `out[i]` is exactly [`crate::walk::trace`]`::<TripleF32, T>` of
-/// `rays[i]`. False (nothing traced) when the CPU lacks the width or `topo`
-/// is not a baseline layout. The batch path of [`crate::sctp::SctpTracer`]
-/// is this walk at [`Width::Avx512`] where the CPU has it.
-pub fn trace_lockstep_sctp<T: Topology>(
-    width: Width,
-    mesh: &TetMesh,
-    topo: &T,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-) -> bool {
-    let Some(g) = baseline_records(mesh, topo) else {
-        return false;
-    };
-    let x = &Gathered::<IDS>(g);
-    match width {
-        Width::Portable4 => walk::run_plain::<Portable<NARROW>, Triple, _, 1>(
-            Portable, x, mesh, rays, start, cap, out,
-        ),
-        Width::Portable8 => walk::run_plain::<Portable<WIDE>, Triple, _, 1>(
-            Portable, x, mesh, rays, start, cap, out,
-        ),
-        #[cfg(target_arch = "x86_64")]
-        Width::Avx2 => match Avx2::detect() {
-            // SAFETY: the token proves the CPU has AVX2.
-            Some(t) => unsafe {
-                walk_avx2::<Triple, _, _>(t, x, mesh, rays, start, cap, out, &mut NoGate)
-            },
-            None => return false,
-        },
-        #[cfg(target_arch = "x86_64")]
-        Width::Avx512 => match Avx512::detect() {
-            // SAFETY: the token proves the CPU has AVX-512F.
-            Some(t) => unsafe {
-                walk_avx512::<Triple, _, _>(t, x, mesh, rays, start, cap, out, &mut NoGate)
-            },
-            None => return false,
-        },
-        #[cfg(not(target_arch = "x86_64"))]
-        Width::Avx2 | Width::Avx512 => return false,
-    }
-    true
-}
-
-/// The gatherable records of a projected layout (Tet20, Tet16, Tet32; the
-/// baseline's `Ids` rule is ScTP's) and their exit rule.
-#[cfg(target_arch = "x86_64")]
-fn projected_records<'a, T: Topology>(mesh: &TetMesh, topo: &'a T) -> Option<(ExitRule, Geo<'a>)> {
-    let rw = topo.record_words()?;
-    if matches!(rw.rule, ExitRule::Ids { .. }) {
-        return None;
-    }
-    Some((rw.rule, Geo::new(mesh, &rw)?))
-}
-
-/// The gatherable records of the 32-byte baseline layout.
-fn baseline_records<'a, T: Topology>(mesh: &TetMesh, topo: &'a T) -> Option<Geo<'a>> {
-    let rw = topo.record_words()?;
-    matches!(rw.rule, ExitRule::Ids { .. }).then_some(())?;
-    Geo::new(mesh, &rw)
-}
-
-/// The widest walk the CPU supports (AVX-512 only when `wide`), stopped
-/// short by `gate`.
-#[allow(clippy::too_many_arguments)]
-fn dispatch<T: Topology, GT: Gate>(
-    mesh: &TetMesh,
-    topo: &T,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-    wide: bool,
-    gate: &mut GT,
-) {
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = wide;
-    #[cfg(target_arch = "x86_64")]
-    {
-        let records = projected_records(mesh, topo);
-        if wide
-            && let Some(t) = Avx512::detect()
-            && let Some((rule, g)) = records
-        {
-            gathered_avx512(t, rule, g, mesh, rays, start, cap, out, gate);
-            return;
-        }
-        if let Some(t) = Avx2::detect() {
-            match records {
-                Some((rule, g)) => gathered_avx2(t, rule, g, mesh, rays, start, cap, out, gate),
-                // SAFETY: the token proves the CPU has AVX2.
-                None => unsafe { portable_avx2(t, topo, mesh, rays, start, cap, out, gate) },
-            }
-            return;
-        }
-    }
-    portable_gated::<T, GT, NARROW>(topo, mesh, rays, start, cap, out, gate);
-}
-
-/// The width the batch paths that choose between a lockstep walk and a
-/// scalar one (the Tet80 tracers, the iso walk's tiles) walk in lockstep
-/// on this CPU: AVX-512F (16 lanes) unless `TET_LOCKSTEP=avx2`, else AVX2
-/// (8 lanes); `None` (the scalar walk) without either, or with
-/// `TET_LOCKSTEP=scalar` in the environment (read once; for same-machine
-/// comparisons).
-pub(crate) fn batch_width() -> Option<Width> {
-    static WIDTH: std::sync::OnceLock<Option<Width>> = std::sync::OnceLock::new();
-    *WIDTH.get_or_init(|| {
+/// [`Width::Auto`] on this CPU: the one reader of `TET_LOCKSTEP`.
+fn auto() -> Option<Width> {
+    static AUTO: std::sync::OnceLock<Option<Width>> = std::sync::OnceLock::new();
+    *AUTO.get_or_init(|| {
         let env = std::env::var("TET_LOCKSTEP").unwrap_or_default();
         if env == "scalar" {
             return None;
@@ -444,133 +255,88 @@ pub(crate) fn batch_width() -> Option<Width> {
     })
 }
 
-/// True when `TET_LOCKSTEP=avx2` asks the lockstep walk to keep to 8-lane
-/// AVX2 on a CPU with AVX-512 (read once; for same-machine comparisons).
-#[cfg(target_arch = "x86_64")]
-fn avx2_only() -> bool {
-    static AVX2_ONLY: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    *AVX2_ONLY.get_or_init(|| std::env::var("TET_LOCKSTEP").is_ok_and(|v| v == "avx2"))
+/// A kernel's geometry in lockstep: what a lane computes per tet and
+/// reads of the records of topology `T`, run by the one driver —
+/// [`Planar`] (Tet20, Tet16, Tet32) and [`Triple`] (ScTP) over a
+/// [`Topology`](crate::walk::Topology), [`Plucker`] (Tet80, both side
+/// rules) over its tracer. [`trace`] walks a batch with one.
+pub trait Geometry<T: ?Sized> {
+    /// What a gate receives of a walk it stops.
+    type Handover;
+    /// Walks `batch` on lanes `l` with `PACKS` packs in flight, stopped
+    /// short by `gate`; `Err` (nothing traced) when its records cannot be
+    /// read at these lanes.
+    fn walk<'a, L: Lanes, GT: Gate<Self::Handover>, const PACKS: usize>(
+        l: L,
+        batch: Batch<'a, T>,
+        gate: &mut GT,
+    ) -> Result<(), Batch<'a, T>>;
 }
 
-/// Runs `$walk::<Planar, _>` with the gathered records of exit rule `$rule`.
-#[cfg(target_arch = "x86_64")]
-macro_rules! by_rule {
-    ($walk:ident, $t:expr, $rule:expr, $g:expr, $($arg:expr),*) => {
-        // SAFETY (all three): the token `$t` proves the CPU has the
-        // entry point's instruction set.
-        match $rule {
-            ExitRule::Rank { .. } => unsafe {
-                $walk::<Planar, _, _>($t, &Gathered::<RANK>($g), $($arg),*)
-            },
-            ExitRule::RankXor { .. } => unsafe {
-                $walk::<Planar, _, _>($t, &Gathered::<RANK_XOR>($g), $($arg),*)
-            },
-            ExitRule::Slot { .. } | ExitRule::Ids { .. } => unsafe {
-                $walk::<Planar, _, _>($t, &Gathered::<SLOT>($g), $($arg),*)
-            },
-        }
-    };
-}
-
-/// The projected walk with AVX-512 lanes and gathered records of `rule`.
-#[cfg(target_arch = "x86_64")]
-#[allow(clippy::too_many_arguments)]
-fn gathered_avx512<GT: Gate>(
-    t: Avx512,
-    rule: ExitRule,
-    g: Geo<'_>,
-    mesh: &TetMesh,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
+/// Traces `batch` in lockstep with geometry `G` at `width`: `out[i]` is
+/// exactly the scalar walk's outcome of `rays[i]` from its start, except
+/// for the walks `gate` stops short ([`NoGate`]: none), whose `out` is
+/// left as it was. `Err` gives the batch back untraced when the CPU lacks
+/// the width ([`Width::Auto`]: when it resolves to none) or the SIMD
+/// lanes cannot gather the layout's records, for the caller's scalar walk.
+pub fn trace<'a, G, T, GT>(
+    batch: Batch<'a, T>,
+    width: Width,
     gate: &mut GT,
-) {
-    by_rule!(walk_avx512, t, rule, g, mesh, rays, start, cap, out, gate)
+) -> Result<(), Batch<'a, T>>
+where
+    G: Geometry<T>,
+    T: ?Sized,
+    GT: Gate<G::Handover>,
+{
+    match width.resolve() {
+        Some(Width::Portable4) => G::walk::<Portable<4>, GT, 1>(Portable, batch, gate),
+        Some(Width::Portable8) => G::walk::<Portable<8>, GT, 1>(Portable, batch, gate),
+        #[cfg(target_arch = "x86_64")]
+        Some(Width::Avx2) => match Avx2::detect() {
+            // SAFETY: the token proves the CPU has the AVX2 set.
+            Some(t) => unsafe { walk_avx2::<G, T, GT>(t, batch, gate) },
+            None => Err(batch),
+        },
+        #[cfg(target_arch = "x86_64")]
+        Some(Width::Avx512) => match Avx512::detect() {
+            // SAFETY: the token proves the CPU has the AVX-512 set.
+            Some(t) => unsafe { walk_avx512::<G, T, GT>(t, batch, gate) },
+            None => Err(batch),
+        },
+        _ => Err(batch),
+    }
 }
 
-/// The projected walk with AVX2 lanes and gathered records of `rule`.
+/// The walk with 8 AVX2 lanes, two packs in flight, compiled for AVX2
+/// (everything inlines into it).
 #[cfg(target_arch = "x86_64")]
-#[allow(clippy::too_many_arguments)]
-fn gathered_avx2<GT: Gate>(
-    t: Avx2,
-    rule: ExitRule,
-    g: Geo<'_>,
-    mesh: &TetMesh,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-    gate: &mut GT,
-) {
-    by_rule!(walk_avx2, t, rule, g, mesh, rays, start, cap, out, gate)
+#[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+fn walk_avx2<'a, G, T, GT>(t: Avx2, batch: Batch<'a, T>, gate: &mut GT) -> Result<(), Batch<'a, T>>
+where
+    G: Geometry<T>,
+    T: ?Sized,
+    GT: Gate<G::Handover>,
+{
+    G::walk::<Avx2, GT, 2>(t, batch, gate)
 }
 
 /// The walk with 16 AVX-512 lanes, two packs in flight, compiled for
 /// AVX-512F (everything inlines into it).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
-#[allow(clippy::too_many_arguments)]
-fn walk_avx512<G: Geometry<Avx512>, X: Records<Avx512>, GT: Gate>(
+fn walk_avx512<'a, G, T, GT>(
     t: Avx512,
-    x: &X,
-    mesh: &TetMesh,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
+    batch: Batch<'a, T>,
     gate: &mut GT,
-) {
-    walk::run::<Avx512, G, X, GT, 2>(t, x, mesh, rays, start, cap, out, gate);
+) -> Result<(), Batch<'a, T>>
+where
+    G: Geometry<T>,
+    T: ?Sized,
+    GT: Gate<G::Handover>,
+{
+    G::walk::<Avx512, GT, 2>(t, batch, gate)
 }
 
-/// The walk with 8 AVX2 lanes, two packs in flight, compiled for AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
-#[allow(clippy::too_many_arguments)]
-fn walk_avx2<G: Geometry<Avx2>, X: Records<Avx2>, GT: Gate>(
-    t: Avx2,
-    x: &X,
-    mesh: &TetMesh,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-    gate: &mut GT,
-) {
-    walk::run::<Avx2, G, X, GT, 2>(t, x, mesh, rays, start, cap, out, gate);
-}
-
-/// The portable lanes, 8 wide, compiled for AVX2, reading the records
-/// through [`Topology`] (layouts without gatherable records).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
-#[allow(clippy::too_many_arguments)]
-fn portable_avx2<T: Topology, GT: Gate>(
-    _: Avx2,
-    topo: &T,
-    mesh: &TetMesh,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-    gate: &mut GT,
-) {
-    portable_gated::<T, GT, WIDE>(topo, mesh, rays, start, cap, out, gate);
-}
-
-/// The projected walk with `W` portable lanes reading the records through
-/// [`Topology`], stopped short by `gate`.
-#[inline(always)]
-fn portable_gated<T: Topology, GT: Gate, const W: usize>(
-    topo: &T,
-    mesh: &TetMesh,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-    gate: &mut GT,
-) {
-    let records = &PerLane(topo);
-    walk::run::<Portable<W>, Planar, _, _, 1>(Portable, records, mesh, rays, start, cap, out, gate);
-}
+#[cfg(test)]
+mod tests;

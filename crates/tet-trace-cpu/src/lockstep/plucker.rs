@@ -28,25 +28,37 @@
 //! ends with bit for bit the outcome of the scalar walk (tested in
 //! `tests/lockstep_tet80.rs`).
 //!
+//! The walk runs on the driver of every lockstep geometry
+//! ([`super::driver::run`], as [`Plucker`] through [`super::trace`]), not a
+//! copy of it: its rounds ([`Rounds`]) are this file's pack, step and rare
+//! path. Measured against its own driver in the same run, alternating the
+//! two builds (Torus Knots, 1920×1440, 2 threads, 5 frames, best of each,
+//! 2-core AMD EPYC with AVX-512 shared with other builds, November 2026):
+//! tet80-consistent 467 → 459 ms and 895 → 875 ms (two runs of 5 rounds;
+//! median paired ratio 0.997, spread 0.81–1.12), tet80 397 → 401 ms and
+//! 708 → 748 ms (median paired ratio 1.006, spread 0.94–1.64); 1 thread at
+//! 960×720: 239 → 241 and 212 → 207 ms. No loss beyond that noise, and the
+//! compiled step is the same: the same 11 gathers and, from the first to
+//! the last, the same instructions but one.
+//!
 //! Gathers index the record words: the tet is clamped to the last record
 //! (`4·tet ≤ 4·(tets − 1)`) and every offset within a record is below 20,
 //! with the word count checked to fit an `i32` once per batch; a layout
 //! whose links point past the tet array reads a clamped record (a wrong
 //! walk, never an out-of-bounds read).
 
+use std::marker::PhantomData;
+
 use glam::{Vec2, Vec3};
 use tet_core::FACE_VERTICES;
 use tet_core::layout::{Tet80, Tet80Face};
 
-use super::Width;
-#[cfg(target_arch = "x86_64")]
-use super::avx2::Avx2;
-#[cfg(target_arch = "x86_64")]
-use super::avx512::Avx512;
+use super::Geometry;
+use super::driver::{Gate, Rounds, next_ungated, run};
 use super::lanes::Lanes;
-use super::portable::Portable;
 use super::side::{Consistent, Faithful, Side};
 use crate::ray::{Failure, Ray, TraceOutcome};
+use crate::walk::lanes::{Batch, Starts};
 
 /// Words per Tet80 record.
 const STRIDE: u32 = 20;
@@ -102,11 +114,12 @@ const SECOND_FACE: [u32; 8] = {
     t
 };
 
-/// A walk the tracer started: the tet entered next, its entry face, the
+/// A walk between two tets: the tet entered next, its entry face, the
 /// tets visited so far and the consistent walk's projection factor, as
-/// the scalar walk's loop begins with them.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Begun {
+/// the scalar walk's loop begins with them (made by the tracer's start;
+/// what a [`Gate`] receives of a walk it stops).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Begun {
     /// Tet entered next.
     pub(crate) tet: u32,
     /// Its entry face (0..=3).
@@ -117,16 +130,21 @@ pub(crate) struct Begun {
     pub(crate) scale: f32,
 }
 
-/// What the lockstep walk takes from a Tet80 tracer: its records, step cap,
-/// side rule and the scalar walk's rare paths, so that every lane ends as
-/// the scalar walk does.
-pub(crate) trait PluckerWalk: Sync {
+/// What the lockstep walk takes from a Tet80 tracer (the topology of its
+/// batches): its records, side rule, starts and the scalar walk's rare
+/// paths, so that every lane ends as the scalar walk does.
+pub trait PluckerWalk: Sync {
     /// The consistent side rule (else the faithful one).
     const CONSISTENT: bool;
     /// The Tet80 records (fewer than 2³⁰).
     fn records(&self) -> &[Tet80];
-    /// The step cap.
-    fn cap(&self) -> u32;
+    /// The starts of the walks of `rays` from `starts`: ray `i`'s, or its
+    /// outcome when its walk ends before it starts.
+    fn starts<'a>(
+        &'a self,
+        rays: &'a [Ray],
+        starts: Starts<'a>,
+    ) -> impl FnMut(usize) -> Result<Begun, TraceOutcome> + 'a;
     /// The scalar walk crossing face `f` of `tet` after `visited` tets:
     /// the next tet and its entry face, or the outcome.
     fn leave(
@@ -152,6 +170,8 @@ struct Pack<L: Lanes, S: Side<L>> {
     live: L::M,
     /// Each lane's ray in the batch.
     ray_index: L::Arr<usize>,
+    /// Each lane's projection factor (for a handover).
+    scale: L::Arr<f32>,
 }
 
 /// The rays of a batch and the tracer's start of each.
@@ -187,6 +207,14 @@ impl<L: Lanes, S: Side<L>> Pack<L, S> {
         self.visited = l.set_i(self.visited, k, b.visited);
         self.live = l.or_m(self.live, l.mask_of_bits(1 << k));
         self.ray_index.as_mut()[k] = i;
+        self.scale.as_mut()[k] = b.scale;
+    }
+
+    /// Parks lane `k` (on tet 0).
+    #[inline(always)]
+    fn park(&mut self, l: L, k: usize) {
+        self.live = l.andnot_m(l.mask_of_bits(1 << k), self.live);
+        self.next = l.set_i(self.next, k, 0);
     }
 
     /// Lanes filled with the next walks of the batch (parked when fewer),
@@ -203,6 +231,7 @@ impl<L: Lanes, S: Side<L>> Pack<L, S> {
             visited: z,
             live: l.mask_of_bits(0),
             ray_index: L::arr(0),
+            scale: L::arr(0.0),
         };
         let mut live = 0;
         for k in 0..L::WIDTH {
@@ -373,8 +402,7 @@ fn events<L: Lanes, S: Side<L>, W: PluckerWalk, B: FnMut(usize) -> Result<Begun,
         match feed.next_lane() {
             Some((j, b)) => pk.put(l, k, j, &feed.rays[j], b),
             None => {
-                pk.live = l.andnot_m(l.mask_of_bits(1 << k), pk.live);
-                pk.next = l.set_i(pk.next, k, 0);
+                pk.park(l, k);
                 parked += 1;
             }
         }
@@ -382,138 +410,156 @@ fn events<L: Lanes, S: Side<L>, W: PluckerWalk, B: FnMut(usize) -> Result<Begun,
     parked
 }
 
-/// Traces `rays` (ray `i` started by `begin(i)`) with `PACKS` packs of
-/// `L::WIDTH` lanes stepped in turn; `out[i]` is exactly the scalar walk's
-/// outcome. `words` are `w`'s records as words: a whole number of records,
-/// at most `i32::MAX` words.
+/// Hands over the lanes of `stop` (their next tet is the gate's) and
+/// refills them, handing over at once the new walks whose first tet is the
+/// gate's too. Returns the number of lanes parked.
 #[inline(always)]
-fn run<L, S, W, B, const PACKS: usize>(
+fn gate_lanes<L, S, B, GT>(
     l: L,
-    w: &W,
-    words: &[u32],
-    rays: &[Ray],
-    begin: B,
-    out: &mut [TraceOutcome],
-) where
+    feed: &mut Feed<'_, B>,
+    pk: &mut Pack<L, S>,
+    gate: &mut GT,
+    stop: u32,
+) -> usize
+where
+    L: Lanes,
+    S: Side<L>,
+    B: FnMut(usize) -> Result<Begun, TraceOutcome>,
+    GT: Gate<Begun>,
+{
+    let mut parked = 0;
+    for k in (0..L::WIDTH).filter(|k| stop >> k & 1 != 0) {
+        let next = l.get_i(pk.next, k);
+        let h = Begun {
+            tet: next >> 2,
+            entry: (next & 3) as usize,
+            visited: l.get_i(pk.visited, k),
+            scale: pk.scale.as_ref()[k],
+        };
+        gate.hand_over(pk.ray_index.as_ref()[k], h);
+        match next_ungated(|| feed.next_lane(), gate, |b| b.tet, |b| b) {
+            Some((j, b)) => pk.put(l, k, j, &feed.rays[j], b),
+            None => {
+                pk.park(l, k);
+                parked += 1;
+            }
+        }
+    }
+    parked
+}
+
+/// The Plücker walk of side rule `S` over `w`'s records (`words`, a whole
+/// number of them, at most `i32::MAX` words), for the driver ([`run`]).
+struct Walk<'a, S, W, B> {
+    w: &'a W,
+    words: &'a [u32],
+    /// The last record.
+    last: u32,
+    cap: u32,
+    _walk: PhantomData<fn() -> (S, B)>,
+}
+
+impl<S, W, B> Clone for Walk<'_, S, W, B> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<S, W, B> Copy for Walk<'_, S, W, B> {}
+
+impl<'a, L, S, W, B> Rounds<L> for Walk<'a, S, W, B>
+where
     L: Lanes,
     S: Side<L>,
     W: PluckerWalk,
     B: FnMut(usize) -> Result<Begun, TraceOutcome>,
 {
-    let n = rays.len().min(out.len());
-    let mut feed = Feed {
-        rays: &rays[..n],
-        begin,
-        next: 0,
-        out: &mut out[..n],
-    };
-    let last = (words.len() / STRIDE as usize).saturating_sub(1) as u32;
-    let cap = w.cap();
-    let mut packs: [(Pack<L, S>, usize); PACKS] = std::array::from_fn(|_| Pack::fill(l, &mut feed));
-    loop {
-        let mut any = false;
-        for (pk, live) in packs.iter_mut() {
-            if *live == 0 {
-                continue;
-            }
-            any = true;
-            if let Some(r) = step::<L, S, W>(l, pk, words, last, cap) {
-                *live -= l.cold(|| events(l, w, &mut feed, pk, &r));
-            }
+    type Feed = Feed<'a, B>;
+    type Pack = Pack<L, S>;
+    type Round = Round<L>;
+    type Handover = Begun;
+
+    #[inline(always)]
+    fn fill(&self, l: L, feed: &mut Feed<'a, B>) -> (Pack<L, S>, usize) {
+        Pack::fill(l, feed)
+    }
+    #[inline(always)]
+    fn step(&self, l: L, pk: &mut Pack<L, S>) -> Option<Round<L>> {
+        step::<L, S, W>(l, pk, self.words, self.last, self.cap)
+    }
+    #[inline(always)]
+    fn events(&self, l: L, feed: &mut Feed<'a, B>, pk: &mut Pack<L, S>, r: &Round<L>) -> usize {
+        events(l, self.w, feed, pk, r)
+    }
+    #[inline(always)]
+    fn entering(&self, l: L, pk: &Pack<L, S>) -> (L::Arr<u32>, u32) {
+        let mut tets = L::i_lanes(pk.next);
+        for t in tets.as_mut() {
+            *t >>= 2;
         }
-        if !any {
-            break;
+        (tets, l.bits(pk.live))
+    }
+    #[inline(always)]
+    fn hand_over<GT: Gate<Begun>>(
+        &self,
+        l: L,
+        feed: &mut Feed<'a, B>,
+        pk: &mut Pack<L, S>,
+        gate: &mut GT,
+        stop: u32,
+    ) -> usize {
+        gate_lanes(l, feed, pk, gate, stop)
+    }
+}
+
+/// The Plücker walk of Maria et al. (the Tet80 kernels): its geometry is
+/// the tracer's side rule over the Tet80 records, its topology the tracer
+/// (`PluckerWalk`).
+#[derive(Clone, Copy, Debug)]
+pub struct Plucker;
+
+impl<W: PluckerWalk> Geometry<W> for Plucker {
+    type Handover = Begun;
+    /// `Err` (nothing traced) when the records are empty or too many to
+    /// gather.
+    #[inline(always)]
+    fn walk<'a, L: Lanes, GT: Gate<Begun>, const PACKS: usize>(
+        l: L,
+        batch: Batch<'a, W>,
+        gate: &mut GT,
+    ) -> Result<(), Batch<'a, W>> {
+        let w = batch.topo;
+        let words: &[u32] = bytemuck::cast_slice(w.records());
+        if words.is_empty() || words.len() > i32::MAX as usize {
+            return Err(batch);
         }
+        let n = batch.rays.len().min(batch.out.len());
+        let mut feed = Feed {
+            rays: &batch.rays[..n],
+            begin: w.starts(&batch.rays[..n], batch.starts),
+            next: 0,
+            out: &mut batch.out[..n],
+        };
+        let last = (words.len() / STRIDE as usize).saturating_sub(1) as u32;
+        if W::CONSISTENT {
+            let walk = Walk::<Consistent, W, _> {
+                w,
+                words,
+                last,
+                cap: batch.cap,
+                _walk: PhantomData,
+            };
+            run::<L, _, GT, PACKS>(l, walk, &mut feed, gate);
+        } else {
+            let walk = Walk::<Faithful, W, _> {
+                w,
+                words,
+                last,
+                cap: batch.cap,
+                _walk: PhantomData,
+            };
+            run::<L, _, GT, PACKS>(l, walk, &mut feed, gate);
+        }
+        Ok(())
     }
-}
-
-/// [`run`] with the side rule of `W`.
-#[inline(always)]
-fn run_side<L, W, B, const PACKS: usize>(
-    l: L,
-    w: &W,
-    words: &[u32],
-    rays: &[Ray],
-    begin: B,
-    out: &mut [TraceOutcome],
-) where
-    L: Lanes,
-    W: PluckerWalk,
-    B: FnMut(usize) -> Result<Begun, TraceOutcome>,
-{
-    if W::CONSISTENT {
-        run::<L, Consistent, W, B, PACKS>(l, w, words, rays, begin, out)
-    } else {
-        run::<L, Faithful, W, B, PACKS>(l, w, words, rays, begin, out)
-    }
-}
-
-/// Traces `rays` with `w`'s Plücker walk in lockstep at `width` (ray `i`
-/// started by `begin(i)`, which also stores the outcome of a walk that
-/// ends before it starts); `out[i]` is exactly the scalar walk's outcome.
-/// False (nothing traced) when the CPU lacks the width or the records are
-/// empty or too many to gather.
-pub(crate) fn trace<W, B>(
-    width: Width,
-    w: &W,
-    rays: &[Ray],
-    begin: B,
-    out: &mut [TraceOutcome],
-) -> bool
-where
-    W: PluckerWalk,
-    B: FnMut(usize) -> Result<Begun, TraceOutcome>,
-{
-    let words: &[u32] = bytemuck::cast_slice(w.records());
-    if words.is_empty() || words.len() > i32::MAX as usize {
-        return false;
-    }
-    match width {
-        Width::Portable4 => run_side::<Portable<4>, W, B, 1>(Portable, w, words, rays, begin, out),
-        Width::Portable8 => run_side::<Portable<8>, W, B, 1>(Portable, w, words, rays, begin, out),
-        #[cfg(target_arch = "x86_64")]
-        Width::Avx2 => match Avx2::detect() {
-            // SAFETY: the token proves the CPU has AVX2.
-            Some(t) => unsafe { walk_avx2(t, w, words, rays, begin, out) },
-            None => return false,
-        },
-        #[cfg(target_arch = "x86_64")]
-        Width::Avx512 => match Avx512::detect() {
-            // SAFETY: the token proves the CPU has AVX-512F.
-            Some(t) => unsafe { walk_avx512(t, w, words, rays, begin, out) },
-            None => return false,
-        },
-        #[cfg(not(target_arch = "x86_64"))]
-        Width::Avx2 | Width::Avx512 => return false,
-    }
-    true
-}
-
-/// The walk with 8 AVX2 lanes, two packs in flight, compiled for AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
-fn walk_avx2<W, B>(t: Avx2, w: &W, words: &[u32], rays: &[Ray], begin: B, out: &mut [TraceOutcome])
-where
-    W: PluckerWalk,
-    B: FnMut(usize) -> Result<Begun, TraceOutcome>,
-{
-    run_side::<Avx2, W, B, 2>(t, w, words, rays, begin, out)
-}
-
-/// The walk with 16 AVX-512 lanes, two packs in flight, compiled for
-/// AVX-512F.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
-fn walk_avx512<W, B>(
-    t: Avx512,
-    w: &W,
-    words: &[u32],
-    rays: &[Ray],
-    begin: B,
-    out: &mut [TraceOutcome],
-) where
-    W: PluckerWalk,
-    B: FnMut(usize) -> Result<Begun, TraceOutcome>,
-{
-    run_side::<Avx512, W, B, 2>(t, w, words, rays, begin, out)
 }

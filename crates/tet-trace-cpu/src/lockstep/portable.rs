@@ -23,6 +23,7 @@ fn cold_portable<R>(f: impl FnOnce() -> R) -> R {
 
 impl<const W: usize> Lanes for Portable<W> {
     const WIDTH: usize = W;
+    const GATHERS: bool = false;
     type F = [f32; W];
     type I = [u32; W];
     type M = [bool; W];

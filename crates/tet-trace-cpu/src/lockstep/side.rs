@@ -7,7 +7,7 @@
 
 use glam::Vec2;
 
-use super::geometry::{Geometry, Planar, PlanarRay};
+use super::geometry::{Planar, PlanarRay, Projected};
 use super::lanes::Lanes;
 use crate::ray::Ray;
 use crate::walk::{DuffF32, Projection};
@@ -132,7 +132,7 @@ impl<L: Lanes> Side<L> for Consistent {
 
     #[inline(always)]
     fn zero(l: L) -> Self::Ray {
-        <Planar as Geometry<L>>::zero(l).0
+        <Planar as Projected<L>>::zero(l).0
     }
     #[inline(always)]
     fn put(l: L, k: usize, ray: &mut Self::Ray, r: &Ray, scale: f32) {
@@ -140,11 +140,11 @@ impl<L: Lanes> Side<L> for Consistent {
     }
     #[inline(always)]
     fn apex(l: L, ray: &Self::Ray, v: &[L::F; 3]) -> Self::Apex {
-        <Planar as Geometry<L>>::project(l, ray, *v)
+        <Planar as Projected<L>>::project(l, ray, *v)
     }
     #[inline(always)]
     fn side(l: L, ray: &Self::Ray, pa: &Self::Apex, x: &[L::F; 3]) -> (L::M, L::M, Self::Vert) {
-        let px = <Planar as Geometry<L>>::project(l, ray, *x);
+        let px = <Planar as Projected<L>>::project(l, ray, *x);
         let det = l.sub_f(l.mul_f(pa[0], px[1]), l.mul_f(pa[1], px[0]));
         let z = l.splat_f(0.0);
         (l.gt_f(det, z), l.eq_f(det, z), px)

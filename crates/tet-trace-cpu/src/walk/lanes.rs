@@ -1,6 +1,6 @@
-//! Batches of rays on one thread: their starts ([`Starts`]), the [`Feed`]
-//! every batch walk draws its lanes from, and the scalar interleaved walk
-//! ([`trace_interleaved`]).
+//! Batches of rays on one thread: the request ([`Batch`]), their starts
+//! ([`Starts`]), the [`Feed`] every batch walk draws its lanes from, and
+//! the scalar interleaved walk ([`trace_interleaved`]).
 
 use glam::Vec3;
 use tet_core::TetMesh;
@@ -26,6 +26,29 @@ pub enum Starts<'a> {
     /// boundary face its line crosses, decided with the walk's own
     /// projection ([`BoundaryEntry::start_with`]).
     Outside(&'a BoundaryEntry),
+}
+
+/// One batch of walks, as every batch walk takes it (the scalar
+/// interleaved walk, [`crate::BatchWalk`], the one lockstep entry
+/// [`crate::lockstep::trace`]): ray `rays[i]` walks from its start in
+/// `starts` over `topo`, at most `cap` tets, into `out[i]`. The batch is
+/// the shorter of `rays` and `out`; [`Starts::Each`] must have a start for
+/// each of its rays.
+#[derive(Debug)]
+pub struct Batch<'a, T: ?Sized> {
+    /// The mesh walked (points, constrained faces).
+    pub mesh: &'a TetMesh,
+    /// Its topology: a layout, or the tracer of a walk over its own
+    /// records (Tet80).
+    pub topo: &'a T,
+    /// The rays.
+    pub rays: &'a [Ray],
+    /// Where each ray starts.
+    pub starts: Starts<'a>,
+    /// The step cap: tets visited before a walk reports failure.
+    pub cap: u32,
+    /// The outcomes, ray by ray.
+    pub out: &'a mut [TraceOutcome],
 }
 
 /// Walks interleaved per thread by the scalar batch walk
@@ -101,16 +124,17 @@ impl<'a> Feed<'a> {
 /// (memory-level parallelism without SIMD). Each step prefetches the record
 /// of the lane's next tet, which that lane reads a round later.
 /// Results are identical to [`trace`](super::step::trace) ray by ray (same
-/// `advance` and `finish_step`). `out.len()` must equal `rays.len()`.
-pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(
-    mesh: &TetMesh,
-    topo: &T,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-) {
-    let mut feed = Feed::new(mesh, rays, start, out);
+/// `advance` and `finish_step`).
+pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(batch: Batch<'_, T>) {
+    let Batch {
+        mesh,
+        topo,
+        rays,
+        starts,
+        cap,
+        out,
+    } = batch;
+    let mut feed = Feed::new(mesh, rays, starts, out);
     let points = &mesh.points[..];
     // Lanes in flight, each with its ray index; a finished lane is replaced
     // in place by the next ray, or removed when none is left.

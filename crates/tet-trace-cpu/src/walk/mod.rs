@@ -2,7 +2,7 @@
 //! containing its origin, one tet per step, until it crosses a constrained
 //! face or the mesh boundary.
 //!
-//! # The projected (2-D) walk of Aman et al. (seed 000 §4, Algorithm 1)
+//! # The projected (2-D) walk of Aman et al. (2022, §4, Algorithm 1)
 //!
 //! A basis `(u, v)` orthogonal to the ray direction `d` (with
 //! `(u × v) · d > 0`) maps every vertex `P` to the 2-D point
@@ -166,7 +166,7 @@ pub(crate) mod until;
 mod tests;
 
 pub use entry::{BoundaryEntry, EntryHint, ViewpointError};
-pub use lanes::{LANES, Starts, trace_interleaved};
+pub use lanes::{Batch, LANES, Starts, trace_interleaved};
 pub(crate) use projection::left_2d;
 pub(crate) use projection::left_f32;
 pub(crate) use projection::simd_face;
@@ -177,5 +177,5 @@ pub use start::{Start, start_exit_face, start_scale};
 pub use step::{EXIT_SLOT, exit_slot, step_cap, trace};
 pub(crate) use stop::degenerate_crossing;
 pub use stop::face_hit;
-pub use topology::{ExitRule, RecordWords, Topology, prefetch_index};
+pub use topology::{Topology, prefetch_index};
 pub use until::{StopAt, stops_at, trace_until};

@@ -1,5 +1,5 @@
 //! The projections: how a ray maps mesh vertices to the quantities whose
-//! signs steer the walk (the 2-D points of Aman et al., seed 000 §4, in f32
+//! signs steer the walk (the 2-D points of Aman et al. (2022) §4, in f32
 //! or f64, with or without the projected origin of Eq. 4–5, or the 3-D
 //! scalar triple products of Lagae & Dutré), and the tie rule that keeps
 //! each edge test exactly antisymmetric.

@@ -8,6 +8,7 @@ use super::projection::Projection;
 use super::start::Start;
 use super::step::trace;
 use super::topology::Topology;
+use crate::lockstep::exit::ByLane;
 use crate::ray::{Ray, TraceOutcome};
 
 /// True when `tet` is in the sorted set `stop` (a linear scan for the usual
@@ -35,6 +36,8 @@ pub struct StopAt<'a, T> {
 }
 
 impl<T: Topology> Topology for StopAt<'_, T> {
+    /// Not gathered: the stop tets' links read as the boundary.
+    type Exit = ByLane;
     #[inline(always)]
     fn vx(&self, tet: u32) -> u32 {
         self.inner.vx(tet)

@@ -18,10 +18,10 @@ use tet_core::TetMesh;
 use super::super::walk_ray::Ctx;
 use super::super::{IsoQuery, IsoStats};
 use super::{IsoOutcome, IsoWalk, WalkState, converted};
-use crate::lockstep::{Gate, Handover, trace_lockstep_gated};
+use crate::lockstep::{self, Gate, Handover, Planar, Width};
 use crate::ray::{Failure, Ray, TraceOutcome};
 use crate::walk::start::begin;
-use crate::walk::{DuffF32, EntryHint, Start, Starts, Topology};
+use crate::walk::{Batch, DuffF32, EntryHint, Start, Starts, Topology};
 
 /// The range test as a gate: walks stop short of the first tet whose
 /// values straddle an isovalue.
@@ -32,7 +32,7 @@ struct RangeGate<'a> {
     handed: Vec<(usize, Handover)>,
 }
 
-impl Gate for RangeGate<'_> {
+impl Gate<Handover> for RangeGate<'_> {
     const ON: bool = true;
 
     #[inline(always)]
@@ -101,15 +101,20 @@ impl IsoWalk<'_> {
             handed: Vec::new(),
         };
         let mut ends = vec![TraceOutcome::Miss { tets_visited: 0 }; walking.len()];
-        trace_lockstep_gated(
+        let batch = Batch {
             mesh,
             topo,
-            &walking,
-            Starts::Each(&starts),
-            self.cap,
-            &mut ends,
-            &mut gate,
-        );
+            rays: &walking,
+            starts: Starts::Each(&starts),
+            cap: self.cap,
+            out: &mut ends,
+        };
+        if let Err(batch) = lockstep::trace::<Planar, _, _>(batch, Width::Auto, &mut gate) {
+            // No SIMD lanes, or records they cannot gather: the portable
+            // lanes, which read any topology.
+            let ran = lockstep::trace::<Planar, _, _>(batch, Width::Portable8, &mut gate);
+            debug_assert!(ran.is_ok(), "the portable lanes read any topology");
+        }
         let mut handed = vec![false; walking.len()];
         for &(j, _) in &gate.handed {
             handed[j] = true;

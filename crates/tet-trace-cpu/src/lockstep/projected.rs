@@ -1,28 +1,34 @@
-//! The lockstep walk, written once over lanes `L` ([`Lanes`]), a
-//! projection `G` ([`Geometry`]) and record reads `X` ([`Records`]): the
-//! packs of lanes in registers, one round of the walk, the rare path, the
-//! driver. Every function is `#[inline(always)]`, so that the walk compiled
-//! inside a `#[target_feature]` entry point inlines down to the intrinsics;
-//! the rare paths run out of line through [`Lanes::cold`].
+//! The projected walk in lockstep (Tet20, Tet16, Tet32 with
+//! [`Planar`], ScTP with [`Triple`]), written once over lanes `L`
+//! ([`Lanes`]), a projection `G` ([`Projected`]) and record reads `X`
+//! ([`Records`]): the packs of lanes in registers, one round of the walk,
+//! the rare path and the gate's handover ([`Rounds`], for the driver
+//! [`run`]). Every function is `#[inline(always)]`, so that the walk
+//! compiled inside a `#[target_feature]` entry point inlines down to the
+//! intrinsics; the rare paths run out of line through [`Lanes::cold`].
+
+use std::marker::PhantomData;
 
 use glam::Vec3;
-use tet_core::{Link, TetMesh};
+use tet_core::Link;
 
-use super::exit::Records;
-use super::geometry::Geometry;
+use super::Geometry;
+use super::driver::{Gate, Rounds, next_ungated, run};
+use super::exit::{Gathered, Geo, Leaving, Records};
+use super::geometry::{Planar, Projected, Triple};
 use super::lanes::Lanes;
-use crate::ray::{Ray, TraceOutcome};
-use crate::walk::lanes::{Feed, Starts};
+use crate::walk::lanes::{Batch, Feed};
 use crate::walk::projection::Projection;
 use crate::walk::start::Lane;
 use crate::walk::stop::{Advance, Stopped};
 use crate::walk::stopped::{AfterStop, after_stop};
+use crate::walk::topology::Topology;
 
 /// A walk's state between two tets, as the scalar walk keeps it (its
 /// `Lane` less the projection, which is a function of the ray and start):
 /// about to enter `next` through the face `ids`, from tet `entry_raw`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Handover {
+pub struct Handover {
     pub(crate) ids: [u32; 3],
     pub(crate) next: u32,
     pub(crate) entry_raw: u32,
@@ -56,35 +62,8 @@ impl Handover {
     }
 }
 
-/// Where a gated lockstep walk stops short: before every round, a lane
-/// about to enter a tet the gate names leaves the walk (its state goes to
-/// [`Gate::hand_over`], its outcome is not written) and the lane is
-/// refilled. The plain walk's gate ([`NoGate`]) names none and compiles
-/// away.
-pub(crate) trait Gate {
-    /// False for [`NoGate`]: no check at all.
-    const ON: bool;
-    /// Whether a walk stops before entering `tet`.
-    fn stops_before(&self, tet: u32) -> bool;
-    /// Receives ray `ray`'s walk, stopped before entering `h.next`.
-    fn hand_over(&mut self, ray: usize, h: Handover);
-}
-
-/// The plain walk: never stops short.
-pub(crate) struct NoGate;
-
-impl Gate for NoGate {
-    const ON: bool = false;
-    #[inline(always)]
-    fn stops_before(&self, _: u32) -> bool {
-        false
-    }
-    #[inline(always)]
-    fn hand_over(&mut self, _: usize, _: Handover) {}
-}
-
 /// `L::WIDTH` walks in registers, and per lane its cold part.
-struct Pack<L: Lanes, G: Geometry<L>> {
+struct Pack<L: Lanes, G: Projected<L>> {
     ray: G::Ray,
     /// The entry face: projected points and ids (counter-clockwise).
     face: [G::Vert; 3],
@@ -103,7 +82,7 @@ struct Pack<L: Lanes, G: Geometry<L>> {
     cold: L::Arr<G::Cold>,
 }
 
-impl<L: Lanes, G: Geometry<L>> Pack<L, G> {
+impl<L: Lanes, G: Projected<L>> Pack<L, G> {
     /// Every lane parked on tet 0 (exists whenever a walk started, so the
     /// loads of parked lanes stay in range).
     #[inline(always)]
@@ -185,7 +164,7 @@ struct Round<L: Lanes> {
 /// moves on to the exit neighbour; `Some` when some live lane needs the rare
 /// path (the step cap, an out-of-range vertex, a non-tet exit link).
 #[inline(always)]
-fn step<L: Lanes, G: Geometry<L>, X: Records<L>>(
+fn step<L: Lanes, G: Projected<L>, X: Records<L>>(
     l: L,
     pk: &mut Pack<L, G>,
     x: &X,
@@ -197,7 +176,7 @@ fn step<L: Lanes, G: Geometry<L>, X: Records<L>>(
     let dc = l.min_u(d, l.splat_i(points.len() as u32 - 1));
     let lost = l.ne_i(dc, d);
     // SAFETY: `dc ≤ points.len() − 1` per lane, and `3 · points.len()`
-    // fits in an `i32` (asserted by `run`).
+    // fits in an `i32` (asserted by `walk`).
     let p = unsafe { l.gather_point(points, dc) };
     // Projection and Algorithm 1's three edge tests; a zero edge value
     // takes the scalar tie rule for that lane.
@@ -224,7 +203,14 @@ fn step<L: Lanes, G: Geometry<L>, X: Records<L>>(
     let s1 = l.andnot_m(left[0], left[2]);
     let s0 = l.not_m(l.or_m(s1, s2));
     let e = l.select_i(s1, pk.ids[1], l.select_i(s2, pk.ids[2], pk.ids[0]));
-    let link = x.link(l, scratch, pk.next, &pk.ids, d, e, pk.entry);
+    let leaving = Leaving {
+        next: pk.next,
+        ids: pk.ids,
+        d,
+        e,
+        entry: pk.entry,
+    };
+    let link = x.link(l, scratch, &leaving);
     // Commit: replace the exiting vertex, count the tet, move on.
     let capped = l.ge_u(pk.visited, l.splat_i(cap));
     let go = l.andnot_m(l.or_m(capped, lost), pk.live);
@@ -252,7 +238,7 @@ fn step<L: Lanes, G: Geometry<L>, X: Records<L>>(
 
 /// The scalar tie rule for the lanes of `tie` (their edge tests replaced).
 #[inline(always)]
-fn ties<L: Lanes, G: Geometry<L>>(
+fn ties<L: Lanes, G: Projected<L>>(
     l: L,
     pk: &Pack<L, G>,
     d: L::I,
@@ -284,7 +270,7 @@ fn ties<L: Lanes, G: Geometry<L>>(
 /// and refill the lane (or park it). Only what ending or crossing needs is
 /// read from the registers. Returns the number of lanes parked.
 #[inline(always)]
-fn events<L: Lanes, G: Geometry<L>>(
+fn events<L: Lanes, G: Projected<L>>(
     l: L,
     feed: &mut Feed<'_>,
     pk: &mut Pack<L, G>,
@@ -320,7 +306,7 @@ fn events<L: Lanes, G: Geometry<L>>(
 /// refills them, handing over at once the new walks whose first tet is the
 /// gate's too. Returns the number of lanes parked.
 #[inline(always)]
-fn gate_lanes<L: Lanes, G: Geometry<L>, GT: Gate>(
+fn gate_lanes<L: Lanes, G: Projected<L>, GT: Gate<Handover>>(
     l: L,
     feed: &mut Feed<'_>,
     pk: &mut Pack<L, G>,
@@ -336,101 +322,232 @@ fn gate_lanes<L: Lanes, G: Geometry<L>, GT: Gate>(
             visited: l.get_i(pk.visited, k),
         };
         gate.hand_over(pk.ray_index.as_ref()[k], h);
-        loop {
-            match feed.next_lane::<G::Proj>() {
-                Some((j, lane)) if gate.stops_before(lane.next) => {
-                    gate.hand_over(j, Handover::of(&lane));
-                }
-                Some((j, lane)) => {
-                    pk.put(l, k, j, &lane);
-                    break;
-                }
-                None => {
-                    pk.park(l, k);
-                    parked += 1;
-                    break;
-                }
+        let first = |lane: &Lane<G::Proj>| lane.next;
+        match next_ungated(|| feed.next_lane(), gate, first, |lane| Handover::of(&lane)) {
+            Some((j, lane)) => pk.put(l, k, j, &lane),
+            None => {
+                pk.park(l, k);
+                parked += 1;
             }
         }
     }
     parked
 }
 
-/// Traces `rays` from `start` (at most `cap` tets each) with `PACKS` packs
-/// of `L::WIDTH` lanes stepped in turn (the out-of-order core overlaps
-/// their dependent load chains); `out[i]` is exactly the scalar walk of
-/// `rays[i]` with `G::Proj`, except for the walks `gate` stops short
-/// (their `out` is left as it was). The points must number at most
-/// `i32::MAX / 3`.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn run<L: Lanes, G: Geometry<L>, X: Records<L>, GT: Gate, const PACKS: usize>(
-    l: L,
-    records: &X,
-    mesh: &TetMesh,
-    rays: &[Ray],
-    start: Starts<'_>,
+/// The projected walk of geometry `G` over the record reads `X`, for the
+/// driver ([`run`]).
+struct Walk<'a, G, X> {
+    records: X,
+    points: &'a [Vec3],
     cap: u32,
-    out: &mut [TraceOutcome],
+    _geometry: PhantomData<fn() -> G>,
+}
+
+impl<G, X: Copy> Clone for Walk<'_, G, X> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<G, X: Copy> Copy for Walk<'_, G, X> {}
+
+impl<'a, L: Lanes, G: Projected<L>, X: Records<L>> Rounds<L> for Walk<'a, G, X> {
+    type Feed = Feed<'a>;
+    type Pack = Pack<L, G>;
+    type Round = Round<L>;
+    type Handover = Handover;
+
+    #[inline(always)]
+    fn fill(&self, l: L, feed: &mut Feed<'a>) -> (Pack<L, G>, usize) {
+        Pack::fill(l, feed)
+    }
+    #[inline(always)]
+    fn step(&self, l: L, pk: &mut Pack<L, G>) -> Option<Round<L>> {
+        step(l, pk, &self.records, self.points, self.cap)
+    }
+    #[inline(always)]
+    fn events(&self, l: L, feed: &mut Feed<'a>, pk: &mut Pack<L, G>, r: &Round<L>) -> usize {
+        events(l, feed, pk, r)
+    }
+    #[inline(always)]
+    fn entering(&self, l: L, pk: &Pack<L, G>) -> (L::Arr<u32>, u32) {
+        (L::i_lanes(pk.next), l.bits(pk.live))
+    }
+    #[inline(always)]
+    fn hand_over<GT: Gate<Handover>>(
+        &self,
+        l: L,
+        feed: &mut Feed<'a>,
+        pk: &mut Pack<L, G>,
+        gate: &mut GT,
+        stop: u32,
+    ) -> usize {
+        gate_lanes(l, feed, pk, gate, stop)
+    }
+}
+
+/// Reads through [`Topology::vx`] and [`Topology::exit_link`] lane by lane.
+struct PerLane<'a, T>(&'a T);
+
+impl<T> Clone for PerLane<'_, T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for PerLane<'_, T> {}
+
+impl<L: Lanes, T: Topology> Records<L> for PerLane<'_, T> {
+    type Scratch = ();
+
+    #[inline(always)]
+    fn enter(&self, l: L, next: L::I, ids: &[L::I; 3]) -> (L::I, ()) {
+        let mut vx = L::i_lanes(next);
+        for v in vx.as_mut() {
+            *v = self.0.vx(*v);
+        }
+        let f = l.xor_i(l.xor_i(ids[0], ids[1]), ids[2]);
+        // The lanes of `vx` into a vector: `f ⊕ vx` lane by lane.
+        let mut d = L::i_lanes(f);
+        for (d, v) in d.as_mut().iter_mut().zip(vx.as_ref()) {
+            *d ^= v;
+        }
+        (from_lanes(l, d), ())
+    }
+    #[inline(always)]
+    fn link(&self, l: L, _: (), x: &Leaving<L>) -> L::I {
+        let (next, d, e, entry) = (
+            L::i_lanes(x.next),
+            L::i_lanes(x.d),
+            L::i_lanes(x.e),
+            L::i_lanes(x.entry),
+        );
+        let ids = x.ids.map(L::i_lanes);
+        let mut raw = L::arr(0u32);
+        for (k, r) in raw.as_mut().iter_mut().enumerate() {
+            let face = [ids[0].as_ref()[k], ids[1].as_ref()[k], ids[2].as_ref()[k]];
+            let at = |x: &L::Arr<u32>| x.as_ref()[k];
+            *r = self
+                .0
+                .exit_link(at(&next), face, at(&d), at(&e), at(&entry));
+        }
+        from_lanes(l, raw)
+    }
+    #[inline(always)]
+    fn prefetch(&self, _: L, link: L::I) {
+        // A prefetch never faults: parked and stopped lanes prefetch harmlessly.
+        for &r in L::i_lanes(link).as_ref() {
+            self.0.prefetch(r);
+        }
+    }
+}
+
+/// The vector of the lanes `a`.
+#[inline(always)]
+fn from_lanes<L: Lanes>(l: L, a: L::Arr<u32>) -> L::I {
+    let mut x = l.splat_i(0);
+    for (k, &v) in a.as_ref().iter().enumerate() {
+        x = l.set_i(x, k, v);
+    }
+    x
+}
+
+/// Walks `batch` with geometry `G` on lanes `l` (`PACKS` packs in flight),
+/// stopped short by `gate`: the SIMD lanes gather the records with the
+/// layout's exit rule (`Err`, nothing traced, when they cannot be
+/// gathered), the portable lanes read them through [`Topology`]. `out[i]`
+/// is exactly the scalar walk of `rays[i]` with `G::Proj`, except for the
+/// walks `gate` stops short (their `out` is left as it was).
+#[inline(always)]
+fn walk<'a, L, G, T, GT, const PACKS: usize>(
+    l: L,
+    batch: Batch<'a, T>,
     gate: &mut GT,
-) {
+) -> Result<(), Batch<'a, T>>
+where
+    L: Lanes,
+    G: Projected<L>,
+    T: Topology,
+    GT: Gate<Handover>,
+{
+    let mesh = batch.mesh;
+    let gathered = match batch.topo.record_words() {
+        Some(rw) if L::GATHERS => match Geo::new::<T::Exit>(mesh, &rw) {
+            Some(g) => Some(Gathered::<T::Exit>(g, PhantomData)),
+            None => return Err(batch),
+        },
+        _ if L::GATHERS => return Err(batch),
+        _ => None,
+    };
     // The gathers' indices `3·i` of the points fit in an `i32` (checked
     // by `RecordWords::gatherable` for every gathered layout already).
     assert!(
         mesh.points.len() <= i32::MAX as usize / 3,
         "too many points for the lockstep walk"
     );
-    let mut feed = Feed::new(mesh, rays, start, out);
-    let mut packs: [(Pack<L, G>, usize); PACKS] = std::array::from_fn(|_| Pack::fill(l, &mut feed));
-    // A walk started only if the mesh has points and tets (its start tet
-    // and vertices exist), so the loads of `step` have something to clamp to.
+    let Batch {
+        topo,
+        rays,
+        starts,
+        cap,
+        out,
+        ..
+    } = batch;
+    let mut feed = Feed::new(mesh, rays, starts, out);
     if mesh.points.is_empty() {
-        return;
+        // No walk starts without points (a start tet has vertices): the
+        // feed stores every ray's outcome.
+        while feed.next_lane::<G::Proj>().is_some() {}
+        return Ok(());
     }
     let points = &mesh.points[..];
-    loop {
-        let mut any = false;
-        for (pk, live) in packs.iter_mut() {
-            if *live == 0 {
-                continue;
-            }
-            if GT::ON {
-                let next = L::i_lanes(pk.next);
-                let live_bits = l.bits(pk.live);
-                let mut stop = 0u32;
-                for k in (0..L::WIDTH).filter(|k| live_bits >> k & 1 != 0) {
-                    if gate.stops_before(next.as_ref()[k]) {
-                        stop |= 1 << k;
-                    }
-                }
-                if stop != 0 {
-                    *live -= l.cold(|| gate_lanes(l, &mut feed, pk, gate, stop));
-                    if *live == 0 {
-                        continue;
-                    }
-                }
-            }
-            any = true;
-            if let Some(r) = step(l, pk, records, points, cap) {
-                *live -= l.cold(|| events(l, &mut feed, pk, &r));
-            }
+    match gathered {
+        Some(records) => {
+            let w = Walk::<G, _> {
+                records,
+                points,
+                cap,
+                _geometry: PhantomData,
+            };
+            run::<L, _, GT, PACKS>(l, w, &mut feed, gate);
         }
-        if !any {
-            break;
+        None => {
+            let w = Walk::<G, _> {
+                records: PerLane(topo),
+                points,
+                cap,
+                _geometry: PhantomData,
+            };
+            run::<L, _, GT, PACKS>(l, w, &mut feed, gate);
         }
+    }
+    Ok(())
+}
+
+/// The projected walk with Duff's 2-D basis ([`crate::DuffF32`]): the
+/// Tet20, Tet16 and Tet32 kernels.
+impl<T: Topology> Geometry<T> for Planar {
+    type Handover = Handover;
+    #[inline(always)]
+    fn walk<'a, L: Lanes, GT: Gate<Handover>, const PACKS: usize>(
+        l: L,
+        batch: Batch<'a, T>,
+        gate: &mut GT,
+    ) -> Result<(), Batch<'a, T>> {
+        walk::<L, Self, T, GT, PACKS>(l, batch, gate)
     }
 }
 
-/// [`run`] without a gate: every walk to its end.
-#[inline(always)]
-pub(crate) fn run_plain<L: Lanes, G: Geometry<L>, X: Records<L>, const PACKS: usize>(
-    l: L,
-    records: &X,
-    mesh: &TetMesh,
-    rays: &[Ray],
-    start: Starts<'_>,
-    cap: u32,
-    out: &mut [TraceOutcome],
-) {
-    run::<L, G, X, NoGate, PACKS>(l, records, mesh, rays, start, cap, out, &mut NoGate);
+/// The projected walk with ScTP's scalar triple products
+/// ([`crate::TripleF32`]).
+impl<T: Topology> Geometry<T> for Triple {
+    type Handover = Handover;
+    #[inline(always)]
+    fn walk<'a, L: Lanes, GT: Gate<Handover>, const PACKS: usize>(
+        l: L,
+        batch: Batch<'a, T>,
+        gate: &mut GT,
+    ) -> Result<(), Batch<'a, T>> {
+        walk::<L, Self, T, GT, PACKS>(l, batch, gate)
+    }
 }
