@@ -95,7 +95,11 @@
 //! * **Hit point.** The CPU computes `t` and barycentrics once per ray in f64;
 //!   the kernel does it in f32 (same formula). They agree to f32 rounding, and
 //!   the decision `t < t_min` (cross a constrained face before the ray's start
-//!   interval) can differ when `t` is within rounding of `t_min`.
+//!   interval) can differ when `t` is within rounding of `t_min`. Where the
+//!   ray runs along a face (within a millionth of a radian of its plane) or
+//!   crosses its plane off the face at a grazing angle, the CPU reports the
+//!   point of the face nearest the line and the kernel the plane's crossing
+//!   (`tet_trace_cpu::walk::face_hit`): the same face, a different `t`.
 //! * **Start.** For batch rays the host runs the CPU's exact start logic
 //!   (`tet_trace_cpu::walk::start_exit_face`: start tet, the tets around an
 //!   origin on a face/edge/vertex, last-resort fallback) and uploads the
