@@ -14,7 +14,8 @@
 //! * no paper named by an internal number (the word "seed" and 000 … 004)
 //!   in the README, `docs/` or the crates' sources (doc comments, comments,
 //!   string literals: table headings, figure titles, CLI help): papers are
-//!   named by their authors and year.
+//!   named by their authors and year;
+//! * one module-file convention: a module with submodules in `name/mod.rs`.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -524,4 +525,42 @@ fn lockstep_takes_one_request_and_reads_its_width_once() {
         }
     }
     assert_eq!(readers.len(), 1, "readers of TET_LOCKSTEP: {readers:?}");
+}
+
+/// Every directory below `dir`, depth first.
+fn dirs_below(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            out.push(p.clone());
+            dirs_below(&p, out);
+        }
+    }
+}
+
+/// One module-file convention: a module with submodules lives in
+/// `name/mod.rs`, never in `name.rs` beside a `name/` folder, so a reader
+/// finds a module's root in one place.
+#[test]
+fn modules_with_submodules_live_in_mod_rs() {
+    let root = workspace();
+    let mut both = Vec::new();
+    for src in crate_src_dirs() {
+        let mut dirs = Vec::new();
+        dirs_below(&src, &mut dirs);
+        for d in dirs {
+            if d.with_extension("rs").is_file() {
+                let rel = d.strip_prefix(&root).unwrap_or(&d);
+                both.push(format!("{0}.rs beside {0}/", rel.display()));
+            }
+        }
+    }
+    assert!(
+        both.is_empty(),
+        "move each module's root into its folder's mod.rs:\n{}",
+        both.join("\n")
+    );
 }

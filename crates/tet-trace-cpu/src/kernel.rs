@@ -86,7 +86,7 @@ impl<L: Topology, P: BatchWalk> Tracer for WalkTracer<'_, L, P> {
         self.mesh
     }
     /// The walk, or where it reached the step cap (lost in a tet thinner
-    /// than its rounding), the exact walk ([`crate::lost`]).
+    /// than its rounding), the exact walk (`lost.rs`).
     #[inline]
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
         let out = trace::<P, L>(self.mesh, &self.layout, ray, start, self.cap);

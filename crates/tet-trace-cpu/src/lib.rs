@@ -6,7 +6,7 @@
 //!
 //! * [`ray`]: [`Ray`], [`Hit`], [`TraceOutcome`] (hit / miss / reported failure);
 //! * [`mod@locate`]: exact point location (Aman et al. 2022, §4.2);
-//! * [`entry`]: rays from a viewpoint outside the mesh enter through its boundary;
+//! * [`boundary_entry`]: rays from a viewpoint outside the mesh enter through its boundary;
 //! * [`walk`]: the watertight traversal engine and its projections;
 //! * [`lockstep`]: the SIMD lockstep batch walks, and [`batch`]: which
 //!   batch walk each projection takes;
@@ -71,7 +71,7 @@
 
 pub mod area_light;
 pub mod batch;
-pub mod entry;
+pub mod boundary_entry;
 pub mod exact;
 pub mod iso;
 pub mod kernel;
@@ -92,7 +92,7 @@ pub mod tracer;
 pub mod walk;
 
 pub use batch::BatchWalk;
-pub use entry::{Viewpoint, ViewpointError};
+pub use boundary_entry::{Viewpoint, ViewpointError};
 pub use kernel::{Tracer, WalkTracer};
 pub use locate::{LocateError, locate};
 pub use ray::{Failure, Hit, Ray, TraceOutcome};

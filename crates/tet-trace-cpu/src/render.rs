@@ -18,7 +18,7 @@
 //! Primary rays start in the camera's tet, or, when the camera lies outside
 //! the mesh (a tight enclosing box), each enters through the boundary face
 //! its line crosses and a ray that misses the mesh visits no tet
-//! ([`crate::entry`]).
+//! ([`crate::boundary_entry`]).
 //!
 //! Shadows (Aman et al. 2022, §6): each point light is located once per frame, from
 //! the camera's tet ([`LightTarget::locate_or_outside`]), and its shadow rays
@@ -45,7 +45,7 @@ use tet_core::scene::{Camera, PointLight};
 use thiserror::Error;
 
 use crate::area_light::{AreaLight, irradiance, irradiance_unshadowed};
-use crate::entry::{Viewpoint, ViewpointError};
+use crate::boundary_entry::{Viewpoint, ViewpointError};
 use crate::kernel::Tracer;
 use crate::locate::LocateError;
 use crate::ray::{Hit, Ray, TraceOutcome};

@@ -666,7 +666,7 @@ impl<const CONSISTENT: bool> Tracer for Tet80Tracer<'_, CONSISTENT> {
         self.mesh
     }
     /// The walk, or where it reached the step cap, the exact walk
-    /// ([`crate::lost`]); likewise the batches.
+    /// (`lost.rs`); likewise the batches.
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
         let out = self.trace_with(ray, start, None, |_| false);
         exact_if_lost(self.mesh, self.cap, ray, start, out)

@@ -27,7 +27,7 @@ pub trait Tracer: Sync {
 
     /// Traces many rays into `out` (same length) from `starts`: one start
     /// for all, one per ray, or each ray's entry into the mesh from outside
-    /// ([`Starts::Outside`], [`crate::entry`]; the entry decided by
+    /// ([`Starts::Outside`], [`crate::boundary_entry`]; the entry decided by
     /// [`Tracer::start_outside`]). Kernels may interleave walks; the results
     /// equal [`Tracer::trace`] ray by ray.
     fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {

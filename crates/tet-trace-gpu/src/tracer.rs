@@ -272,7 +272,7 @@ impl<'a> GpuTracer<'a> {
     /// [`GpuTracer::render`] from a located viewpoint: the GPU's own camera
     /// rays when the camera is inside the mesh; from outside, the rays are
     /// made on the host, each starts through the boundary face it enters by
-    /// (`tet_trace_cpu::entry`, host side, like the starts of
+    /// (`tet_trace_cpu::boundary_entry`, host side, like the starts of
     /// [`GpuTracer::trace_batch`]) and a ray that misses the mesh is a miss
     /// that visits no tet.
     pub fn render_view(

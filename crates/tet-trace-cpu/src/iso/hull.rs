@@ -1,7 +1,7 @@
 //! The boundary face a ray from outside enters the volume through, found
 //! with a small BVH over the boundary faces.
 //!
-//! [`crate::entry::BoundaryEntry`] scans the faces a viewpoint sees, which
+//! [`crate::boundary_entry::BoundaryEntry`] scans the faces a viewpoint sees, which
 //! suits a tight enclosing box (a dozen faces) but not a volume mesh, whose
 //! boundary has thousands. Here the faces sit in a median-split BVH; a face
 //! is entered when the walk's own edge test ([`DuffF32`], with its tie

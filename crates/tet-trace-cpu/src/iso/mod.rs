@@ -54,7 +54,6 @@ pub mod packet;
 pub mod reference;
 pub mod regions;
 pub mod walk;
-mod walk_ray;
 
 use glam::{Mat3, Vec3};
 use thiserror::Error;

@@ -17,11 +17,11 @@ use super::driver::{Gate, Rounds, next_ungated, run};
 use super::exit::{Gathered, Geo, Leaving, Records};
 use super::geometry::{Planar, Projected, Triple};
 use super::lanes::Lanes;
+use crate::walk::after_stop::{AfterStop, after_stop};
 use crate::walk::lanes::{Batch, Feed};
 use crate::walk::projection::Projection;
 use crate::walk::start::Lane;
 use crate::walk::stop::{Advance, Stopped};
-use crate::walk::stopped::{AfterStop, after_stop};
 use crate::walk::topology::Topology;
 
 /// A walk's state between two tets, as the scalar walk keeps it (its

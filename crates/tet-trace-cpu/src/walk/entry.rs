@@ -1,6 +1,6 @@
 //! The boundary entry of rays from outside the mesh: the boundary faces
 //! of a convex mesh ([`BoundaryEntry`]) and the face a ray's line enters
-//! through, decided with the walk's own projection. See [`crate::entry`]
+//! through, decided with the walk's own projection. See [`crate::boundary_entry`]
 //! for why and how.
 
 use std::collections::HashMap;
@@ -77,7 +77,7 @@ pub struct BoundaryEntry {
 
 impl BoundaryEntry {
     /// Every boundary face of `mesh`, after checking that the boundary is
-    /// convex (exact; see [`crate::entry`]).
+    /// convex (exact; see [`crate::boundary_entry`]).
     pub fn new(mesh: &TetMesh) -> Result<BoundaryEntry, ViewpointError> {
         let mut faces = Vec::new();
         for (t, links) in mesh.neighbors.iter().enumerate() {

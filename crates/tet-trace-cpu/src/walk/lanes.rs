@@ -65,7 +65,7 @@ pub(crate) struct Feed<'a> {
     /// The next ray not started yet.
     next: usize,
     /// The boundary face the last ray from outside entered through (tested
-    /// first for the next, see [`crate::entry`]).
+    /// first for the next, see [`crate::boundary_entry`]).
     hint: EntryHint,
     /// The projection scale of the last ray started from [`Starts::Same`]
     /// and its origin: rays from one viewpoint share it.

@@ -150,15 +150,15 @@
 //! * `until`: walks that end on entering given tets (shadow rays);
 //! * `entry`: the boundary face a ray from outside enters through;
 //! * `lanes`: batches on one thread, the interleaved walk;
-//! * `stopped`: the stopped-lane cold path of the SIMD walks.
+//! * `after_stop`: the stopped-lane cold path of the SIMD walks.
 
+pub(crate) mod after_stop;
 pub(crate) mod entry;
 pub(crate) mod lanes;
 pub(crate) mod projection;
 pub(crate) mod start;
 pub(crate) mod step;
 pub(crate) mod stop;
-pub(crate) mod stopped;
 pub(crate) mod topology;
 pub(crate) mod until;
 

@@ -31,7 +31,7 @@ pub enum Start {
     /// `face`), ahead of the origin, as the walk would have entered it. A
     /// boundary face ([`Link::BOUNDARY`]): the ray comes from outside the
     /// mesh, where nothing lies, so the walk starts there; see
-    /// [`crate::entry`], which finds it (and resolves a constrained face on
+    /// [`crate::boundary_entry`], which finds it (and resolves a constrained face on
     /// the boundary itself). An inner face: the caller knows the walk finds
     /// nothing before it and that the ray's line enters `tet` through it
     /// (the iso walk's regions, [`crate::iso::regions`]); the walk then

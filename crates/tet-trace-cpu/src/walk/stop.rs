@@ -84,8 +84,8 @@ pub(crate) fn degenerate_crossing(t: f64, bary: &[f32; 3]) -> bool {
 /// near an edge, where the walk's tie rule took it across (see the walk's
 /// module docs, "Why the walk ends"). The hit is then the point of that
 /// segment at `t_min` if it holds it, else its end nearer `t_min`
-/// ([`along_face`]), so the hit lies on the face. So is a crossing ahead
-/// of `t_min` that lies off the face ([`OFF_FACE`]).
+/// (`along_face`), so the hit lies on the face. So is a crossing ahead
+/// of `t_min` that lies off the face (more than a millionth, in barycentrics).
 pub fn face_hit(mesh: &TetMesh, ray: &Ray, ids: [u32; 3]) -> (f64, [f64; 3]) {
     let o = ray.origin.as_dvec3();
     let d = ray.direction.as_dvec3();

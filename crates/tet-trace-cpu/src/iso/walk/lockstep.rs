@@ -15,8 +15,8 @@
 
 use tet_core::TetMesh;
 
-use super::super::walk_ray::Ctx;
 use super::super::{IsoQuery, IsoStats};
+use super::ray::Ctx;
 use super::{IsoOutcome, IsoWalk, WalkState, converted};
 use crate::lockstep::{self, Gate, Handover, Planar, Width};
 use crate::ray::{Failure, Ray, TraceOutcome};

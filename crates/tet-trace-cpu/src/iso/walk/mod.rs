@@ -2,7 +2,7 @@
 //! [`crate::walk`] finds the isosurface without any acceleration structure.
 //!
 //! A ray enters the volume through a boundary face (the entry decision of
-//! [`crate::entry`], the walk's own edge test, with the faces in a BVH:
+//! [`crate::boundary_entry`], the walk's own edge test, with the faces in a BVH:
 //! `iso::hull`) or starts in the tet around its origin
 //! ([`crate::locate()`]), then steps tet to neighbour across
 //! the exit face chosen by Algorithm 1 of Aman et al. (2022) over the Tet32, Tet20 or
@@ -48,6 +48,7 @@
 //! README's isosurface figures).
 
 mod lockstep;
+mod ray;
 mod skip;
 
 use std::borrow::Cow;
@@ -56,12 +57,12 @@ use glam::Vec3;
 use tet_core::layout::{LayoutMesh, Tet16Mesh, Tet20Mesh, Tet32Mesh};
 use tet_core::{Link, TetMesh};
 
+use self::ray::{Ctx, Found};
 use super::hull::Hull;
 use super::marching::RayPre;
 use super::regions::{RegionHit, RegionTree};
-use super::walk_ray::{Ctx, Found};
 use super::{IsoError, IsoHit, IsoQuery, IsoStats, check_values};
-use crate::entry::Viewpoint;
+use crate::boundary_entry::Viewpoint;
 use crate::kernel::LANES;
 use crate::locate::{LocateError, locate};
 use crate::ray::{Failure, Ray, TraceOutcome};

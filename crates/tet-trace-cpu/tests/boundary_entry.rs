@@ -1,5 +1,5 @@
 //! Rays from outside the mesh enter through its boundary
-//! (`tet_trace_cpu::entry`): against the f64 brute force, through boundary
+//! (`tet_trace_cpu::boundary_entry`): against the f64 brute force, through boundary
 //! vertices and edges exactly, along boundary faces, batched, and refused on
 //! a non-convex boundary.
 
@@ -7,7 +7,7 @@ use glam::Vec3;
 use proptest::prelude::*;
 use tet_core::TetMesh;
 use tet_core::synthetic::SplitMix64;
-use tet_trace_cpu::entry::{BoundaryEntry, Viewpoint, ViewpointError};
+use tet_trace_cpu::boundary_entry::{BoundaryEntry, Viewpoint, ViewpointError};
 use tet_trace_cpu::reference::{closest_hit, grazes_an_edge, random_direction};
 use tet_trace_cpu::sctp::SctpTracer;
 use tet_trace_cpu::tet16::{Tet16Tracer, Tet16TracerF64};

@@ -1,12 +1,12 @@
 //! The iso walk's per-ray constants and per-tet arithmetic: the range
 //! test, the field value and ray parameter where the ray crosses a face
-//! (canonical vertex order, see [`super::walk`]), the crossing between a
+//! (canonical vertex order, see [`super`]), the crossing between a
 //! tet's entry and exit faces, and the start tet's f64 linear field.
 
 use glam::{DVec3, Vec2};
 use tet_core::TetMesh;
 
-use super::{IsoHit, IsoQuery, gradient};
+use super::super::{IsoHit, IsoQuery, gradient};
 use crate::ray::Ray;
 use crate::walk::Face2;
 
