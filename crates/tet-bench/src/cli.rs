@@ -1,9 +1,23 @@
-//! The command-line interface (a scripted interface: see the README for the
-//! `--json` schema; do not change it silently).
+//! The command line (a scripted interface: see the README for the
+//! `--json` schema; do not change it silently): the subcommands, their
+//! arguments, and the parsers of values that exist only here (boxes,
+//! counts). What the arguments name lives with the code that uses it: the
+//! methods ([`crate::methods::method`]), the build flags
+//! ([`crate::load::build_flags`]), the view ([`crate::load::camera`]), the
+//! out-of-core options ([`crate::outofcore::options`]) and the iso methods
+//! ([`crate::iso::IsoMethod`]).
 
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+
+use crate::iso::IsoMethod;
+use crate::load::build_flags::BuildFlags;
+use crate::load::camera::{ViewArgs, parse_vec3};
+use crate::methods::method::{Method, Precision};
+use crate::outofcore::options::{
+    MemPerPart, MergeMode, Planner, parse_mem_per_part, parse_memory_limit,
+};
 
 /// Ray tracing through constrained Delaunay tetrahedralizations: build,
 /// inspect, render, measure accuracy and reproduce the papers' tables.
@@ -75,103 +89,6 @@ pub fn procedural_scenes_help() -> String {
         help.push_str(&format!("  {:width$}  {}\n", p.name, p.about));
     }
     help
-}
-
-/// How to build a mesh from a scene.
-#[derive(Debug, Clone, Copy, Args)]
-pub struct BuildFlags {
-    /// TetGen quality bound (radius-edge ratio, `-q`); off by default (`-pY` only).
-    #[arg(long)]
-    pub quality: Option<f64>,
-    /// Refine tets whose smallest dihedral angle is below this many
-    /// degrees (slivers; TetGen `-q<ratio>/<degrees>`), with or without
-    /// `--quality`.
-    #[arg(long, value_name = "DEGREES")]
-    pub min_dihedral: Option<f64>,
-    /// Cap on the Steiner points of the quality refinement (`-S`; the
-    /// points TetGen adds to recover the scene's edges and faces do not
-    /// count): a number, or a percentage of the scene's vertices (`1%`).
-    /// With `--min-dihedral 2`, 1 % already removes the worst slivers.
-    #[arg(long, value_name = "N|P%", value_parser = parse_max_steiner)]
-    pub max_steiner: Option<MaxSteiner>,
-    /// TetGen's mesh optimisation `LEVEL/SCHEME` (`-O`): up to 2^LEVEL − 1
-    /// passes (LEVEL 0 to 9) of flips (SCHEME bit 1), smoothing (2) and
-    /// vertex insertion/deletion (4). Default: TetGen's 2/7.
-    #[arg(long, value_name = "LEVEL/SCHEME", value_parser = parse_optimization)]
-    pub optimize: Option<tet_build::tetgen_options::Optimization>,
-    /// Dihedral angle in degrees above which TetGen's optimisation works on
-    /// a tet (`-o/`; TetGen's default 165).
-    #[arg(long, value_name = "DEGREES")]
-    pub max_dihedral: Option<f64>,
-    /// Time limit for TetGen in seconds (the build runs in a worker process).
-    #[arg(long, default_value_t = 600.0)]
-    pub time_limit: f64,
-    /// Do not add the enclosing box around the scene.
-    #[arg(long)]
-    pub no_box: bool,
-    /// Make the enclosing box hold the camera and lights too (10 % margin),
-    /// so that primary rays start in the camera's tet; by default it is
-    /// tight around the scene (0.2 % margin) and rays from a camera outside
-    /// enter through the mesh boundary.
-    #[arg(long, conflicts_with = "no_box")]
-    pub wide_box: bool,
-    /// Skip Hilbert reordering of points and tets.
-    #[arg(long)]
-    pub no_sort: bool,
-    /// Do not split triangles that cross, touch in their interiors or
-    /// overlap: such a scene then fails with the list of intersecting
-    /// pairs instead of being resolved.
-    #[arg(long)]
-    pub no_resolve: bool,
-    /// Cut the enclosing box into parts with exact walls between them (the
-    /// out-of-core builder's recursive planes), tetrahedralize the parts
-    /// in parallel and merge them: the walls break up the long sliver fans
-    /// of the unrefined `-pY` mesh, which every ray crosses. `auto`: dense
-    /// regions cut until each part's predicted TetGen peak is about 28 MiB
-    /// (light parts and empty margins left whole; where no walled build
-    /// succeeds, the scene in one piece); `N`: every part cut to the same
-    /// depth, N parts (rounded up to a power of two); `none`: one TetGen
-    /// run for the whole scene. Default: `auto`, or `none` with
-    /// `--no-box`, `--quality` or `--min-dihedral` (the papers' refined
-    /// builds are one piece).
-    #[arg(long, value_name = "N|auto|none", value_parser = parse_walls)]
-    pub walls: Option<Walls>,
-}
-
-/// How finely `--walls` cuts the enclosing box.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Walls {
-    /// Parts of about 28 MiB predicted TetGen peak
-    /// (`tet_build::outofcore::split::RAY_PART_TARGET_BYTES`, the size every
-    /// build shaped for rays cuts toward; if that build fails: one part per about
-    /// [`Walls::TRIANGLES_PER_PART`] scene triangles, uniform depth; if
-    /// that fails too: the scene in one piece, the switches saying why).
-    Auto,
-    /// This many parts (rounded up to a power of two).
-    Parts(u32),
-    /// The scene in one piece: one TetGen run, no walls.
-    None,
-}
-
-#[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
-impl Walls {
-    /// `auto`'s fallback: scene triangles per part at uniform depth (Torus
-    /// Knots: 32 parts, Armadillo and Nefertiti: 64).
-    pub const TRIANGLES_PER_PART: usize = 2_000;
-
-    /// The depth of the cut tree (`2^depth` parts, at most 4096) for a
-    /// scene of `triangles` triangles.
-    pub fn depth(self, triangles: usize) -> usize {
-        let parts = match self {
-            Walls::None => 1,
-            Walls::Parts(n) => n as usize,
-            Walls::Auto => {
-                let x = triangles as f64 / Self::TRIANGLES_PER_PART as f64;
-                x.max(1.0).log2().round().exp2() as usize
-            }
-        };
-        parts.clamp(1, 4096).next_power_of_two().trailing_zeros() as usize
-    }
 }
 
 /// `build` arguments.
@@ -308,24 +225,6 @@ pub struct SubmitArgs {
     pub dry_run: bool,
 }
 
-/// Memory per part task.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MemPerPart {
-    /// From the plan's predictions.
-    Auto,
-    /// This many bytes.
-    Bytes(u64),
-}
-
-/// Parses `auto` or a memory size ([`parse_memory_limit`]).
-pub fn parse_mem_per_part(s: &str) -> Result<MemPerPart, String> {
-    if s.trim().eq_ignore_ascii_case("auto") {
-        Ok(MemPerPart::Auto)
-    } else {
-        parse_memory_limit(s).map(MemPerPart::Bytes)
-    }
-}
-
 /// `info` arguments.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
@@ -339,107 +238,6 @@ pub struct InfoArgs {
     /// Build options (ignored for mesh files).
     #[command(flatten)]
     pub build: BuildFlags,
-}
-
-/// Traversal methods.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, ValueEnum, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Method {
-    /// Scalar triple products (Lagae & Dutré 2008; 32-byte baseline layout).
-    Sctp,
-    /// Plücker traversal (Maria et al. 2017; Tet80 layout).
-    Tet80,
-    /// Tet80 with consistent side products: one per edge, the same in
-    /// every tet around it (canonical edge orientation, one rule for zero).
-    Tet80Consistent,
-    /// 2-D projected traversal of Aman et al. (2022) on Tet32.
-    Tet32,
-    /// 2-D projected traversal of Aman et al. (2022) on Tet20.
-    Tet20,
-    /// 2-D projected traversal of Aman et al. (2022) on Tet16.
-    Tet16,
-    /// BVH baseline (obvhs, BVH2).
-    Obvhs,
-    /// Ray-Strips (Lauterbach et al. 2007): strip hierarchies under an SAH BVH,
-    /// one ray at a time.
-    Strips,
-    /// Ray-Strips with 2×2 ray packets (groups of four consecutive rays).
-    StripsPackets,
-    /// Embree 3, one `rtcIntersect1` per ray (needs the `embree` feature).
-    Embree,
-    /// Embree 3, `rtcIntersect8` on packets of 8 rays (needs the `embree` feature).
-    Embree8,
-    /// f64 brute force over all triangles (reference; slow).
-    Brute,
-    /// The exact reference walk: exact side products with a symbolic tie
-    /// rule (reference; not in the default comparisons).
-    Exact,
-    /// Tet20 walk as a wgpu compute shader (needs the `gpu` feature).
-    GpuTet20,
-    /// Tet32 on the GPU.
-    GpuTet32,
-    /// Tet16 on the GPU.
-    GpuTet16,
-    /// Tet80 (Plücker) on the GPU.
-    GpuTet80,
-}
-
-impl Method {
-    /// Name as on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Sctp => "sctp",
-            Method::Tet80 => "tet80",
-            Method::Tet80Consistent => "tet80-consistent",
-            Method::Tet32 => "tet32",
-            Method::Tet20 => "tet20",
-            Method::Tet16 => "tet16",
-            Method::Obvhs => "obvhs",
-            Method::Strips => "strips",
-            Method::StripsPackets => "strips-packets",
-            Method::Embree => "embree",
-            Method::Embree8 => "embree8",
-            Method::Brute => "brute",
-            Method::Exact => "exact",
-            Method::GpuTet20 => "gpu-tet20",
-            Method::GpuTet32 => "gpu-tet32",
-            Method::GpuTet16 => "gpu-tet16",
-            Method::GpuTet80 => "gpu-tet80",
-        }
-    }
-
-    /// The tet layout the method walks (a name of
-    /// `tet_core::memory::LAYOUT_NAMES`); `None` for the methods that walk
-    /// no layout (BVHs, Ray-Strips, brute force, the exact walk).
-    pub fn layout(self) -> Option<&'static str> {
-        match self {
-            Method::Sctp => Some("baseline32"),
-            Method::Tet80 | Method::Tet80Consistent | Method::GpuTet80 => Some("tet80"),
-            Method::Tet32 | Method::GpuTet32 => Some("tet32"),
-            Method::Tet20 | Method::GpuTet20 => Some("tet20"),
-            Method::Tet16 | Method::GpuTet16 => Some("tet16"),
-            Method::Obvhs
-            | Method::Strips
-            | Method::StripsPackets
-            | Method::Embree
-            | Method::Embree8
-            | Method::Brute
-            | Method::Exact => None,
-        }
-    }
-
-    /// True for the methods that walk tets (and so report tets per ray).
-    pub fn walks_tets(self) -> bool {
-        self.layout().is_some() || self == Method::Exact
-    }
-
-    /// True for the GPU methods.
-    pub fn is_gpu(self) -> bool {
-        matches!(
-            self,
-            Method::GpuTet20 | Method::GpuTet32 | Method::GpuTet16 | Method::GpuTet80
-        )
-    }
 }
 
 /// `render` arguments.
@@ -478,63 +276,6 @@ pub struct RenderArgs {
     /// Build options (ignored for mesh files).
     #[command(flatten)]
     pub build: BuildFlags,
-}
-
-/// The view: each flag given replaces that part of the scene's camera (or
-/// of the default camera, which frames the whole scene from outside on
-/// its +z side). Checked before anything is traced: finite coordinates,
-/// an eye away from the target, an up direction not along the line of
-/// sight, and a field of view strictly between 0 and 180 degrees.
-#[derive(Debug, Clone, Copy, Default, Args)]
-pub struct ViewArgs {
-    /// Camera position `X,Y,Z`, replacing the scene's camera position (without
-    /// a scene camera: outside the scene on its +z side, framing it).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub eye: Option<glam::Vec3>,
-    /// Point `X,Y,Z` the camera looks at (default: the scene camera's target,
-    /// or the centre of the scene).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub target: Option<glam::Vec3>,
-    /// Up direction `X,Y,Z` of the image, across the line of sight (default:
-    /// the scene camera's, or +y).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub up: Option<glam::Vec3>,
-    /// Vertical field of view in degrees, between 0 and 180 (default: the
-    /// scene camera's, or 60).
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
-    pub fov: Option<f32>,
-}
-
-/// Parses `X,Y,Z` (three finite numbers separated by commas).
-pub fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    let [x, y, z] = parts.as_slice() else {
-        return Err(format!(
-            "`{s}` is not a point: give three numbers separated by commas, e.g. 0,1.5,-4"
-        ));
-    };
-    let mut v = [0.0f32; 3];
-    for (out, text) in v.iter_mut().zip([x, y, z]) {
-        *out = text
-            .parse::<f32>()
-            .map_err(|_| format!("`{text}` in `{s}` is not a number"))?;
-        if !out.is_finite() {
-            return Err(format!("`{text}` in `{s}` is not finite"));
-        }
-    }
-    Ok(glam::Vec3::from_array(v))
-}
-
-/// Floating-point precision of the kernels.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Precision {
-    /// f32 kernels.
-    F32,
-    /// f64 kernels.
-    F64,
-    /// Both.
-    Both,
 }
 
 /// `accuracy` arguments.
@@ -681,131 +422,6 @@ impl TablesArgs {
     }
 }
 
-/// How `build --memory-limit` splits a scene whose prediction exceeds the
-/// limit.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum Planner {
-    /// The paper's recursive tree, parallel slabs when no tree fits.
-    #[default]
-    Auto,
-    /// Only the paper's recursive tree (perpendicular planes).
-    Tree,
-    /// Only parallel slabs on the axis of largest variance.
-    Slabs,
-}
-
-/// How the parts of an out-of-core build are merged.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum MergeMode {
-    /// Part files merged into the mesh file a part at a time (each part
-    /// Hilbert-sorted on its own): the merge holds one part and the seams.
-    #[default]
-    Stream,
-    /// The whole mesh merged in memory and Hilbert-sorted as a whole.
-    Memory,
-}
-
-/// Parses a memory size: a byte count, or a number with a unit `K`, `M`,
-/// `G`, `T` (also `KB`/`KiB`, …, any case), all powers of 1024: `512M`,
-/// `1.5G`, `2097152`.
-pub fn parse_memory_limit(s: &str) -> Result<u64, String> {
-    let t = s.trim();
-    let split = t
-        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
-        .unwrap_or(t.len());
-    let (num, unit) = t.split_at(split);
-    let unit = unit.trim().to_ascii_lowercase();
-    let scale: f64 = match unit.as_str() {
-        "" | "b" => 1.0,
-        "k" | "kb" | "kib" => 1024.0,
-        "m" | "mb" | "mib" => 1024.0 * 1024.0,
-        "g" | "gb" | "gib" => 1024.0 * 1024.0 * 1024.0,
-        "t" | "tb" | "tib" => 1024.0 * 1024.0 * 1024.0 * 1024.0,
-        _ => {
-            return Err(format!(
-                "unknown unit `{unit}` in `{s}`: give bytes or a number with K, M, G or T (powers of 1024), e.g. 512M or 1.5G"
-            ));
-        }
-    };
-    let value: f64 = num.parse().map_err(|_| {
-        format!("`{s}` is not a memory size: give bytes or a number with K, M, G or T, e.g. 512M or 1.5G")
-    })?;
-    let bytes = value * scale;
-    if !(bytes >= 1.0 && bytes < u64::MAX as f64) {
-        return Err(format!(
-            "memory limit `{s}` must be at least one byte and finite"
-        ));
-    }
-    Ok(bytes.round() as u64)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `--walls`: counts and `auto`, the tree depth they give, and what
-    /// is refused.
-    #[test]
-    fn walls_parse_as_part_counts_or_auto() {
-        assert_eq!(parse_walls("auto"), Ok(Walls::Auto));
-        assert_eq!(parse_walls(" 8 "), Ok(Walls::Parts(8)));
-        assert_eq!(parse_walls("None"), Ok(Walls::None));
-        assert_eq!(Walls::None.depth(100_000), 0);
-        for bad in ["0", "4097", "-2", "x", ""] {
-            assert!(parse_walls(bad).is_err(), "{bad}");
-        }
-        // Rounded up to a power of two.
-        assert_eq!(Walls::Parts(1).depth(10), 0);
-        assert_eq!(Walls::Parts(5).depth(10), 3);
-        assert_eq!(Walls::Parts(4096).depth(10), 12);
-        // One part per about 2,000 triangles, to the nearest power of two.
-        assert_eq!(Walls::Auto.depth(500), 0);
-        assert_eq!(Walls::Auto.depth(77_760), 5);
-        assert_eq!(Walls::Auto.depth(100_000), 6);
-        assert_eq!(Walls::Auto.depth(u32::MAX as usize), 12);
-    }
-
-    #[test]
-    fn steiner_caps_parse_as_counts_or_shares_of_the_vertices() {
-        assert_eq!(parse_max_steiner("500"), Ok(MaxSteiner::Count(500)));
-        assert_eq!(parse_max_steiner("1%"), Ok(MaxSteiner::Percent(1.0)));
-        assert_eq!(parse_max_steiner("0.5 %"), Ok(MaxSteiner::Percent(0.5)));
-        for bad in [
-            "", "%", "-1", "0%", "-2%", "1e9999%", "nan%", "x", "5 points",
-        ] {
-            assert!(parse_max_steiner(bad).is_err(), "{bad}");
-        }
-        // 1 % of 38,888 vertices is 388.88: rounded up.
-        assert_eq!(MaxSteiner::Percent(1.0).resolve(38_888), 389);
-        assert_eq!(MaxSteiner::Percent(1.0).resolve(0), 0);
-        assert_eq!(MaxSteiner::Count(7).resolve(1_000_000), 7);
-    }
-
-    #[test]
-    fn memory_sizes_parse_with_binary_units() {
-        assert_eq!(parse_memory_limit("2097152"), Ok(2_097_152));
-        assert_eq!(parse_memory_limit("512M"), Ok(512 << 20));
-        assert_eq!(parse_memory_limit("512mb"), Ok(512 << 20));
-        assert_eq!(parse_memory_limit("1.5G"), Ok(3 << 29));
-        assert_eq!(parse_memory_limit("64 KiB"), Ok(64 << 10));
-        for bad in ["", "M", "12X", "-5M", "1.2.3G", "0", "0.1"] {
-            let e = parse_memory_limit(bad).unwrap_err();
-            assert!(e.contains(bad.trim()), "{bad}: {e}");
-        }
-    }
-
-    #[test]
-    fn points_parse_as_three_finite_numbers() {
-        assert_eq!(
-            parse_vec3("1,-2.5, 3e2"),
-            Ok(glam::Vec3::new(1.0, -2.5, 300.0))
-        );
-        for bad in ["", "1,2", "1,2,3,4", "1,x,3", "1,inf,3", "NaN,0,0", "1;2;3"] {
-            assert!(parse_vec3(bad).is_err(), "{bad}");
-        }
-    }
-}
-
 /// `iso` arguments.
 #[derive(Debug, Args)]
 pub struct IsoArgs {
@@ -895,9 +511,19 @@ pub fn parse_box(s: &str) -> Result<(glam::Vec3, glam::Vec3), String> {
     Ok((a.min(b), a.max(b)))
 }
 
+/// `convert` arguments.
+#[derive(Debug, Args)]
+pub struct ConvertArgs {
+    /// Input: a mesh file, VTK file, TetGen `.node` file or synthetic
+    /// volume name.
+    pub input: String,
+    /// Output, by extension: `.tmesh` (any other extension too), `.vtk`,
+    /// `.vtu`, `.pvd`, or `.node` (TetGen files beside it).
+    pub output: PathBuf,
+}
+
 #[cfg(test)]
-mod iso_args_tests {
-    use clap::Parser;
+mod tests {
     use glam::Vec3;
 
     use super::*;
@@ -918,30 +544,6 @@ mod iso_args_tests {
         ] {
             assert!(parse_box(bad).is_err(), "{bad}");
         }
-    }
-
-    /// The walls a build uses: `auto` by default, none where there is no
-    /// box or a quality bound is asked for, and what `--walls` says.
-    #[test]
-    fn builds_are_walled_by_default_but_not_refined_or_boxless_ones() {
-        let walls = |extra: &[&str]| {
-            let mut argv = vec!["tet-bench", "build", "torus-knot", "-o", "x.tmesh"];
-            argv.extend_from_slice(extra);
-            let Command::Build(a) = Cli::try_parse_from(argv).unwrap().command else {
-                panic!("not build")
-            };
-            (a.build.walls(), a.build.resolved().walls)
-        };
-        assert_eq!(walls(&[]), (Walls::Auto, Some(Walls::Auto)));
-        assert_eq!(walls(&["--no-box"]).0, Walls::None);
-        assert_eq!(walls(&["--quality", "5"]).0, Walls::None);
-        assert_eq!(walls(&["--min-dihedral", "2"]).0, Walls::None);
-        assert_eq!(walls(&["--max-steiner", "1%"]).0, Walls::Auto);
-        assert_eq!(walls(&["--walls", "none"]).0, Walls::None);
-        assert_eq!(
-            walls(&["--walls", "8", "--quality", "5"]).0,
-            Walls::Parts(8)
-        );
     }
 
     #[test]
@@ -987,174 +589,4 @@ mod iso_args_tests {
             .is_err()
         );
     }
-}
-
-/// `convert` arguments.
-#[derive(Debug, Args)]
-pub struct ConvertArgs {
-    /// Input: a mesh file, VTK file, TetGen `.node` file or synthetic
-    /// volume name.
-    pub input: String,
-    /// Output, by extension: `.tmesh` (any other extension too), `.vtk`,
-    /// `.vtu`, `.pvd`, or `.node` (TetGen files beside it).
-    pub output: PathBuf,
-}
-
-/// Isosurface methods (`--method`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, ValueEnum, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum IsoMethod {
-    /// The paper's implicit min-max BVH, BIH-style build, single rays.
-    Ibvh,
-    /// The same with the SAH build.
-    IbvhSah,
-    /// The BIH-built IBVH traced by 16×16 packets.
-    IbvhPackets,
-    /// The iso walk over Tet20 (no BVH over the tets).
-    WalkTet20,
-    /// The iso walk over Tet16.
-    WalkTet16,
-    /// The iso walk over Tet32.
-    WalkTet32,
-}
-
-impl IsoMethod {
-    /// Every method, in table order.
-    pub const ALL: [IsoMethod; 6] = [
-        IsoMethod::Ibvh,
-        IsoMethod::IbvhSah,
-        IsoMethod::IbvhPackets,
-        IsoMethod::WalkTet20,
-        IsoMethod::WalkTet16,
-        IsoMethod::WalkTet32,
-    ];
-
-    /// Name as on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            IsoMethod::Ibvh => "ibvh",
-            IsoMethod::IbvhSah => "ibvh-sah",
-            IsoMethod::IbvhPackets => "ibvh-packets",
-            IsoMethod::WalkTet20 => "walk-tet20",
-            IsoMethod::WalkTet16 => "walk-tet16",
-            IsoMethod::WalkTet32 => "walk-tet32",
-        }
-    }
-}
-
-impl BuildFlags {
-    /// The walls these flags build with: `--walls` as given, else `auto`
-    /// for the unrefined build in a box and `none` where there is no box
-    /// to cut or a quality bound is asked for (the papers' refined builds
-    /// are one piece).
-    pub fn walls(&self) -> Walls {
-        self.walls.unwrap_or(
-            if self.no_box || self.quality.is_some() || self.min_dihedral.is_some() {
-                Walls::None
-            } else {
-                Walls::Auto
-            },
-        )
-    }
-
-    /// These flags with the walls they build with spelled out: builds that
-    /// come out the same compare equal.
-    pub fn resolved(&self) -> BuildFlags {
-        BuildFlags {
-            walls: Some(self.walls()),
-            ..*self
-        }
-    }
-
-    /// The TetGen options these flags ask for: every TetGen flag given
-    /// replaces its default, the rest keep [`tet_build::tetgen_options::TetgenOptions::default`]. The
-    /// one mapping for in-core, out-of-core and job builds.
-    /// `--max-steiner P%` is resolved against the scene's
-    /// `scene_vertices` (rounded up; the out-of-core parts each get the
-    /// resulting cap).
-    #[cfg_attr(not(feature = "tetgen"), allow(dead_code))]
-    pub fn tetgen_options(
-        &self,
-        scene_vertices: usize,
-    ) -> tet_build::tetgen_options::TetgenOptions {
-        let d = tet_build::tetgen_options::TetgenOptions::default();
-        tet_build::tetgen_options::TetgenOptions {
-            quality: self.quality,
-            max_steiner: self.max_steiner.map(|m| m.resolve(scene_vertices)),
-            min_dihedral: self.min_dihedral.or(d.min_dihedral),
-            optimization: self.optimize.or(d.optimization),
-            max_dihedral: self.max_dihedral.or(d.max_dihedral),
-            ..d
-        }
-    }
-}
-
-/// `--max-steiner`: a number of Steiner points, or a share of the scene's
-/// vertices.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum MaxSteiner {
-    /// At most this many.
-    Count(u64),
-    /// At most this percentage of the scene's vertices (rounded up).
-    Percent(f64),
-}
-
-impl MaxSteiner {
-    /// The cap for a scene of `vertices` vertices.
-    pub fn resolve(self, vertices: usize) -> u64 {
-        match self {
-            MaxSteiner::Count(n) => n,
-            MaxSteiner::Percent(p) => (vertices as f64 * p / 100.0).ceil() as u64,
-        }
-    }
-}
-
-/// Parses `--walls N` (1 to 4096 parts), `--walls auto` or `--walls none`.
-fn parse_walls(s: &str) -> Result<Walls, String> {
-    if s.trim().eq_ignore_ascii_case("auto") {
-        return Ok(Walls::Auto);
-    }
-    if s.trim().eq_ignore_ascii_case("none") {
-        return Ok(Walls::None);
-    }
-    s.trim()
-        .parse::<u32>()
-        .ok()
-        .filter(|n| (1..=4096).contains(n))
-        .map(Walls::Parts)
-        .ok_or_else(|| {
-            format!("`{s}` is neither a count of parts from 1 to 4096 nor `auto` or `none`")
-        })
-}
-
-/// Parses `--max-steiner N` or `--max-steiner P%` (P in (0, 1000]).
-fn parse_max_steiner(s: &str) -> Result<MaxSteiner, String> {
-    match s.strip_suffix('%') {
-        Some(p) => p
-            .trim()
-            .parse::<f64>()
-            .ok()
-            .filter(|p| *p > 0.0 && *p <= 1000.0)
-            .map(MaxSteiner::Percent)
-            .ok_or_else(|| format!("`{s}` is not a percentage above 0 and at most 1000")),
-        None => s
-            .parse::<u64>()
-            .map(MaxSteiner::Count)
-            .map_err(|_| format!("`{s}` is neither a count of points nor a percentage (`1%`)")),
-    }
-}
-
-/// Parses `--optimize LEVEL/SCHEME` (`7/7`; a bare `LEVEL` keeps scheme 7).
-fn parse_optimization(s: &str) -> Result<tet_build::tetgen_options::Optimization, String> {
-    let (level, scheme) = s.split_once('/').unwrap_or((s, "7"));
-    let digit = |x: &str, max: u8, what: &str| {
-        x.parse::<u8>()
-            .ok()
-            .filter(|v| *v <= max)
-            .ok_or_else(|| format!("{what} `{x}` is not a number from 0 to {max}"))
-    };
-    Ok(tet_build::tetgen_options::Optimization {
-        level: digit(level, 9, "level")?,
-        scheme: digit(scheme, 7, "scheme")?,
-    })
 }

@@ -20,6 +20,7 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
 use glam::Vec3;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -32,7 +33,47 @@ use tet_trace_cpu::iso::{
 };
 use tet_trace_cpu::render::PinholeCamera;
 
-pub use crate::cli::IsoMethod;
+/// Isosurface methods (`--method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IsoMethod {
+    /// The paper's implicit min-max BVH, BIH-style build, single rays.
+    Ibvh,
+    /// The same with the SAH build.
+    IbvhSah,
+    /// The BIH-built IBVH traced by 16×16 packets.
+    IbvhPackets,
+    /// The iso walk over Tet20 (no BVH over the tets).
+    WalkTet20,
+    /// The iso walk over Tet16.
+    WalkTet16,
+    /// The iso walk over Tet32.
+    WalkTet32,
+}
+
+impl IsoMethod {
+    /// Every method, in table order.
+    pub const ALL: [IsoMethod; 6] = [
+        IsoMethod::Ibvh,
+        IsoMethod::IbvhSah,
+        IsoMethod::IbvhPackets,
+        IsoMethod::WalkTet20,
+        IsoMethod::WalkTet16,
+        IsoMethod::WalkTet32,
+    ];
+
+    /// Name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            IsoMethod::Ibvh => "ibvh",
+            IsoMethod::IbvhSah => "ibvh-sah",
+            IsoMethod::IbvhPackets => "ibvh-packets",
+            IsoMethod::WalkTet20 => "walk-tet20",
+            IsoMethod::WalkTet16 => "walk-tet16",
+            IsoMethod::WalkTet32 => "walk-tet32",
+        }
+    }
+}
 
 /// A volume ready to trace: the mesh with its field, and an isovalue that
 /// gives a surface.

@@ -1,21 +1,24 @@
 //! `tet-bench`: the user-facing command-line tool and benchmark harness.
 //! See the README for every subcommand and the `--json` schema.
 //!
-//! The modules lie in layers; each uses only the layers below it:
+//! The modules lie in layers; each uses only the layers below it (and,
+//! within a layer, the modules named before it):
 //!
 //! 1. commands — [`commands`] (`build`, `info`, `render`, `accuracy`,
 //!    `iso`, `convert`, and the job commands `build --plan`, `build-part`,
-//!    `merge`, `job status`, `submit`) and
-//!    [`tables`] (one module per paper table, the driver, and the report
-//!    writers: Markdown, CSV, JSON, SVG figures);
-//! 2. measurement, returning plain serialisable data — [`timing`], [`gpu`],
-//!    [`layouts`], [`accuracy`], [`extremes`], [`exitface`], [`outofcore`],
-//!    [`iso`];
-//! 3. plumbing — [`load`] (scenes and mesh files), [`camera`] (the default
-//!    view and the view flags), [`methods`] with the tracers that are not
-//!    in `tet-trace-cpu` ([`bvh`], [`strips`], [`brute`], `embree`), [`plots`] (SVG
-//!    drawing), [`output`] (stdout and error text) and [`cli`] (the
-//!    arguments).
+//!    `merge`, `job status`, `submit`) and [`tables`] (one module per paper
+//!    table, the driver, and the report writers: Markdown, CSV, JSON, SVG
+//!    figures);
+//! 2. the command line — [`cli`] (the subcommands and their arguments; the
+//!    values they name are defined below);
+//! 3. measurement, returning plain serialisable data — [`timing`] (speed,
+//!    CPU and GPU), [`accuracy`] (against an f64 reference), [`iso`]
+//!    (isosurfaces of tet volumes) and [`outofcore`] (builds under a
+//!    memory limit);
+//! 4. the traversal methods — [`methods`] (what a `--method` names, the
+//!    tracers that are not in `tet-trace-cpu`, the bytes of each layout);
+//! 5. plumbing — [`load`] (scenes and mesh files, the build flags, the
+//!    camera) and [`output`] (stdout and error text).
 #![deny(missing_docs)]
 // A binary exports nothing, so `missing_docs` checks only the crate root;
 // clippy's lint holds every module, item and field to the same rule.
@@ -23,28 +26,13 @@
 #![deny(clippy::print_stdout)]
 
 mod accuracy;
-mod accuracy_scale;
-mod adversarial;
-mod brute;
-mod bvh;
-mod camera;
 mod cli;
 mod commands;
-#[cfg(feature = "embree")]
-mod embree;
-mod exitface;
-mod extremes;
-mod failed_rays;
-mod gpu;
-mod grazing;
 mod iso;
-mod layouts;
 mod load;
 mod methods;
 mod outofcore;
 mod output;
-mod plots;
-mod strips;
 mod tables;
 mod timing;
 

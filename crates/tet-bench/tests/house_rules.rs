@@ -416,7 +416,6 @@ fn readme_is_short() {
     );
 }
 
-
 /// The lines of `text` without their indentation and comment markers
 /// (`//!`, `///`, `//`, a block comment's `*`), joined by single spaces and
 /// lower-cased, so that a phrase wrapped across comment lines reads as one.

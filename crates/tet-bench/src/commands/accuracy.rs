@@ -5,9 +5,10 @@ use anyhow::{Result, bail};
 use serde::Serialize;
 
 use crate::accuracy::{CaseAccuracy, RayPlan, all_cases};
-use crate::cli::{AccuracyArgs, Method};
+use crate::cli::AccuracyArgs;
 use crate::load::{load, require_tets};
 use crate::methods::cpu_methods;
+use crate::methods::method::Method;
 use crate::output::{outln, print_json};
 
 /// The `accuracy` document.

@@ -11,8 +11,10 @@ use tet_core::TetMesh;
 use tet_core::scene::SceneInfo;
 
 use super::text::print_build;
-use crate::cli::{BuildArgs, MergeMode, Walls};
+use crate::cli::BuildArgs;
+use crate::load::build_flags::Walls;
 use crate::load::{BuildSummary, MESH_EXTENSION, load};
+use crate::outofcore::options::MergeMode;
 use crate::outofcore::{Limited, MemoryReport, predict, tet20_speed};
 use crate::output::{outln, print_json};
 use crate::timing::RenderDoc;

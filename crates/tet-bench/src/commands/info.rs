@@ -5,8 +5,8 @@ use anyhow::Result;
 
 use super::text::print_build;
 use crate::cli::InfoArgs;
-use crate::layouts::{LayoutBytes, info};
 use crate::load::load;
+use crate::methods::layouts::{LayoutBytes, info};
 use crate::output::{outln, print_json};
 
 /// Bytes as MB (10⁶ bytes).

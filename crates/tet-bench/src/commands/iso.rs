@@ -6,9 +6,9 @@ use tet_trace_cpu::render::{Frame, FrameStats};
 
 use tet_trace_cpu::iso::{ClipBox, ClipMode};
 
-use crate::camera::apply_view;
 use crate::cli::{IsoArgs, IsoClipMode};
 use crate::iso::{IsoFrames, IsoLight, IsoView, load_iso_volume_with, measure, shade};
+use crate::load::camera::apply_view;
 use crate::output::{outln, print_json};
 use crate::timing::pool;
 

@@ -5,9 +5,9 @@ use anyhow::{Result, bail};
 use tet_trace_cpu::render::RenderOptions;
 
 use crate::cli::RenderArgs;
-use crate::gpu::time_gpu;
 use crate::load::{load, require_tets};
 use crate::output::{outln, print_json};
+use crate::timing::gpu::time_gpu;
 use crate::timing::{pool, time_method};
 
 /// `tet-bench render`.

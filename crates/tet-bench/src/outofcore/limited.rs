@@ -22,9 +22,10 @@ use tet_build::outofcore::tree_memory::TreeSampler;
 use tet_core::TetMesh;
 use tet_core::scene::SceneInfo;
 
+use super::options::Planner;
 use super::predict::predict;
 use super::types::{Limited, MemoryReport, Written, mib};
-use crate::cli::Planner;
+use crate::load::build_flags::{BuildFlags, Walls};
 use crate::load::{BuildSummary, CleaningSummary};
 
 /// The split chosen.
@@ -191,8 +192,8 @@ impl Limited<'_> {
         let own = builder_bytes(self.scene.triangles.len());
         let predicted = predict(self.scene, self.flags.no_box)?.predicted_peak_bytes;
         // The limit chooses the parts: where the scene fits, one piece.
-        let one_piece = crate::cli::BuildFlags {
-            walls: Some(crate::cli::Walls::None),
+        let one_piece = BuildFlags {
+            walls: Some(Walls::None),
             ..*self.flags
         };
         let (mesh, build) =
@@ -319,7 +320,7 @@ impl Limited<'_> {
         // (`--walls auto`), cut toward the part size of that build where
         // the share is larger: a mesh shaped for rays (the job planner
         // cuts the same way). `--walls none`: for the limit alone.
-        let shaped = self.flags.walls() == crate::cli::Walls::Auto;
+        let shaped = self.flags.walls() == Walls::Auto;
         let share =
             |p: usize| SplitOptions::under_limit(worker_share(limit_bytes, triangles, p), shaped);
         let max_parallel = self.max_parallel.max(1);

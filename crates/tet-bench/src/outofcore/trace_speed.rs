@@ -8,7 +8,8 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use tet_trace_cpu::render::RenderOptions;
 
-use crate::cli::{BuildFlags, Method};
+use crate::load::build_flags::BuildFlags;
+use crate::methods::method::Method;
 use crate::timing::{RenderDoc, pool, time_method};
 
 /// Image width of the measurement.

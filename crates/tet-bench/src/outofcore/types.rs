@@ -4,7 +4,8 @@
 use serde::{Deserialize, Serialize};
 use tet_build::scene::Scene;
 
-use crate::cli::{BuildFlags, Planner};
+use super::options::Planner;
+use crate::load::build_flags::BuildFlags;
 
 /// Bytes as MiB.
 #[cfg_attr(not(feature = "tetgen"), allow(dead_code))]

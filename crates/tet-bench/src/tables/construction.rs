@@ -10,9 +10,9 @@ use anyhow::Result;
 
 use super::doc::TablesDoc;
 use super::paper::paper_scene;
-use crate::bvh::BvhTracer;
-use crate::layouts::{Info, info};
 use crate::load::Loaded;
+use crate::methods::bvh::BvhTracer;
+use crate::methods::layouts::{Info, info};
 
 /// The scene's counts and layout bytes, and the seconds to build its BVH.
 pub fn measure(loaded: &Loaded) -> Result<(Info, f64)> {

@@ -6,12 +6,12 @@
 use serde::Serialize;
 
 use crate::accuracy::{CaseAccuracy, MethodAccuracy};
-use crate::cli::BuildFlags;
-use crate::exitface::ExitFaceTable;
-use crate::layouts::Info;
 use crate::load::BuildSummary;
+use crate::load::build_flags::BuildFlags;
+use crate::methods::layouts::Info;
 use crate::outofcore::MemoryReport;
 use crate::timing::RenderDoc;
+use crate::timing::exitface::ExitFaceTable;
 
 /// True for the scene the papers' Torus Knots numbers belong to: the
 /// procedural `torus-knots` or a scenes.json's "Torus Knots".
@@ -209,7 +209,7 @@ pub const TABLE_FLAGS: BuildFlags = BuildFlags {
 
 /// Speed against accuracy (Maria et al. 2017, Table 4 beside render speed): every CPU method in f32 and,
 /// where it has one, f64, on the first scene as given and on its extreme
-/// cases ([`crate::extremes`]).
+/// cases ([`crate::accuracy::extremes`]).
 #[derive(Clone, Debug, Serialize)]
 pub struct SpeedAccuracy {
     /// The scene's spec.

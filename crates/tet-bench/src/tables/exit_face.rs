@@ -1,12 +1,12 @@
 //! Exit-face search (Maria et al. 2017, Table 5): the cost of one
 //! exit-face decision per method, and whole walks on the same grid
-//! (measured by [`crate::exitface`], single thread).
+//! (measured by [`crate::timing::exitface`], single thread).
 
 use std::fmt::Write as _;
 
 use anyhow::Result;
 
-use crate::exitface::{self, ExitFaceSizes, ExitFaceTable};
+use crate::timing::exitface::{self, ExitFaceSizes, ExitFaceTable};
 
 /// The exit-face table, at the quick or full sizes.
 pub fn measure(quick: bool) -> Result<ExitFaceTable> {

@@ -1,5 +1,5 @@
 //! The SVG figures of a `tables` run, drawn from the measured
-//! [`TablesDoc`] with [`crate::plots`]:
+//! [`TablesDoc`] with [`super::plots`]:
 //!
 //! * `speed_vs_accuracy.svg` — Mrays/s (render) against failures per 1024²
 //!   rays (accuracy), one circle per method and scene: Maria et al.'s
@@ -16,8 +16,8 @@
 use anyhow::Result;
 
 use super::doc::TablesDoc;
-use crate::cli::Method;
-use crate::plots::{BarGroup, Point, bars_svg, scatter_svg};
+use super::plots::{BarGroup, Point, bars_svg, scatter_svg};
+use crate::methods::method::Method;
 
 /// The figures of a `tables` run: `(file name, SVG)`.
 pub fn figures(doc: &TablesDoc) -> Result<Vec<(&'static str, String)>> {

@@ -8,11 +8,11 @@ use tet_trace_cpu::render::RenderOptions;
 
 use super::doc::TablesDoc;
 use super::paper::paper_scene;
-use crate::cli::Method;
-use crate::gpu::time_gpu;
 use crate::load::Loaded;
+use crate::methods::method::Method;
 use crate::output::error_chain;
 use crate::timing::RenderDoc;
+use crate::timing::gpu::time_gpu;
 
 /// The GPU methods' rows, or why there are none.
 pub fn measure(

@@ -24,10 +24,10 @@ use tet_core::{Attributes, TetMesh};
 use tet_trace_cpu::render::RenderOptions;
 
 use super::doc::{LargeModelRow, LargeStructure, TablesDoc};
-use crate::bvh::BvhTracer;
-use crate::cli::Method;
-use crate::layouts::strips_bytes;
 use crate::load::Loaded;
+use crate::methods::bvh::BvhTracer;
+use crate::methods::layouts::strips_bytes;
+use crate::methods::method::Method;
 use crate::timing::time_method;
 
 /// Bytes each structure needs per triangle while it is built and timed
@@ -169,8 +169,8 @@ fn tet20(
     }
     eprintln!("  {}: building the CDT", scene.name);
     use super::doc::TABLE_FLAGS;
-    use crate::layouts::layout_bytes;
     use crate::load::from_scene;
+    use crate::methods::layouts::layout_bytes;
     let loaded = from_scene(scene, &TABLE_FLAGS, true)?;
     let build_s = loaded.build.as_ref().map_or(0.0, |b| b.total_s);
     let bytes = layout_bytes(&loaded.mesh)

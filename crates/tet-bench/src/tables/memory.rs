@@ -1,6 +1,6 @@
 //! Bytes per layout (Aman et al. 2022, Table 4): hot and cold bytes of
 //! every layout per scene (measured with the construction table, by
-//! [`crate::layouts::info`]), beside the paper's numbers for that scene
+//! [`crate::methods::layouts::info`]), beside the paper's numbers for that scene
 //! (their meshes are larger: compare bytes per tet, or the ratios between
 //! layouts).
 

@@ -35,7 +35,8 @@
 //!
 //! This module is the driver: it plans the scenes ([`plan`](mod@plan)), measures
 //! each table into a [`doc::TablesDoc`], and hands it to the report
-//! writers: Markdown, CSV and JSON ([`report`]) and SVG ([`figures`]).
+//! writers: Markdown, CSV and JSON ([`report`]) and SVG ([`figures`],
+//! drawn with [`plots`]).
 //!
 //! Scenes with the same geometry (the Armadillo Zoom series, Mix / Mix
 //! close: same objects, other cameras) are built once, in an enclosing box
@@ -54,6 +55,7 @@ mod out_of_core;
 mod out_of_core_large;
 mod paper;
 mod plan;
+mod plots;
 mod quality;
 mod render_speed;
 mod report;
@@ -69,8 +71,9 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use tet_trace_cpu::render::RenderOptions;
 
-use crate::cli::{Method, TablesArgs};
+use crate::cli::TablesArgs;
 use crate::methods::cpu_methods;
+use crate::methods::method::Method;
 use crate::output::{error_chain, outln, print_json};
 use crate::timing::{pool, target_features};
 use doc::{QualityTrade, SceneResult, Setup, TABLE_FLAGS, TablesDoc};

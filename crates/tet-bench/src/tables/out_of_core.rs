@@ -13,7 +13,7 @@
 use std::fmt::Write as _;
 
 use super::doc::{Quality, TablesDoc};
-use crate::cli::Method;
+use crate::methods::method::Method;
 
 #[cfg(feature = "tetgen")]
 pub use measuring::{build_in_own_process, measure};
@@ -22,7 +22,7 @@ pub use measuring::{build_in_own_process, measure};
 /// TetGen, so only with the `tetgen` feature).
 #[cfg(feature = "tetgen")]
 mod measuring {
-    use crate::cli::Method;
+    use crate::methods::method::Method;
     use crate::tables::doc::{OutOfCoreRow, Quality, TABLE_FLAGS};
     use std::path::Path;
     use std::process::Command;

@@ -30,8 +30,8 @@ mod measuring {
     use tet_trace_cpu::render::RenderOptions;
 
     use crate::accuracy::{RayPlan, run_case};
-    use crate::cli::{Method, Precision};
     use crate::load::with_mesh;
+    use crate::methods::method::{Method, Precision};
     use crate::outofcore::predict;
     use crate::tables::doc::{LargeOutOfCoreRow, TABLE_FLAGS};
     use crate::tables::out_of_core::build_in_own_process;

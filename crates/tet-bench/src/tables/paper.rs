@@ -8,7 +8,7 @@
 //! 548 k), so absolute times and sizes do not compare; ratios within a
 //! table (a method against the BVH of the same run) do.
 
-use crate::cli::Method;
+use crate::methods::method::Method;
 
 /// One scene's published figures.
 pub struct PaperScene {

@@ -12,7 +12,8 @@ use glam::Vec3;
 use tet_build::scene::Scene;
 use tet_core::TetMesh;
 
-use crate::cli::{BuildFlags, TablesArgs};
+use crate::cli::TablesArgs;
+use crate::load::build_flags::BuildFlags;
 use crate::load::{BuildSummary, Loaded, MESH_EXTENSION, build_scene_in, load, with_mesh};
 
 /// The default run's flat-faced scene ("Flat Parts": CAD-like solids on one

@@ -15,8 +15,9 @@ use tet_trace_cpu::render::RenderOptions;
 
 use super::doc::{QualityTrade, TABLE_FLAGS, TablesDoc};
 use super::plan::{MeshCache, Planned};
-use crate::cli::{BuildFlags, MaxSteiner, Method};
 use crate::load::BuildSummary;
+use crate::load::build_flags::{BuildFlags, MaxSteiner};
+use crate::methods::method::Method;
 use crate::timing::time_method;
 
 /// The papers' setting: `-q5`, at most 2 M Steiner points.
@@ -47,7 +48,7 @@ pub const CAPPED: BuildFlags = BuildFlags {
 
 /// The scene in one TetGen run, `-pY`, no walls.
 pub const ONE_PIECE: BuildFlags = BuildFlags {
-    walls: Some(crate::cli::Walls::None),
+    walls: Some(crate::load::build_flags::Walls::None),
     ..TABLE_FLAGS
 };
 

@@ -11,9 +11,9 @@ use tet_trace_cpu::render::RenderOptions;
 
 use super::doc::{TablesDoc, is_torus_knots};
 use super::paper::paper_scene;
-use crate::cli::Method;
 use crate::load::Loaded;
 use crate::methods::cpu_methods;
+use crate::methods::method::Method;
 use crate::timing::{RenderDoc, time_method};
 
 /// neptun (the authors' C++ code) on a 2-core machine, Torus Knots,

@@ -7,16 +7,16 @@ use std::fmt::Write as _;
 use anyhow::Result;
 
 use super::doc::TablesDoc;
+use crate::accuracy::scale::run_streamed;
 use crate::accuracy::{CaseAccuracy, RayPlan, run_case};
-use crate::accuracy_scale::run_streamed;
-use crate::cli::{Method, Precision};
 use crate::load::Loaded;
+use crate::methods::method::{Method, Precision};
 
 /// Every CPU method (`methods`) in f32 on the scene's camera image and
 /// random interior rays (256² + 20,000 with `--quick`, else 1024² +
 /// 100,000), each method timed for at least `min_time_s`; or, with
 /// `streamed`, that many rays in batches (camera image, random and
-/// adversarial rays: [`crate::accuracy_scale`]).
+/// adversarial rays: [`crate::accuracy::scale`]).
 pub fn measure(
     spec: &str,
     loaded: &Loaded,

@@ -9,7 +9,8 @@ use tet_trace_cpu::render::RenderOptions;
 use super::doc::TablesDoc;
 use super::plan::{MeshCache, Planned};
 use super::variant::tet20_on_variant;
-use crate::cli::{BuildFlags, Method};
+use crate::load::build_flags::BuildFlags;
+use crate::methods::method::Method;
 use crate::timing::RenderDoc;
 
 /// tet20 on the scene built without Hilbert sorting.

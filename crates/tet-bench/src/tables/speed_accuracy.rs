@@ -1,6 +1,6 @@
 //! Speed against accuracy: every CPU method in f32 and, where it has one,
 //! f64, on the first scene as given and on its extreme cases (scaled,
-//! translated, slivers: [`crate::extremes`]) — Maria et al.'s robustness
+//! translated, slivers: [`crate::accuracy::extremes`]) — Maria et al.'s robustness
 //! (Maria et al. 2017, Table 4) beside the speed it costs.
 
 use std::fmt::Write as _;
@@ -9,9 +9,9 @@ use anyhow::Result;
 
 use super::doc::{SpeedAccuracy, TABLE_FLAGS};
 use crate::accuracy::{CaseAccuracy, RayPlan, all_cases};
-use crate::cli::Precision;
 use crate::load::load;
 use crate::methods::cpu_methods;
+use crate::methods::method::Precision;
 use crate::output::error_chain;
 
 /// Runs the speed-against-accuracy cases on `spec`, each method timed for

@@ -12,10 +12,10 @@ use anyhow::Result;
 use tet_trace_cpu::render::RenderOptions;
 
 use super::doc::{StripsRow, TablesDoc};
-use crate::bvh::BvhTracer;
-use crate::cli::Method;
 use crate::load::Loaded;
-use crate::strips::StripsTracer;
+use crate::methods::bvh::BvhTracer;
+use crate::methods::method::Method;
+use crate::methods::strips::StripsTracer;
 use crate::timing::time_method;
 
 /// The paper's Bunny row (67 k triangles): Table 1 MB (Ray-Strips total,

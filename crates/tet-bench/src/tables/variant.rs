@@ -7,7 +7,8 @@ use tet_trace_cpu::render::RenderOptions;
 
 use super::doc::TABLE_FLAGS;
 use super::plan::{MeshCache, Planned};
-use crate::cli::{BuildFlags, Method};
+use crate::load::build_flags::BuildFlags;
+use crate::methods::method::Method;
 use crate::timing::{RenderDoc, time_method};
 
 /// Times tet20 on `planned`'s scene built with `variant` (a change of the

@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use super::doc::{SceneResult, TablesDoc};
-use crate::cli::Method;
+use crate::methods::method::Method;
 
 /// Aman et al. (2022) Table 5 (Armadillo Zoom 0–5): Tet20 tets per pixel, BVH nodes
 /// per pixel, Tet20 ms, BVH ms.

@@ -9,8 +9,10 @@ use tet_build::outofcore::job::{PlanOptions, Planner, plan_job};
 use tet_build::outofcore::seam::SeamOptions;
 use tet_core::scene::SceneInfo;
 
-use crate::cli::{BuildArgs, Planner as CliPlanner};
+use crate::cli::BuildArgs;
 use crate::load::MESH_EXTENSION;
+use crate::load::build_flags::Walls;
+use crate::outofcore::options::Planner as PlannerOption;
 use crate::output::{outln, print_json};
 
 /// The `build --plan` document.
@@ -58,13 +60,13 @@ pub fn plan(args: &BuildArgs, dir: &Path, json: bool) -> Result<()> {
         limit_bytes: args.memory_limit,
         parts: args.parts.unwrap_or(1),
         planner: match args.planner {
-            CliPlanner::Auto => Planner::Auto,
-            CliPlanner::Tree => Planner::Tree,
-            CliPlanner::Slabs => Planner::Slabs,
+            PlannerOption::Auto => Planner::Auto,
+            PlannerOption::Tree => Planner::Tree,
+            PlannerOption::Slabs => Planner::Slabs,
         },
         // As the default build: walled unless `--walls none` (or a
         // quality bound, whose builds are one piece).
-        shaped_for_rays: flags.walls() == crate::cli::Walls::Auto,
+        shaped_for_rays: flags.walls() == Walls::Auto,
         sort_parts: !flags.no_sort,
         time_limit_s: flags.time_limit,
         scene_info: SceneInfo {

@@ -11,7 +11,8 @@ use serde::Serialize;
 use tet_build::outofcore::job::{JobManifest, PartState, job_status};
 
 use super::slurm::{SlurmPlan, merge_script, parts_script, submit_script};
-use crate::cli::{Engine, MemPerPart, SubmitArgs};
+use crate::cli::{Engine, SubmitArgs};
+use crate::outofcore::options::MemPerPart;
 use crate::output::{outln, print_json};
 
 /// Memory a part task asks for with `--mem-per-part auto`, from the plan's

@@ -1,4 +1,19 @@
-//! Which tracer implements each `--method` at each precision.
+//! The traversal methods: what a `--method` names and its precision
+//! ([`method`]), the tracers that are not in `tet-trace-cpu` — the BVH
+//! baseline ([`bvh`]), Ray-Strips ([`strips`]), the f64 brute force
+//! ([`brute`]) and Embree (`embree`, cargo feature `embree`) — and the
+//! bytes of the layout each method walks ([`layouts`]).
+//!
+//! This module says which tracer implements each `--method` at each
+//! precision ([`tracer`]).
+
+pub mod brute;
+pub mod bvh;
+#[cfg(feature = "embree")]
+pub mod embree;
+pub mod layouts;
+pub mod method;
+pub mod strips;
 
 use anyhow::{Result, bail};
 use tet_core::TetMesh;
@@ -9,9 +24,9 @@ use tet_trace_cpu::tet20::{Tet20Tracer, Tet20TracerF64};
 use tet_trace_cpu::tet32::{Tet32Tracer, Tet32TracerF64};
 use tet_trace_cpu::tet80::{Tet80ConsistentTracer, Tet80Tracer};
 
-use crate::bvh::BvhTracer;
-use crate::cli::Method;
-use crate::strips::StripsTracer;
+use bvh::BvhTracer;
+use method::Method;
+use strips::StripsTracer;
 
 /// Builds the tracer of `method` over `mesh`, in f64 when `f64` is set.
 pub fn tracer<'m>(method: Method, f64: bool, mesh: &'m TetMesh) -> Result<Box<dyn Tracer + 'm>> {
@@ -49,16 +64,16 @@ pub fn tracer_capped<'m>(
         (Method::Strips, false) => Box::new(StripsTracer::new(mesh, false)?),
         (Method::StripsPackets, false) => Box::new(StripsTracer::new(mesh, true)?),
         #[cfg(feature = "embree")]
-        (Method::Embree, false) => Box::new(crate::embree::EmbreeTracer::new(mesh, false)?),
+        (Method::Embree, false) => Box::new(embree::EmbreeTracer::new(mesh, false)?),
         #[cfg(feature = "embree")]
-        (Method::Embree8, false) => Box::new(crate::embree::EmbreeTracer::new(mesh, true)?),
+        (Method::Embree8, false) => Box::new(embree::EmbreeTracer::new(mesh, true)?),
         #[cfg(not(feature = "embree"))]
         (Method::Embree | Method::Embree8, _) => bail!(
             "method {} needs tet-bench built with `--features embree` (and the system Embree 3 \
              library: `apt-get install libembree-dev`)",
             method.name()
         ),
-        (Method::Brute, _) => Box::new(crate::brute::BruteTracer { mesh }),
+        (Method::Brute, _) => Box::new(brute::BruteTracer { mesh }),
         (Method::Exact, false) => walk!(tet_trace_cpu::exact::ExactTracer::new(mesh)),
         (m, true) => bail!("method {} has no f64 variant", m.name()),
         (m, false) => bail!("{} runs on the GPU: only `render` supports it", m.name()),

@@ -8,8 +8,8 @@ use tet_core::TetMesh;
 use tet_core::memory::MemoryReport;
 use tet_core::regions::{compute_regions, locate_brute, locate_seeds_brute, prune_unreachable};
 
+use super::strips::StripsTracer;
 use crate::load::{BuildSummary, Loaded};
-use crate::strips::StripsTracer;
 
 /// Bytes of one layout (JSON `layouts[]`).
 #[derive(Clone, Debug, Serialize)]

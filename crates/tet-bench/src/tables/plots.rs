@@ -1,7 +1,7 @@
 //! SVG drawing for the figures of `tet-bench tables` (plotters, SVG
 //! backend only: no system font libraries; text is left to the SVG
 //! viewer): scatter plots ([`scatter_svg`]) and grouped bars ([`bars_svg`])
-//! of plain points; which figures a run draws is [`crate::tables`]' business.
+//! of plain points; which figures a run draws is [`super::figures`]' business.
 //!
 //! Every data point is exactly one mark (`<circle>` in scatter plots,
 //! `<rect>` in bar charts besides the white background); legends are

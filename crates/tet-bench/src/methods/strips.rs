@@ -3,7 +3,7 @@
 //! BVH: the structure is built over the mesh's input triangles (its
 //! constrained faces merged back into the scene's triangles:
 //! [`InputTriangles`], exactly the BVH baseline's primitives), and a hit
-//! is reported as the BVH's record ([`crate::bvh::input_hit`]), so every
+//! is reported as the BVH's record ([`super::bvh::input_hit`]), so every
 //! method renders and is checked the same way.
 //!
 //! `strips` traces one ray at a time; `strips-packets` hands each batch to
@@ -19,7 +19,7 @@ use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Ray, TraceOutcome};
 use tet_trace_cpu::walk::{Start, Starts};
 
-use crate::bvh::input_hit;
+use super::bvh::input_hit;
 
 /// Ray-Strips over the input triangles of a mesh.
 pub struct StripsTracer<'m> {

@@ -13,7 +13,7 @@
 //!   batch (the renderer's batches are 16×16 tiles, so packets are coherent).
 //!
 //! Hits are returned through the same record as every other method
-//! ([`crate::bvh::input_hit`]: t from Embree, barycentrics and sides
+//! ([`super::bvh::input_hit`]: t from Embree, barycentrics and sides
 //! recomputed from the mesh), so images and accuracy compare like for like.
 //! A ray that starts on a face (secondary rays, [`Start::Face`]) must not
 //! hit that face again: Embree has no per-ray skip, so a hit on it is
@@ -32,7 +32,7 @@ use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::ray::{Failure, Ray, TraceOutcome};
 use tet_trace_cpu::walk::Start;
 
-use crate::bvh::input_hit;
+use super::bvh::input_hit;
 
 /// Embree's "no hit" geometry id.
 const INVALID_ID: u32 = u32::MAX;

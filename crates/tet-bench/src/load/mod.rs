@@ -1,4 +1,8 @@
-//! Resolving a `SCENE|FILE` argument: a mesh file is loaded, a scene is
+//! Scenes and mesh files: what a `SCENE|FILE` argument becomes — a mesh
+//! with its camera and lights — how a scene's mesh is built
+//! ([`build_flags`]), and where the camera stands ([`camera`]).
+//!
+//! This module resolves the argument: a mesh file is loaded, a scene is
 //! loaded and built (TetGen in a worker process, killed at the time limit).
 
 use std::path::Path;
@@ -12,8 +16,11 @@ use tet_build::scene::Scene;
 use tet_core::TetMesh;
 use tet_core::scene::{Camera, PointLight};
 
-use crate::camera::{ViewError, apply_view, framing_camera};
-use crate::cli::{BuildFlags, ViewArgs};
+pub mod build_flags;
+pub mod camera;
+
+use build_flags::BuildFlags;
+use camera::{ViewArgs, ViewError, apply_view, framing_camera};
 
 /// File extension of mesh files written by `tet-bench build`.
 pub const MESH_EXTENSION: &str = "tmesh";
@@ -153,7 +160,7 @@ pub const TIGHT_BOX_MARGIN: f32 = 0.002;
 /// The enclosing box. By default it holds the scene only, grown by
 /// [`TIGHT_BOX_MARGIN`] of its largest extent: cameras and lights may lie
 /// outside, where primary rays enter the mesh through its boundary
-/// (`tet_trace_cpu::entry`) and shadow rays leave it unoccluded. With
+/// (`tet_trace_cpu::boundary_entry`) and shadow rays leave it unoccluded. With
 /// `wide`, it also holds the camera, the lights and `extra` points (the
 /// cameras and lights of other scenes sharing this mesh), grown by 10 %:
 /// every ray then starts inside the mesh and walks the empty space
@@ -243,7 +250,7 @@ pub fn build_scene_in(
     use tet_build::pipeline::{BuildOptions, build};
 
     let walls = flags.walls();
-    if walls != crate::cli::Walls::None {
+    if walls != build_flags::Walls::None {
         return build_walled(scene, flags, walls, quiet, extra);
     }
     let start = Instant::now();
@@ -297,7 +304,7 @@ pub fn build_scene_in(
 /// `--walls`: a scene built as parts with exact walls between them, in
 /// memory, even when it would fit one TetGen run. The out-of-core
 /// builder's recursive planes (Erkoç et al. 2021) cut the enclosing
-/// box ([`crate::cli::Walls`] says how finely), each part is tetrahedralized by its own
+/// box ([`build_flags::Walls`] says how finely), each part is tetrahedralized by its own
 /// TetGen worker (as many at once as there are cores), and the parts merge
 /// exactly. Why: an unrefined `-pY` CDT fills empty space with long fans
 /// of slivers from the fine surface to the box's corners, which every ray
@@ -309,7 +316,7 @@ pub fn build_scene_in(
 fn build_walled(
     scene: &Scene,
     flags: &BuildFlags,
-    walls: crate::cli::Walls,
+    walls: build_flags::Walls,
     quiet: bool,
     extra: &[Vec3],
 ) -> Result<(TetMesh, BuildSummary)> {
@@ -337,7 +344,7 @@ fn build_walled(
         min_depth: depth,
         ..SplitOptions::default()
     };
-    use crate::cli::Walls;
+    use build_flags::Walls;
     let splits = match walls {
         Walls::Auto => vec![SplitOptions::shaped_for_rays(u64::MAX), uniform],
         Walls::Parts(_) | Walls::None => vec![uniform],

@@ -17,8 +17,8 @@ use tet_core::TetMesh;
 use tet_core::scene::{Camera, PointLight};
 use tet_core::synthetic::{GridSpec, kuhn_grid};
 
-use crate::camera::framing_camera;
-use crate::cli::BuildFlags;
+use crate::load::build_flags::BuildFlags;
+use crate::load::camera::framing_camera;
 use crate::load::{Loaded, from_scene};
 
 /// The transforms applied to the scene.

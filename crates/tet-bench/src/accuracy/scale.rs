@@ -2,7 +2,7 @@
 //! 10⁸ rays and more, which no one batch holds in memory. The rays come in
 //! batches of [`BATCH_RAYS`] — the first with the camera's 1024² image,
 //! each with random interior rays and as many adversarial rays
-//! ([`crate::accuracy::adversarial_rays`]: aimed at vertices, edges and
+//! ([`super::adversarial::adversarial_rays`]: aimed at vertices, edges and
 //! faces of the tetrahedralization, along edges, started on faces), a new
 //! seed per batch —; the f64 reference judges each batch, every method
 //! traces it once, and the counters add up. Each method's Mrays/s is its
@@ -13,9 +13,9 @@ use std::time::Instant;
 
 use anyhow::Result;
 
-use crate::accuracy::{CaseAccuracy, MethodAccuracy, Reference, ray_set, trace_all, variants};
-use crate::cli::{Method, Precision};
+use super::{CaseAccuracy, MethodAccuracy, Reference, ray_set, trace_all, variants};
 use crate::load::{Loaded, spinner};
+use crate::methods::method::{Method, Precision};
 use crate::methods::tracer_capped;
 
 /// Rays per batch: about 60 MB of rays, starts, reference hits and
@@ -174,7 +174,7 @@ fn run_in_batches(
 mod tests {
     use super::*;
     use crate::accuracy::{RayPlan, run_case};
-    use crate::camera::framing_camera;
+    use crate::load::camera::framing_camera;
     use tet_core::synthetic::{GridSpec, kuhn_grid};
 
     /// Batches add up to exactly what the one-batch harness

@@ -1,5 +1,6 @@
 //! Where the camera is when the scene does not say ([`framing_camera`]),
-//! and the `--eye`, `--target`, `--up`, `--fov` overrides ([`apply_view`]).
+//! and the `--eye`, `--target`, `--up`, `--fov` overrides ([`ViewArgs`],
+//! [`apply_view`]).
 //!
 //! The default camera stands outside the scene, as in every viewer: on the
 //! +z side of the centre of the scene's bounding box, looking at it, far
@@ -8,11 +9,55 @@
 //! primary rays enter the mesh through its boundary
 //! (`tet_trace_cpu::Viewpoint`), so a closed object is seen from outside.
 
+use clap::Args;
 use glam::Vec3;
 use tet_core::TetMesh;
 use tet_core::scene::Camera;
 
-use crate::cli::ViewArgs;
+/// The view: each flag given replaces that part of the scene's camera (or
+/// of the default camera, which frames the whole scene from outside on
+/// its +z side). Checked before anything is traced: finite coordinates,
+/// an eye away from the target, an up direction not along the line of
+/// sight, and a field of view strictly between 0 and 180 degrees.
+#[derive(Debug, Clone, Copy, Default, Args)]
+pub struct ViewArgs {
+    /// Camera position `X,Y,Z`, replacing the scene's camera position (without
+    /// a scene camera: outside the scene on its +z side, framing it).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<glam::Vec3>,
+    /// Point `X,Y,Z` the camera looks at (default: the scene camera's target,
+    /// or the centre of the scene).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<glam::Vec3>,
+    /// Up direction `X,Y,Z` of the image, across the line of sight (default:
+    /// the scene camera's, or +y).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<glam::Vec3>,
+    /// Vertical field of view in degrees, between 0 and 180 (default: the
+    /// scene camera's, or 60).
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub fov: Option<f32>,
+}
+
+/// Parses `X,Y,Z` (three finite numbers separated by commas).
+pub fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [x, y, z] = parts.as_slice() else {
+        return Err(format!(
+            "`{s}` is not a point: give three numbers separated by commas, e.g. 0,1.5,-4"
+        ));
+    };
+    let mut v = [0.0f32; 3];
+    for (out, text) in v.iter_mut().zip([x, y, z]) {
+        *out = text
+            .parse::<f32>()
+            .map_err(|_| format!("`{text}` in `{s}` is not a number"))?;
+        if !out.is_finite() {
+            return Err(format!("`{text}` in `{s}` is not finite"));
+        }
+    }
+    Ok(glam::Vec3::from_array(v))
+}
 
 /// Vertical field of view of the default camera, degrees.
 pub const DEFAULT_VFOV_DEG: f32 = 60.0;
@@ -195,6 +240,17 @@ mod tests {
                 matches!(apply_view(cam, &v), Err(ViewError::Fov(_))),
                 "{fov}"
             );
+        }
+    }
+
+    #[test]
+    fn points_parse_as_three_finite_numbers() {
+        assert_eq!(
+            parse_vec3("1,-2.5, 3e2"),
+            Ok(glam::Vec3::new(1.0, -2.5, 300.0))
+        );
+        for bad in ["", "1,2", "1,2,3,4", "1,x,3", "1,inf,3", "NaN,0,0", "1;2;3"] {
+            assert!(parse_vec3(bad).is_err(), "{bad}");
         }
     }
 }

@@ -1,5 +1,10 @@
 //! Accuracy of every method against an f64 reference (the `accuracy`
-//! command, and the robustness and speed-vs-accuracy tables of `tables`).
+//! command, and the robustness and speed-vs-accuracy tables of `tables`):
+//! the rays built to hurt a walk ([`adversarial`]), the scene scaled,
+//! translated and on slivers ([`extremes`]), which grazing rays must cross
+//! the surface ([`grazing`]), the failing rays kept for study
+//! ([`failed_rays`]), and the same measurement streamed over 10⁸ rays and
+//! more ([`scale`]).
 //!
 //! The reference is exact in structure: every candidate triangle is tested
 //! with the f64 ray–triangle test of `tet_trace_cpu::reference`; candidates
@@ -11,7 +16,7 @@
 //! line within `tol` of the ray crosses the surface — the reference hit
 //! lies within `tol` of edges or vertices of its triangle, and the faces
 //! around them cross every nearby line (an odd number of times; see
-//! [`crate::grazing`]: a ray entering a closed surface across an edge or
+//! [`grazing`]: a ray entering a closed surface across an edge or
 //! through a vertex, not one clipping a convex edge or touching the
 //! outline); or the ray may pass such a grazed part by, and the method
 //! also skips the first watertight face beyond it (skipping one of an open
@@ -50,13 +55,20 @@ use tet_trace_cpu::reference::{Aim, edge_distance, line_edge_distance, random_ra
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::walk::Start;
 
-pub use crate::adversarial::adversarial_rays;
-use crate::bvh::unit_scale;
-use crate::cli::{BuildFlags, Method, Precision};
-use crate::extremes;
-use crate::failed_rays::{FailedRay, KEPT, ReferenceHit};
-use crate::grazing::{Graze, Surface};
+pub mod adversarial;
+pub mod extremes;
+pub mod failed_rays;
+pub mod grazing;
+pub mod scale;
+
+use adversarial::adversarial_rays;
+use failed_rays::{FailedRay, KEPT, ReferenceHit};
+use grazing::{Graze, Surface};
+
 use crate::load::Loaded;
+use crate::load::build_flags::BuildFlags;
+use crate::methods::bvh::unit_scale;
+use crate::methods::method::{Method, Precision};
 use crate::methods::{has_f64, tracer};
 use crate::output::error_chain;
 
@@ -340,7 +352,7 @@ pub struct MethodAccuracy {
     /// repeated passes over the same rays, timed for at least
     /// [`RayPlan::min_time_s`] in all (and at least [`MIN_PASSES`] passes).
     pub mrays_per_s: f64,
-    /// The first failing rays ([`crate::failed_rays::KEPT`] at most), to
+    /// The first failing rays ([`failed_rays::KEPT`] at most), to
     /// reproduce them.
     pub failed_rays: Vec<FailedRay>,
 }
@@ -365,12 +377,12 @@ pub struct CaseAccuracy {
     pub skipped: Option<String>,
     /// `method/precision` left out of this case: at ×1e±30 the f32 kernels
     /// whose products of coordinates are not rescaled (sctp, tet80) would
-    /// walk to their step cap on most rays (see [`crate::extremes`]).
+    /// walk to their step cap on most rays (see [`extremes`]).
     pub left_out: Vec<String>,
 }
 
 /// A batch of rays with their start (`None`: a camera ray, started from
-/// `view` by each tracer; see `tet_trace_cpu::entry` for a camera outside
+/// `view` by each tracer; see `tet_trace_cpu::boundary_entry` for a camera outside
 /// the mesh).
 pub struct RaySet {
     /// Each ray with its start (`None` for camera rays).
@@ -709,7 +721,7 @@ pub fn run_case(
 }
 
 /// The scene as given and, with `extremes` (the build flags to rebuild
-/// with), the extreme cases of [`crate::extremes::cases`]; a case that
+/// with), the extreme cases of [`extremes::cases`]; a case that
 /// cannot be built is reported as skipped with its error.
 pub fn all_cases(
     loaded: &Loaded,

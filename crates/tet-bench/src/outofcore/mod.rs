@@ -1,5 +1,7 @@
 //! Building under a memory limit (Erkoç et al. 2021): `build --predict-memory`,
-//! `build --memory-limit`, and the out-of-core table of `tables`.
+//! `build --memory-limit`, and the out-of-core table of `tables`; the
+//! options of such builds and of their jobs (`--memory-limit`,
+//! `--planner`, `--merge`, `submit --mem-per-part`) are [`options`].
 //!
 //! The prediction is `tet_build`'s memory model
 //! ([`tet_build::outofcore::memory_model::predict_peak_memory`], TetGen's
@@ -31,7 +33,7 @@
 //! forces one. The tree's planes usually cut far fewer scene triangles
 //! than slabs do (the README's results give the numbers).
 //!
-//! **Merging.** `build` streams by default ([`MergeMode::Stream`](crate::cli::MergeMode::Stream),
+//! **Merging.** `build` streams by default ([`MergeMode::Stream`](options::MergeMode::Stream),
 //! [`Limited::to_file`]): each part goes to a part file as soon as its
 //! worker returns and the part files are merged into the output a part at
 //! a time, so the process never holds the whole mesh — what a build under
@@ -52,6 +54,7 @@ use {crate::load::BuildSummary, anyhow::Result, tet_core::TetMesh};
 
 #[cfg(feature = "tetgen")]
 mod limited;
+pub mod options;
 mod predict;
 mod trace_speed;
 mod types;

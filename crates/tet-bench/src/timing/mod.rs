@@ -1,6 +1,12 @@
-//! Timing one method on one scene: frames rendered on a thread pool, the
-//! best and the median reported as a [`RenderDoc`] (the `render --json`
-//! document and the rows of every speed table).
+//! Speed: how fast a method traces. The GPU methods are timed by [`gpu`],
+//! the exit-face decision alone (single thread) by [`exitface`].
+//!
+//! This module times one method on one scene: frames rendered on a thread
+//! pool, the best and the median reported as a [`RenderDoc`] (the
+//! `render --json` document and the rows of every speed table).
+
+pub mod exitface;
+pub mod gpu;
 
 use std::time::Instant;
 
@@ -10,10 +16,10 @@ use tet_core::TetMesh;
 use tet_trace_cpu::kernel::Tracer;
 use tet_trace_cpu::render::{Frame, FrameStats, RenderOptions, render, render_into};
 
-use crate::bvh::BvhTracer;
-use crate::cli::Method;
-use crate::layouts::layout_bytes;
 use crate::load::Loaded;
+use crate::methods::bvh::BvhTracer;
+use crate::methods::layouts::{layout_bytes, strips_bytes};
+use crate::methods::method::Method;
 use crate::methods::tracer;
 
 /// Timings of one method on one scene (JSON document of `render`, and rows
@@ -183,7 +189,7 @@ fn hot_bytes(method: Method, mesh: &TetMesh) -> Result<usize> {
             let (nodes, triangles) = BvhTracer::new(mesh).bytes();
             nodes + triangles
         }
-        Method::Strips | Method::StripsPackets => crate::layouts::strips_bytes(mesh)?.hot_bytes,
+        Method::Strips | Method::StripsPackets => strips_bytes(mesh)?.hot_bytes,
         _ => 0,
     })
 }

@@ -4,8 +4,8 @@
 
 use anyhow::{Result, bail};
 
-use crate::cli::Method;
 use crate::load::Loaded;
+use crate::methods::method::Method;
 use crate::timing::RenderDoc;
 
 /// Renders `frames` GPU frames (plus a warm-up) of `method`.
