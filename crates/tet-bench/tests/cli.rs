@@ -512,6 +512,26 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
     for r in sc[0]["renders"].as_array().unwrap() {
         assert_eq!(r["nodes_per_ray"].is_null(), r["method"] != "obvhs", "{r}");
     }
+    // The build-choice tables time the default mesh again beside the
+    // variant: the same mesh and rays as the render table's tet20 row.
+    for s in sc {
+        let tet20 = s["renders"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["method"] == "tet20")
+            .unwrap();
+        for (base, variant) in [
+            ("sorted_tet20", "unsorted_tet20"),
+            ("tight_box_tet20", "wide_box_tet20"),
+        ] {
+            assert_eq!(s[base]["method"], "tet20", "{base}: {}", s[base]);
+            assert_eq!(s[variant]["method"], "tet20", "{variant}: {}", s[variant]);
+            for k in ["rays", "hits", "tets_per_ray"] {
+                assert_eq!(s[base][k], tet20[k], "{base}.{k}");
+            }
+        }
+    }
     // The exit-face table: every method, every decision right.
     let stabs = doc["exit_face"]["stabs"].as_array().unwrap();
     assert_eq!(stabs.len(), 5);

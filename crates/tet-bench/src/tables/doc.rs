@@ -53,10 +53,16 @@ pub struct SceneResult {
     pub renders: Vec<RenderDoc>,
     /// tet20 on the unsorted (TetGen order) mesh, for Figure 8.
     pub unsorted_tet20: Option<RenderDoc>,
+    /// tet20 on the default (Hilbert-sorted) mesh, timed in alternating
+    /// rounds with `unsorted_tet20`: the figure to compare it with.
+    pub sorted_tet20: Option<RenderDoc>,
     /// tet20 on the mesh built with `--wide-box` (the enclosing box holds
     /// the camera, which primary rays start from), against the default tight
     /// box (rays enter through the boundary).
     pub wide_box_tet20: Option<RenderDoc>,
+    /// tet20 on the default (tight-box) mesh, timed in alternating rounds
+    /// with `wide_box_tet20`: the figure to compare it with.
+    pub tight_box_tet20: Option<RenderDoc>,
     /// Accuracy against the f64 reference.
     pub accuracy: Option<CaseAccuracy>,
     /// Ray-Strips beside the BVH (Lauterbach et al. 2007, Tables 1, 3, 4, 5).

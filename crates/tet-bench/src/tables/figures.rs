@@ -52,7 +52,7 @@ pub fn figures(doc: &TablesDoc) -> Result<Vec<(&'static str, String)>> {
         .scenes
         .iter()
         .filter_map(|sc| {
-            let sorted = sc.renders.iter().find(|r| r.method == Method::Tet20)?;
+            let sorted = sc.sorted_tet20.as_ref()?;
             let unsorted = sc.unsorted_tet20.as_ref()?;
             Some(BarGroup {
                 name: sorted.scene.clone(),

@@ -127,18 +127,22 @@ fn measure_scene(
     // builds): one that fails leaves its row empty and says why in
     // `partial_errors`, not the whole scene.
     let mut partial_errors = Vec::new();
-    let unsorted_tet20 = optional(
+    let (sorted_tet20, unsorted_tet20) = optional(
         &mut partial_errors,
         spec,
         "unsorted mesh",
-        sorting::measure(planned, cache, opts, frames, pool),
-    );
-    let wide_box_tet20 = optional(
+        sorting::measure(planned, &loaded, cache, opts, frames, pool),
+    )
+    .map(|p| (p.baseline, p.variant))
+    .unzip();
+    let (tight_box_tet20, wide_box_tet20) = optional(
         &mut partial_errors,
         spec,
         "wide-box mesh",
-        entry::measure(planned, cache, opts, frames, pool),
-    );
+        entry::measure(planned, &loaded, cache, opts, frames, pool),
+    )
+    .map(|p| (p.baseline, p.variant))
+    .unzip();
     let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames);
     let (quality5, min_dihedral2, min_dihedral2_capped, one_piece) = if args.quick {
         (None, None, None, None)
@@ -194,7 +198,9 @@ fn measure_scene(
         bvh_build_s: Some(bvh_build_s),
         renders,
         unsorted_tet20,
+        sorted_tet20,
         wide_box_tet20,
+        tight_box_tet20,
         accuracy: Some(accuracy),
         partial_errors,
         error: None,
@@ -255,7 +261,9 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
                     bvh_build_s: None,
                     renders: Vec::new(),
                     unsorted_tet20: None,
+                    sorted_tet20: None,
                     wide_box_tet20: None,
+                    tight_box_tet20: None,
                     accuracy: None,
                     gpu_renders: Vec::new(),
                     gpu_note: None,

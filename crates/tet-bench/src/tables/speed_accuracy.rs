@@ -60,7 +60,7 @@ pub fn markdown(m: &mut String, x: &SpeedAccuracy) {
     );
     let _ = writeln!(
         m,
-        "Per case, the same camera and random interior rays for every method; failures as above (per 1024² rays); Mrays/s: the best of passes over these same rays (all threads), repeated for at least `--min-time` seconds per method (0.5 s, or 0.2 s with `--quick`), so speeds compare within a case. Cases: the scene as given (with `--quick` the single torus knot), scaled by 1e-4, 1e4, 1e-30 and 1e30 (each rebuilt; at ×1e±30 sctp and tet80 in f32 are left out: their 3-D products leave f32's range), translated by 1e5, and a sliver-heavy jittered grid.\n"
+        "Per case, the same camera and random interior rays for every method; failures as above (per 1024² rays); Mrays/s: the best of passes over these same rays (all threads), repeated for at least `--min-time` seconds per method (0.5 s, or 0.2 s with `--quick`), so speeds compare within a case; half the rays are random interior rays (incoherent), so these speeds lie below the render table's camera rays and do not compare with it. Cases: the scene as given (with `--quick` the single torus knot), scaled by 1e-4, 1e4, 1e-30 and 1e30 (each rebuilt; at ×1e±30 sctp and tet80 in f32 are left out: their 3-D products leave f32's range), translated by 1e5, and a sliver-heavy jittered grid.\n"
     );
     if let Some(e) = &x.error {
         let _ = writeln!(m, "Not measured: {e}\n");
