@@ -8,8 +8,9 @@
 //! shell of constrained faces around the middle third, puts the camera in a
 //! corner looking at the centre, renders `width × height` primary rays
 //! `repeats` times per layout and prints one line per layout (GPU time from
-//! timestamp queries when available, wall time otherwise). Defaults: 40 cells,
-//! 640×480, 3 repeats.
+//! timestamp queries when available, wall time otherwise; apart from them,
+//! the rays whose walk lost its way and was walked again on the host, with
+//! their host time). Defaults: 40 cells, 640×480, 3 repeats.
 
 use std::time::Instant;
 
@@ -67,7 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let s = best.expect("repeats >= 1");
         println!(
             "{:10} {}x{}: gpu {:>9} ms, wall {:8.2} ms, {:8.2} Mrays/s, hits {}, \
-             failures {}, tets/ray {:.1}, GPU memory {} B",
+             failures {}, tets/ray {:.1}, re-walked on the host {} ({:.2} ms), GPU memory {} B",
             s.method,
             w,
             h,
@@ -77,6 +78,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             s.hits,
             s.failures,
             s.tets_visited as f64 / s.rays as f64,
+            s.host_rewalks,
+            s.host_rewalk_ms,
             gpu.memory().total()
         );
     }

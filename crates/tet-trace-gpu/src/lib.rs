@@ -14,7 +14,10 @@
 //!   arbitrary rays (secondary rays from the CPU side), [`GpuTracer::render`]
 //!   generates camera rays on the GPU;
 //! * results are [`tet_trace_cpu::TraceOutcome`]s (the CPU hit records, same
-//!   meaning field by field) plus [`DispatchStats`].
+//!   meaning field by field) plus [`DispatchStats`];
+//! * walks that lost their way on the GPU are walked again on the host by
+//!   the exact walk, as the CPU tracers do (see "Walks that lost their
+//!   way" below).
 //!
 //! ## The kernels: a port of the CPU walk (Aman et al. 2022, Algorithms 1–7)
 //!
@@ -100,6 +103,8 @@
 //!   crosses its plane off the face at a grazing angle, the CPU reports the
 //!   point of the face nearest the line and the kernel the plane's crossing
 //!   (`tet_trace_cpu::walk::face_hit`): the same face, a different `t`.
+//!   A ray re-walked on the host (see "Walks that lost their way") has the
+//!   exact walk's hit, computed on the host as on the CPU.
 //! * **Start.** For batch rays the host runs the CPU's exact start logic
 //!   (`tet_trace_cpu::walk::start_exit_face`: start tet, the tets around an
 //!   origin on a face/edge/vertex, last-resort fallback) and uploads the
@@ -107,6 +112,47 @@
 //!   Camera rays start on the GPU in the one start tet (`start_in_tet`); the
 //!   few rays whose origin lies on that tet's boundary so that no face winds
 //!   around it are re-traced through the batch path (CPU-generated rays).
+//!   From outside the mesh ([`GpuTracer::render_view`]) the host chooses
+//!   each ray's entry face and traces the rays through the batch path.
+//!
+//! ## Walks that lost their way: the exact walk, on the host
+//!
+//! A floating-point walk decides every step with the exact sign of its
+//! rounded projection; in a tet thinner than that rounding (a near-flat
+//! sliver) it can circle until its step cap, and the Plücker walk (Tet80,
+//! not watertight) can leave the ray's line and circle too. The default
+//! step cap ([`tet_trace_cpu::walk::step_cap`], twice the tets plus 1024)
+//! is more than any line's walk takes, so reaching it proves the walk
+//! lost; so does a start that finds no tet whose projection holds the
+//! line (`Failure::Lost`). The CPU tracers then walk the ray again with
+//! the exact walk ([`tet_trace_cpu::exact::ExactTracer`]: exact predicates,
+//! symbolic perturbation) from the same start, and report that outcome
+//! with the tets of both walks counted.
+//!
+//! WGSL has no exact arithmetic, so the GPU tracer does the same on the
+//! host: after a dispatch's outcomes are read back, every walk that reached
+//! the step cap or reported `Lost` is walked again by `ExactTracer` on the
+//! CPU, from the same start, with the tets of both walks counted:
+//!
+//! * [`GpuTracer::trace_batch`]: from the ray's own [`tet_trace_cpu::Start`];
+//! * [`GpuTracer::render`]: from the start tet, on the host's camera ray
+//!   (`tet_trace_cpu::render::PinholeCamera`, the CPU renderer's ray; the
+//!   GPU's own ray may differ in the last bit, see "Projection basis");
+//!   rays whose GPU start failed are re-traced through the batch path, which
+//!   re-walks them there if they lose their way again;
+//! * [`GpuTracer::render_view`] from outside the mesh: through the batch
+//!   path, from the entry face the host chose.
+//!
+//! So where the CPU walk was lost, the GPU tracer reports what the CPU
+//! tracer reports (bit for bit for batch rays whose GPU walk was lost as
+//! well). A caller's lower step cap ([`GpuTracer::with_step_cap`], to bound
+//! the work per ray) keeps the `StepCap` failure, as on the CPU: below the
+//! default cap it no longer proves a lost walk. [`DispatchStats`] counts
+//! the re-walked rays ([`DispatchStats::host_rewalks`]) and their host time
+//! ([`DispatchStats::host_rewalk_ms`]) apart from the GPU and wall times,
+//! so those measure the GPU walk alone. The GPU's own walk has no such
+//! fallback: a kernel that needs the exact outcome on the device (no host
+//! round trip) would need an exact walk in WGSL.
 //!
 //! ## Limits
 //!
@@ -122,6 +168,14 @@
 //! and the limit. Ray batches and camera frames are split into as many
 //! dispatches as the limits (and the 65 535-workgroup dispatch limit)
 //! require.
+//!
+//! A walk that loses its way spends its whole step cap on the GPU before
+//! the host re-walks it (see "Walks that lost their way"); the re-walks run
+//! on the calling thread, one exact walk per lost ray. They are rare (none
+//! of the projected walks' test rays; a few per thousand of the Plücker
+//! walk's rays aimed at vertices on a jittered grid), but a mesh full of
+//! slivers makes them a host cost that [`DispatchStats::host_rewalk_ms`]
+//! shows.
 //!
 //! ## Testing without a GPU
 //!
@@ -141,6 +195,9 @@
 //! With `Features::TIMESTAMP_QUERY` every dispatch is bracketed by timestamp
 //! writes and [`DispatchStats::gpu_ms`] holds the summed GPU time; wall time
 //! (submit to results on the host) is always in [`DispatchStats::wall_ms`].
+//! The host re-walks of lost walks are in neither: their count and time are
+//! [`DispatchStats::host_rewalks`] and [`DispatchStats::host_rewalk_ms`]
+//! ([`DispatchStats::total_ms`] adds them to the wall time).
 
 #![deny(missing_docs)]
 
@@ -148,6 +205,7 @@ mod context;
 mod dispatch;
 mod error;
 mod layout;
+mod lost;
 mod records;
 mod starts;
 mod stats;

@@ -37,7 +37,9 @@ pub struct DispatchStats {
     /// `None` when the adapter has no timestamp queries.
     pub gpu_ms: Option<f64>,
     /// Wall time from the first submit to the last result on the host
-    /// (includes uploads of per-ray data and read-back), ms.
+    /// (includes uploads of per-ray data and read-back, and the host-side
+    /// starts; excludes the host re-walks of lost walks, which are in
+    /// [`DispatchStats::host_rewalk_ms`]), ms.
     pub wall_ms: f64,
     /// Number of dispatches.
     pub dispatches: u32,
@@ -47,8 +49,18 @@ pub struct DispatchStats {
     pub hits: u64,
     /// Rays that failed (step cap, lost, invalid).
     pub failures: u64,
-    /// Tets visited by all rays.
+    /// Tets visited by all rays (for a re-walked ray, both walks' tets).
     pub tets_visited: u64,
+    /// Rays whose GPU walk lost its way (reached the default step cap, or
+    /// found no start: `Failure::StepCap`, `Failure::Lost`) and that the
+    /// host walked again with the exact walk
+    /// ([`tet_trace_cpu::exact::ExactTracer`]), as the CPU tracers do (see
+    /// the crate docs, "Walks that lost their way").
+    pub host_rewalks: u64,
+    /// Host (CPU) time of those exact re-walks, ms: kept apart from
+    /// [`DispatchStats::gpu_ms`] and [`DispatchStats::wall_ms`] so that the
+    /// GPU timings measure the GPU walk alone.
+    pub host_rewalk_ms: f64,
 }
 
 impl DispatchStats {
@@ -60,6 +72,22 @@ impl DispatchStats {
     /// Million rays per second over [`DispatchStats::ms`].
     pub fn mrays_per_s(&self) -> f64 {
         self.rays as f64 / (self.ms() * 1e3)
+    }
+
+    /// Wall time plus the host re-walks: the time the caller waited, ms.
+    pub fn total_ms(&self) -> f64 {
+        self.wall_ms + self.host_rewalk_ms
+    }
+
+    /// Adds the dispatches, GPU time and host re-walks of `other` (a
+    /// nested batch, e.g. the camera rays re-traced through the batch path).
+    pub(crate) fn absorb(&mut self, other: &DispatchStats) {
+        self.dispatches += other.dispatches;
+        if let (Some(a), Some(b)) = (self.gpu_ms, other.gpu_ms) {
+            self.gpu_ms = Some(a + b);
+        }
+        self.host_rewalks += other.host_rewalks;
+        self.host_rewalk_ms += other.host_rewalk_ms;
     }
 
     pub(crate) fn count(&mut self, outcomes: &[TraceOutcome]) {
@@ -81,7 +109,8 @@ pub struct GpuFrame {
     pub height: u32,
     /// Outcome per pixel, row-major from the top.
     pub outcomes: Vec<TraceOutcome>,
-    /// Statistics of the whole frame (re-traced rays included).
+    /// Statistics of the whole frame (re-traced rays and host re-walks of
+    /// lost walks included).
     pub stats: DispatchStats,
     /// Rays whose origin lay on the start tet's boundary so that the GPU
     /// start failed; they were re-traced through
@@ -100,7 +129,7 @@ impl GpuFrame {
         t0: Instant,
         retraced: u64,
     ) -> GpuFrame {
-        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        stats.wall_ms = (t0.elapsed().as_secs_f64() * 1e3 - stats.host_rewalk_ms).max(0.0);
         stats.count(&outcomes);
         GpuFrame {
             width,

@@ -18,6 +18,7 @@ use crate::context::GpuContext;
 use crate::dispatch::{Kernel, add_gpu_ms, rays_per_dispatch};
 use crate::error::GpuError;
 use crate::layout::GpuLayout;
+use crate::lost::exact_where_lost;
 use crate::records::{HitRec, Params, RayRec, StartRec};
 use crate::starts::start_record;
 use crate::stats::{DispatchStats, GpuFrame, GpuMemory};
@@ -88,6 +89,10 @@ impl<'a> GpuTracer<'a> {
     /// Traces arbitrary rays, ray `i` from `starts[i]` (a tet containing its
     /// origin, or a constrained face for secondary rays), like the CPU
     /// `Tracer::trace`. Large batches are split into several dispatches.
+    /// A walk that lost its way (the default step cap, or no start) is
+    /// walked again on the host by the exact walk from `starts[i]`, as the
+    /// CPU tracers do (crate docs, "Walks that lost their way"), counted in
+    /// [`DispatchStats::host_rewalks`].
     pub fn trace_batch(
         &self,
         rays: &[Ray],
@@ -151,6 +156,11 @@ impl<'a> GpuTracer<'a> {
             out.extend(hits.iter().map(HitRec::outcome));
         }
         stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        // Walks that lost their way: the exact walk from the same start,
+        // on the host (see the crate docs, "Walks that lost their way").
+        exact_where_lost(self.mesh, self.cap, &mut out, &mut stats, |i| {
+            Some((rays[i], starts[i]))
+        });
         stats.count(&out);
         Ok((out, stats))
     }
@@ -159,6 +169,11 @@ impl<'a> GpuTracer<'a> {
     /// GPU with the conventions of `scenes.json` (see
     /// `tet_trace_cpu::render::PinholeCamera`), all starting in `start_tet`
     /// (a tet containing the eye, e.g. from `tet_trace_cpu::locate`).
+    /// Rays the GPU cannot start there (eye on the tet's boundary) are
+    /// re-traced through [`GpuTracer::trace_batch`] ([`GpuFrame::retraced`]);
+    /// a walk that lost its way (the default step cap) is walked again on
+    /// the host by the exact walk from `start_tet`, on the host's camera ray
+    /// (crate docs, "Walks that lost their way").
     pub fn render(
         &self,
         camera: &Camera,
@@ -228,8 +243,8 @@ impl<'a> GpuTracer<'a> {
             first += n;
         }
         // Rays the GPU could not start (origin on the start tet's boundary):
-        // re-trace them with the CPU's full start logic.
-        let lost: Vec<usize> = outcomes
+        // re-traced below with the CPU's full start logic.
+        let unstarted: Vec<usize> = outcomes
             .iter()
             .enumerate()
             .filter(|(_, o)| {
@@ -243,19 +258,24 @@ impl<'a> GpuTracer<'a> {
             })
             .map(|(i, _)| i)
             .collect();
-        if !lost.is_empty() {
-            let cam = PinholeCamera::new(camera, width, height, pixel_centers);
-            let rays: Vec<Ray> = lost
-                .iter()
-                .map(|&i| cam.ray(i as u32 % width, i as u32 / width))
-                .collect();
+        let cam = PinholeCamera::new(camera, width, height, pixel_centers);
+        let ray_of = |i: usize| cam.ray(i as u32 % width, i as u32 / width);
+        // The other walks that lost their way: the exact walk from the
+        // start tet, of the host's camera ray (the ray of the CPU renderer;
+        // the GPU's may differ in the last bit, see the crate docs).
+        exact_where_lost(mesh, self.cap, &mut outcomes, &mut stats, |i| {
+            unstarted
+                .binary_search(&i)
+                .is_err()
+                .then(|| (ray_of(i), Start::Tet(start_tet)))
+        });
+        if !unstarted.is_empty() {
+            let rays: Vec<Ray> = unstarted.iter().map(|&i| ray_of(i)).collect();
             let starts = vec![Start::Tet(start_tet); rays.len()];
+            // With its own host re-walks of walks that lost their way.
             let (re, s) = self.trace_batch(&rays, &starts)?;
-            stats.dispatches += s.dispatches;
-            if let (Some(a), Some(b)) = (stats.gpu_ms, s.gpu_ms) {
-                stats.gpu_ms = Some(a + b);
-            }
-            for (&i, o) in lost.iter().zip(re) {
+            stats.absorb(&s);
+            for (&i, o) in unstarted.iter().zip(re) {
                 outcomes[i] = o;
             }
         }
@@ -265,7 +285,7 @@ impl<'a> GpuTracer<'a> {
             outcomes,
             stats,
             t0,
-            lost.len() as u64,
+            unstarted.len() as u64,
         ))
     }
 
@@ -274,7 +294,9 @@ impl<'a> GpuTracer<'a> {
     /// made on the host, each starts through the boundary face it enters by
     /// (`tet_trace_cpu::boundary_entry`, host side, like the starts of
     /// [`GpuTracer::trace_batch`]) and a ray that misses the mesh is a miss
-    /// that visits no tet.
+    /// that visits no tet. Walks that lost their way are walked again on
+    /// the host by the exact walk, from the same start (see
+    /// [`GpuTracer::render`], [`GpuTracer::trace_batch`]).
     pub fn render_view(
         &self,
         camera: &Camera,

@@ -13,7 +13,12 @@
 //! the same triangle as the brute force, and the GPU walk must equal the CPU
 //! walk (same face, same tets visited). Tet80 is not watertight (on the CPU
 //! either): there the GPU must equal the CPU, and disagreements with the
-//! brute force are counted and printed (see `check`).
+//! brute force are counted and printed (see `check`). Where a walk lost its
+//! way (the default step cap, or no start), the CPU tracers and the GPU
+//! tracer (on the host) both take the exact walk from the same start, so
+//! the outcomes must be equal there too (see
+//! `lost_walks_are_rewalked_exactly_on_the_host` and
+//! `lost_camera_rays_are_rewalked_exactly_on_the_host`).
 
 use glam::Vec3;
 use tet_core::TetMesh;
@@ -115,14 +120,14 @@ fn differences(
     (differ, along)
 }
 
-/// True when a walk stopped at its step cap: what the GPU must report where
-/// the CPU walk was capped and its tracer took the exact walk
-/// (`tet_trace_cpu::lost`), which the GPU has not.
-fn capped(o: &TraceOutcome) -> bool {
+/// True when a walk lost its way (its step cap, or no start): where a
+/// tracer at the default cap re-walks the ray with the exact walk
+/// (`tet_trace_cpu::lost` on the CPU, the host-side fallback on the GPU).
+fn lost(o: &TraceOutcome) -> bool {
     matches!(
         o,
         TraceOutcome::Failed {
-            failure: Failure::StepCap,
+            failure: Failure::StepCap | Failure::Lost,
             ..
         }
     )
@@ -155,17 +160,17 @@ fn check(
     for (i, ((ray, g), c)) in rays.iter().zip(gpu).zip(cpu).enumerate() {
         let graze = grazes_an_edge(mesh, ray, GRAZE);
         // Where the CPU walk lost its way (the step cap) its tracer took
-        // the exact walk (`tet_trace_cpu::lost`), which the GPU has not: the
-        // GPU walk must then have reached the cap as well, or the ray
-        // grazes an edge (where the walks may differ).
+        // the exact walk (`tet_trace_cpu::lost`), and so does the GPU
+        // tracer on the host: the same ray from the same start, so the
+        // same outcome bit for bit (both walks' tets counted), unless the
+        // ray grazes an edge (where the GPU walk may not have been capped).
         if c.tets_visited() >= cap {
             assert!(
-                capped(g) || graze,
-                "{layout:?} ray {i} {ray:?}: the CPU walk was capped, the GPU gave {g:?}"
+                g == c || graze,
+                "{layout:?} ray {i} {ray:?}: the CPU walk was capped (then exact: {c:?}), \
+                 the GPU gave {g:?}"
             );
             exact += 1;
-            wrong += 1;
-            continue;
         }
         let tet80_as_cpu = layout == GpuLayout::Tet80 && same_walk(g, c);
         assert!(
@@ -223,8 +228,8 @@ fn check(
     eprintln!(
         "{layout:?}: {} rays: {grazing} grazing, {differ} walks differ from the CPU (all \
          grazing), {bits_differ} same walks with different t/barycentric bits, {wrong} \
-         non-grazing rays disagree with the brute force or fail (CPU and GPU alike; \
-         {exact} capped, where the CPU took the exact walk)",
+         non-grazing rays disagree with the brute force or fail (CPU and GPU alike); \
+         {exact} CPU walks capped, where CPU and GPU took the exact walk",
         rays.len()
     );
     differ
@@ -356,13 +361,14 @@ fn random_faces_case(ctx: &GpuContext, mesh: &TetMesh, layout: GpuLayout) {
     for (i, (g, c)) in out2.iter().zip(&cpu2).enumerate() {
         if c.tets_visited() >= cap {
             // The CPU walk was capped and its tracer took the exact walk
-            // (`tet_trace_cpu::lost`); the GPU has none: it must be capped
-            // too, or the ray grazes an edge (where the walks may differ).
+            // (`tet_trace_cpu::lost`), as the GPU tracer does on the host:
+            // the same outcome, or the ray grazes an edge (where the GPU
+            // walk may not have been capped).
             assert!(
-                capped(g) || grazes_an_edge(mesh, &rays2[i], GRAZE),
-                "secondary ray {i}: the CPU walk was capped, the GPU gave {g:?}"
+                g == c || grazes_an_edge(mesh, &rays2[i], GRAZE),
+                "secondary ray {i}: the CPU walk was capped (then exact: {c:?}), the GPU \
+                 gave {g:?}"
             );
-            continue;
         }
         assert!(
             !g.is_failure()
@@ -758,4 +764,208 @@ fn limits_give_typed_errors_and_split_buffers_and_batches() {
         assert_eq!(a, b, "{layout:?}");
         assert!(a.iter().filter(|o| o.hit().is_some()).count() > 100);
     }
+}
+
+/// The host-side fallback on real dispatches: a tracer at the default step
+/// cap against the same tracer one step below it (where a lost walk keeps
+/// its failure, as on the CPU). Every walk that the lower cap reports lost
+/// (its step cap, or no start) is, at the default cap, the exact walk from
+/// the same start with both walks' tets, counted in
+/// `DispatchStats::host_rewalks`; every other walk is the same; and the
+/// outcomes equal the CPU tracer's wherever the walks agree.
+fn fallback_case(
+    ctx: &GpuContext,
+    mesh: &TetMesh,
+    layout: GpuLayout,
+    rays: &[Ray],
+    starts: &[Start],
+) -> (usize, usize) {
+    let cap = tet_trace_cpu::walk::step_cap(mesh);
+    let gpu = GpuTracer::new(ctx, mesh, layout).unwrap();
+    assert_eq!(gpu.step_cap(), cap);
+    let raw_gpu = GpuTracer::new(ctx, mesh, layout)
+        .unwrap()
+        .with_step_cap(cap - 1);
+    let (out, stats) = gpu.trace_batch(rays, starts).unwrap();
+    let (raw, raw_stats) = raw_gpu.trace_batch(rays, starts).unwrap();
+    assert_eq!(
+        raw_stats.host_rewalks, 0,
+        "{layout:?}: a lower cap re-walks nothing"
+    );
+    let exact = tet_trace_cpu::exact::ExactTracer::new(mesh);
+    let mut rewalked = 0;
+    for (i, (o, r)) in out.iter().zip(&raw).enumerate() {
+        if !lost(r) {
+            assert_eq!(o, r, "{layout:?} ray {i}: not lost, yet changed");
+            continue;
+        }
+        rewalked += 1;
+        // The tets of the GPU walk: at the default cap, one more than the
+        // lower cap's where that stopped the walk.
+        let spent = match r {
+            TraceOutcome::Failed {
+                failure: Failure::StepCap,
+                ..
+            } => cap,
+            _ => r.tets_visited(),
+        };
+        let mut want = exact.trace(&rays[i], starts[i]);
+        match &mut want {
+            TraceOutcome::Hit(h) => h.tets_visited += spent,
+            TraceOutcome::Miss { tets_visited } | TraceOutcome::Failed { tets_visited, .. } => {
+                *tets_visited += spent
+            }
+        }
+        assert_eq!(*o, want, "{layout:?} ray {i}: lost as {r:?}");
+    }
+    assert_eq!(stats.host_rewalks, rewalked as u64, "{layout:?}");
+    assert_eq!(
+        stats.tets_visited,
+        out.iter().map(|o| o.tets_visited() as u64).sum()
+    );
+    let cpu = cpu_trace(mesh, layout, rays, starts, None);
+    let differ = out
+        .iter()
+        .zip(&cpu)
+        .filter(|(g, c)| !same_walk(g, c))
+        .count();
+    let fixed = out
+        .iter()
+        .zip(&raw)
+        .zip(&cpu)
+        .filter(|((o, r), c)| lost(r) && same_walk(o, c))
+        .count();
+    let recovered = out
+        .iter()
+        .zip(&raw)
+        .filter(|(o, r)| lost(r) && !o.is_failure())
+        .count();
+    eprintln!(
+        "{layout:?}: {} rays, {rewalked} lost on the GPU and re-walked on the host ({recovered} \
+         no longer failed, {fixed} now as the CPU tracer, {:.2} ms), {differ} walks differ \
+         from the CPU",
+        rays.len(),
+        stats.host_rewalk_ms
+    );
+    (rewalked, recovered)
+}
+
+#[test]
+fn lost_walks_are_rewalked_exactly_on_the_host() {
+    let Some(ctx) = gpu() else { return };
+    // Axis rays through the vertices of an unjittered grid (where the
+    // Plücker walk of Tet80, not watertight, loses its start or its way),
+    // and random rays on a jittered one; plus starts that cannot start.
+    let grid = unjittered_grid(5);
+    let mut rng = SplitMix64(21);
+    let mut rays: Vec<Ray> = (0..600)
+        .map(|_| axis_ray(&mut rng, Vec3::ZERO, Vec3::splat(4.0)))
+        .collect();
+    let mut starts = located(&grid, &rays);
+    rays.push(Ray::new(Vec3::splat(1.5), Vec3::X));
+    starts.push(Start::Tet(u32::MAX - 1));
+    let (mut total, mut recovered) = (0, 0);
+    let mut add = |(t, r)| {
+        total += t;
+        recovered += r;
+    };
+    for layout in GpuLayout::ALL {
+        add(fallback_case(&ctx, &grid, layout, &rays, &starts));
+    }
+    let jittered = kuhn_grid(&GridSpec {
+        cells: [5, 5, 5],
+        jitter: 0.12,
+        constrained_fraction: 0.15,
+        seed: 11,
+        ..Default::default()
+    });
+    let (rays, starts) = random_rays(&jittered, 1000, 5);
+    for layout in GpuLayout::ALL {
+        add(fallback_case(&ctx, &jittered, layout, &rays, &starts));
+    }
+    eprintln!("{total} walks re-walked on the host, {recovered} of them no longer failed");
+    // The unjittered grid's impossible start is re-walked in every layout
+    // (and stays lost); on the jittered grid the Plücker walk of one ray
+    // circles to its step cap (on lavapipe, as on the CPU), which the
+    // exact walk ends at a hit.
+    assert!(total > GpuLayout::ALL.len(), "no walk lost its way");
+    assert!(
+        recovered > 0,
+        "no lost walk was recovered by the exact walk"
+    );
+}
+
+/// The fallback of camera rays made on the GPU ([`GpuTracer::render`]): a
+/// narrow camera whose centre ray is a ray on which the Plücker walk (Tet80)
+/// circles to its step cap (found among `random_rays(_, 2000, 5)`, on the
+/// CPU as on lavapipe). The host re-walks it from the camera's start tet
+/// with the exact walk, so every pixel equals the CPU tracer's outcome on
+/// the CPU camera's ray, the centre pixel bit for bit.
+#[test]
+fn lost_camera_rays_are_rewalked_exactly_on_the_host() {
+    let Some(ctx) = gpu() else { return };
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [5, 5, 5],
+        jitter: 0.12,
+        constrained_fraction: 0.15,
+        seed: 11,
+        ..Default::default()
+    });
+    let (rays, starts) = random_rays(&mesh, 2000, 5);
+    let (ray, start) = (rays[1161], starts[1161]);
+    let Start::Tet(start_tet) = start else {
+        unreachable!("random rays start in a tet")
+    };
+    let camera = Camera {
+        position: ray.origin,
+        target: ray.origin + ray.direction,
+        up: Vec3::Y,
+        vfov_deg: 1e-3,
+    };
+    let layout = GpuLayout::Tet80;
+    let cap = tet_trace_cpu::walk::step_cap(&mesh);
+    let cpu = cpu_tracer(&mesh, layout, None);
+    let raw_cpu = cpu_tracer(&mesh, layout, Some(cap - 1));
+    let (n, centre) = (3, 4);
+    let cam = PinholeCamera::new(&camera, n, n, true);
+    assert!(
+        lost(&raw_cpu.trace(&cam.ray(1, 1), start)),
+        "the centre ray's walk no longer loses its way: pick another ray"
+    );
+    let gpu = GpuTracer::new(&ctx, &mesh, layout).unwrap();
+    let view = Viewpoint::Inside(start_tet);
+    for frame in [
+        gpu.render(&camera, n, n, true, start_tet).unwrap(),
+        gpu.render_view(&camera, n, n, true, &view).unwrap(),
+    ] {
+        assert!(frame.stats.host_rewalks > 0, "{:?}", frame.stats);
+        for (k, g) in frame.outcomes.iter().enumerate() {
+            let r = cam.ray(k as u32 % n, k as u32 / n);
+            let c = cpu.trace(&r, start);
+            assert!(
+                same_walk(g, &c) || grazes_an_edge(&mesh, &r, GRAZE),
+                "pixel {k}: GPU {g:?} != CPU {c:?}"
+            );
+            assert!(!lost(g), "pixel {k}: {g:?}");
+        }
+        let c = cpu.trace(&cam.ray(1, 1), start);
+        assert_eq!(frame.outcomes[centre], c);
+        assert!(c.tets_visited() >= cap, "both walks' tets: {c:?}");
+        assert_eq!(
+            frame.stats.tets_visited,
+            frame.outcomes.iter().map(|o| o.tets_visited() as u64).sum()
+        );
+        eprintln!("{:?}", frame.stats);
+    }
+    // Under a lower cap the failure stays, as on the CPU.
+    let low = GpuTracer::new(&ctx, &mesh, layout)
+        .unwrap()
+        .with_step_cap(cap - 1);
+    let frame = low.render(&camera, n, n, true, start_tet).unwrap();
+    assert_eq!(frame.stats.host_rewalks, 0);
+    assert!(
+        lost(&frame.outcomes[centre]),
+        "{:?}",
+        frame.outcomes[centre]
+    );
 }
