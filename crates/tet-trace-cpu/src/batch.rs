@@ -1,9 +1,12 @@
 //! Which batch walk each projection takes: the SIMD lockstep walks where
 //! one exists for it ([`crate::lockstep`]), else the scalar interleaved
 //! walk ([`crate::walk::trace_interleaved`]). Every batch walk gives, ray by
-//! ray, exactly the outcome of [`crate::walk::trace`].
+//! ray, exactly the outcome of [`crate::walk::trace`]; the batches of
+//! shadow rays ([`BatchWalk::trace_until_batch`]) that of
+//! [`crate::walk::trace_until`].
 
 use crate::lockstep::{self, NoGate, Planar, Triple, Width};
+use crate::shadow_batch;
 use crate::walk::{
     Batch, DuffF32, DuffF64, LANES, OriginF32, Projection, Topology, TripleF32, trace_interleaved,
 };
@@ -18,6 +21,21 @@ pub trait BatchWalk: Projection {
     fn trace_batch<T: Topology>(batch: Batch<'_, T>) {
         trace_interleaved::<Self, T, LANES>(batch)
     }
+
+    /// Traces `batch` as shadow rays: each ray's outcome is
+    /// [`crate::walk::trace_until`]'s with `stop` (sorted; the walk ends
+    /// with a miss on entering one of its tets, start tet included), from
+    /// its start (rays from outside the mesh, [`Starts::Outside`](crate::walk::Starts::Outside), enter
+    /// as [`crate::walk::trace`] has them enter, and stop on entering a
+    /// stop tet too). In lockstep at `width` where this projection has a
+    /// lockstep walk and the CPU and layout allow it, else the scalar
+    /// interleaved walk. True when the walks ran in lockstep. Default: the
+    /// scalar interleaved walk.
+    fn trace_until_batch<T: Topology>(batch: Batch<'_, T>, stop: &[u32], width: Width) -> bool {
+        let _ = width;
+        shadow_batch::interleaved::<Self, T>(batch, stop);
+        false
+    }
 }
 
 /// SIMD lanes in lockstep ([`lockstep::trace`] with [`Planar`]) where the
@@ -28,6 +46,9 @@ impl BatchWalk for DuffF32 {
             trace_interleaved::<Self, T, LANES>(batch)
         }
     }
+    fn trace_until_batch<T: Topology>(batch: Batch<'_, T>, stop: &[u32], width: Width) -> bool {
+        shadow_batch::projected::<Planar, Self, T>(batch, stop, width)
+    }
 }
 
 /// ScTP's SIMD lanes in lockstep ([`lockstep::trace`] with [`Triple`])
@@ -37,6 +58,9 @@ impl BatchWalk for TripleF32 {
         if let Err(batch) = lockstep::trace::<Triple, _, _>(batch, Width::Auto, &mut NoGate) {
             trace_interleaved::<Self, T, LANES>(batch)
         }
+    }
+    fn trace_until_batch<T: Topology>(batch: Batch<'_, T>, stop: &[u32], width: Width) -> bool {
+        shadow_batch::projected::<Triple, Self, T>(batch, stop, width)
     }
 }
 

@@ -11,6 +11,7 @@ use tet_core::layout::{LayoutError, LayoutMesh, LayoutRecord};
 use tet_core::link::Link;
 
 use crate::batch::BatchWalk;
+use crate::lockstep::Width;
 use crate::lockstep::exit::{ExitRule, RecordWords};
 use crate::lost::{exact_if_lost, exact_where_lost};
 use crate::ray::{Ray, TraceOutcome};
@@ -57,6 +58,42 @@ impl<'m, L: Topology, P: Projection> WalkTracer<'m, L, P> {
     /// The step cap (tets visited before a walk reports failure).
     pub fn step_cap(&self) -> u32 {
         self.cap
+    }
+
+    /// [`Tracer::trace_until_batch`] with the lockstep walk at `width`
+    /// (the trait method takes [`Width::Auto`]): `out[i]` is exactly
+    /// [`Tracer::trace_until`] of `rays[i]` from `starts[i]` with `stop`,
+    /// over the shortest of the three slices, the walks that reach the
+    /// step cap walked again by the exact walk as there. The walks run in
+    /// lockstep where the projection has a lockstep walk
+    /// ([`BatchWalk::trace_until_batch`]) and the CPU the width, else the
+    /// scalar interleaved walk; true when in lockstep.
+    pub fn trace_until_batch_at(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+        stop: &[u32],
+        out: &mut [TraceOutcome],
+        width: Width,
+    ) -> bool
+    where
+        P: BatchWalk,
+    {
+        let n = rays.len().min(starts.len()).min(out.len());
+        let (rays, starts, out) = (&rays[..n], &starts[..n], &mut out[..n]);
+        // The step cap of `Tracer::trace_until`: the mesh's default.
+        let cap = step_cap(self.mesh);
+        let batch = Batch {
+            mesh: self.mesh,
+            topo: &self.layout,
+            rays,
+            starts: Starts::Each(starts),
+            cap,
+            out: &mut *out,
+        };
+        let ran = P::trace_until_batch(batch, stop, width);
+        exact_where_lost(self.mesh, cap, rays, Starts::Each(starts), out);
+        ran
     }
 
     /// The batch of `rays` from `starts` into `out` over this tracer's
@@ -108,6 +145,17 @@ impl<L: Topology, P: BatchWalk> Tracer for WalkTracer<'_, L, P> {
         let cap = step_cap(self.mesh);
         let out = trace_until::<P, L>(self.mesh, &self.layout, ray, start, stop, cap);
         exact_if_lost(self.mesh, cap, ray, start, out)
+    }
+    /// In SIMD lockstep where the CPU has it
+    /// ([`WalkTracer::trace_until_batch_at`] at [`Width::Auto`]).
+    fn trace_until_batch(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+        stop: &[u32],
+        out: &mut [TraceOutcome],
+    ) {
+        self.trace_until_batch_at(rays, starts, stop, out, Width::Auto);
     }
     fn start_outside(
         &self,

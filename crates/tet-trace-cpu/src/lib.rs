@@ -84,6 +84,7 @@ pub mod render;
 pub mod scaled;
 pub mod sctp;
 pub mod secondary;
+mod shadow_batch;
 pub mod tet16;
 pub mod tet20;
 pub mod tet32;

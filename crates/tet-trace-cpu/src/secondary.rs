@@ -63,15 +63,34 @@
 //! walk asks for the exit link of a star tet, so the projected walks reuse
 //! the watertight engine unchanged ([`crate::walk::trace`]); Tet80 checks
 //! the tet at the top of its loop.
+//!
+//! # Batches
+//!
+//! [`ShadowTracer::trace_until_batch`] (and [`Tracer::trace_until_batch`])
+//! trace many shadow rays toward one light, e.g. a render tile's. The tet
+//! kernels walk them side by side in SIMD lockstep, as they walk primary
+//! rays ([`crate::lockstep`]): over the layout itself (the lockstep walk
+//! gathers the layout's records, not [`StopAt`]'s), with a gate that takes
+//! a walk out just before it enters a star tet and writes the outcome the
+//! single-ray walk reaches there (one more tet visited, a miss; the step
+//! cap first, as that walk checks it). A walk that starts in a star tet
+//! ends there before any walk, as above. So every outcome is the
+//! single-ray walk's, bit for bit, hit records and tets visited included,
+//! and the walks that reach the step cap are walked again by the exact
+//! walk as single rays are. Tracers without tets (and any
+//! [`ShadowTracer`] that does not override it) trace the batch ray by
+//! ray; [`PerRay`] forces that, as the reference.
 
 use glam::Vec3;
 use tet_core::{Link, NO_TET, TetMesh};
 
+use crate::batch::BatchWalk;
 use crate::kernel::{Tracer, WalkTracer};
 use crate::locate::{LocateError, locate, star};
 use crate::lockstep::exit::ByLane;
 use crate::ray::{Hit, Ray, TraceOutcome};
-use crate::walk::{DuffF32, Projection, Start, Topology, step_cap, trace_until};
+use crate::shadow_batch;
+use crate::walk::{Batch, DuffF32, Start, Starts, Topology, step_cap, trace_until};
 pub use crate::walk::{StopAt, stops_at};
 
 /// Unit geometric normal of a hit's face (from the source triangle winding).
@@ -275,14 +294,59 @@ pub trait ShadowTracer: Sync {
     /// [`TraceOutcome::Miss`] as soon as the walk enters a tet of `stop`
     /// (sorted; see [`stops_at`]), including the start tet.
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome;
+
+    /// Many shadow rays toward one light (a tile's, in [`crate::render`]):
+    /// `out[i]` is [`ShadowTracer::trace_until`] of `rays[i]` from
+    /// `starts[i]` with `stop`, over the shortest of the three slices. The
+    /// default traces them one by one (right for any tracer, e.g. a BVH);
+    /// the tet kernels walk them side by side, in SIMD lockstep where the
+    /// CPU has it, with the same outcomes bit for bit.
+    fn trace_until_batch(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+        stop: &[u32],
+        out: &mut [TraceOutcome],
+    ) {
+        for ((r, s), o) in rays.iter().zip(starts).zip(out.iter_mut()) {
+            *o = self.trace_until(r, *s, stop);
+        }
+    }
 }
 
-/// Any [`Tracer`] as a [`ShadowTracer`], through [`Tracer::trace_until`]:
-/// the shadow rays of a render walked by its own primary tracer.
+/// Any [`Tracer`] as a [`ShadowTracer`], through [`Tracer::trace_until`]
+/// and [`Tracer::trace_until_batch`]: the shadow rays of a render walked
+/// by its own primary tracer.
 #[derive(Clone, Copy)]
 pub struct OwnShadows<'a, T: ?Sized>(pub &'a T);
 
 impl<T: Tracer + ?Sized> ShadowTracer for OwnShadows<'_, T> {
+    fn mesh(&self) -> &TetMesh {
+        self.0.mesh()
+    }
+    fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
+        self.0.trace_until(ray, start, stop)
+    }
+    fn trace_until_batch(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+        stop: &[u32],
+        out: &mut [TraceOutcome],
+    ) {
+        self.0.trace_until_batch(rays, starts, stop, out)
+    }
+}
+
+/// A [`ShadowTracer`] whose batches are traced one ray at a time (the
+/// trait's default [`ShadowTracer::trace_until_batch`] over the wrapped
+/// tracer's [`ShadowTracer::trace_until`]): the reference the batched
+/// shadow walks are tested and measured against, e.g.
+/// `render_scene_with(t, &PerRay(&OwnShadows(t)), ...)`.
+#[derive(Clone, Copy)]
+pub struct PerRay<'a, S: ?Sized>(pub &'a S);
+
+impl<S: ShadowTracer + ?Sized> ShadowTracer for PerRay<'_, S> {
     fn mesh(&self) -> &TetMesh {
         self.0.mesh()
     }
@@ -318,16 +382,48 @@ impl ShadowTracer for MeshWalker<'_> {
         let topo = MeshTopology(self.mesh);
         trace_until::<DuffF32, _>(self.mesh, &topo, ray, start, stop, self.cap)
     }
+    /// The scalar interleaved walk, the single-ray walk's step (the SIMD
+    /// lanes cannot gather the canonical mesh's records).
+    fn trace_until_batch(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+        stop: &[u32],
+        out: &mut [TraceOutcome],
+    ) {
+        let n = rays.len().min(starts.len()).min(out.len());
+        let topo = MeshTopology(self.mesh);
+        let batch = Batch {
+            mesh: self.mesh,
+            topo: &topo,
+            rays: &rays[..n],
+            starts: Starts::Each(&starts[..n]),
+            cap: self.cap,
+            out: &mut out[..n],
+        };
+        shadow_batch::interleaved::<DuffF32, _>(batch, stop);
+    }
 }
 
-/// Every projected-walk kernel walks its shadow rays on its own layout.
-impl<L: Topology, P: Projection> ShadowTracer for WalkTracer<'_, L, P> {
+/// Every projected-walk kernel walks its shadow rays on its own layout,
+/// as [`Tracer::trace_until`] (and its batches as
+/// [`Tracer::trace_until_batch`]): where a walk reaches the step cap, the
+/// exact walk.
+impl<L: Topology, P: BatchWalk> ShadowTracer for WalkTracer<'_, L, P> {
     fn mesh(&self) -> &TetMesh {
         self.mesh
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
-        let mesh = self.mesh;
-        trace_until::<P, _>(mesh, self.layout(), ray, start, stop, step_cap(mesh))
+        Tracer::trace_until(self, ray, start, stop)
+    }
+    fn trace_until_batch(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+        stop: &[u32],
+        out: &mut [TraceOutcome],
+    ) {
+        Tracer::trace_until_batch(self, rays, starts, stop, out)
     }
 }
 

@@ -115,6 +115,7 @@ use crate::lockstep::{self, NoGate, Plucker, Width};
 use crate::lost::{exact_if_lost, exact_where_lost};
 use crate::ray::{Failure, Hit, Ray, TraceOutcome};
 use crate::secondary::{ShadowTracer, stops_at};
+use crate::shadow_batch::{self, PluckerUntil};
 use crate::walk::{
     Batch, DuffF32, EntryHint, Projection, Start, Starts, TripleF32, degenerate_crossing, face_hit,
     left_f32, start_exit_face, start_scale, step_cap,
@@ -482,17 +483,15 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
     }
 }
 
-impl<const CONSISTENT: bool> PluckerWalk for Tet80Tracer<'_, CONSISTENT> {
-    const CONSISTENT: bool = CONSISTENT;
-    fn records(&self) -> &[Tet80] {
-        &self.layout.tets
-    }
-    /// This walk's own start of each ray: rays sharing one origin share the
+impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
+    /// This walk's own start of each ray of a batch, with the stop test
+    /// `stop` of [`Tet80Tracer::begin`]: rays sharing one origin share the
     /// start tet's interior test.
-    fn starts<'a>(
+    fn starts_with<'a, S: Fn(u32) -> bool + 'a>(
         &'a self,
         rays: &'a [Ray],
         starts: Starts<'a>,
+        stop: S,
     ) -> impl FnMut(usize) -> Result<Begun, TraceOutcome> + 'a {
         let inside = match starts {
             Starts::Same(s) => self.shared_inside(rays, s),
@@ -506,8 +505,65 @@ impl<const CONSISTENT: bool> PluckerWalk for Tet80Tracer<'_, CONSISTENT> {
                 Starts::Each(s) => s[i],
                 Starts::Outside(entry) => self.start_outside(entry, r, &mut hint)?,
             };
-            self.begin(r, start, inside, &|_| false)
+            self.begin(r, start, inside, &stop)
         }
+    }
+
+    /// [`ShadowTracer::trace_until_batch`] with the lockstep walk at
+    /// `width` (the trait method takes [`Width::Auto`]): `out[i]` is
+    /// exactly [`ShadowTracer::trace_until`] of `rays[i]` from `starts[i]`
+    /// with `stop`, over the shortest of the three slices. The walks run in
+    /// lockstep where the CPU has the width (each stopped short of the stop
+    /// tets, see [`lockstep`]'s gates), else one by one; true when in
+    /// lockstep. Walks that reach the step cap are walked again by the
+    /// exact walk, as there.
+    pub fn trace_until_batch_at(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+        stop: &[u32],
+        out: &mut [TraceOutcome],
+        width: Width,
+    ) -> bool {
+        let n = rays.len().min(starts.len()).min(out.len());
+        let (rays, starts, out) = (&rays[..n], &starts[..n], &mut out[..n]);
+        let batch = self.batch(rays, Starts::Each(starts), out);
+        let ran = shadow_batch::plucker(batch, stop, width);
+        if !ran {
+            for ((r, s), o) in rays.iter().zip(starts).zip(out.iter_mut()) {
+                *o = self.trace_with(r, *s, None, |t| stops_at(stop, t));
+            }
+        }
+        exact_where_lost(self.mesh, self.cap, rays, Starts::Each(starts), out);
+        ran
+    }
+}
+
+/// Shadow rays' starts: the stop test of the single-ray start.
+impl<const CONSISTENT: bool> PluckerUntil for Tet80Tracer<'_, CONSISTENT> {
+    fn starts_until<'a>(
+        &'a self,
+        rays: &'a [Ray],
+        starts: Starts<'a>,
+        stop: &'a [u32],
+    ) -> impl FnMut(usize) -> Result<Begun, TraceOutcome> + 'a {
+        self.starts_with(rays, starts, move |t| stops_at(stop, t))
+    }
+}
+
+impl<const CONSISTENT: bool> PluckerWalk for Tet80Tracer<'_, CONSISTENT> {
+    const CONSISTENT: bool = CONSISTENT;
+    fn records(&self) -> &[Tet80] {
+        &self.layout.tets
+    }
+    /// This walk's own start of each ray: rays sharing one origin share the
+    /// start tet's interior test.
+    fn starts<'a>(
+        &'a self,
+        rays: &'a [Ray],
+        starts: Starts<'a>,
+    ) -> impl FnMut(usize) -> Result<Begun, TraceOutcome> + 'a {
+        self.starts_with(rays, starts, |_| false)
     }
     fn leave(
         &self,
@@ -674,6 +730,15 @@ impl<const CONSISTENT: bool> Tracer for Tet80Tracer<'_, CONSISTENT> {
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
         ShadowTracer::trace_until(self, ray, start, stop)
     }
+    fn trace_until_batch(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+        stop: &[u32],
+        out: &mut [TraceOutcome],
+    ) {
+        ShadowTracer::trace_until_batch(self, rays, starts, stop, out)
+    }
     /// In SIMD lockstep ([`lockstep::trace`] at [`Width::Auto`]): 16 lanes
     /// with AVX-512F (unless `TET_LOCKSTEP=avx2`), else 8 with AVX2; else,
     /// or with `TET_LOCKSTEP=scalar`, the scalar walk
@@ -709,5 +774,16 @@ impl<const CONSISTENT: bool> ShadowTracer for Tet80Tracer<'_, CONSISTENT> {
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
         let out = self.trace_with(ray, start, None, |t| stops_at(stop, t));
         exact_if_lost(self.mesh, self.cap, ray, start, out)
+    }
+    /// In SIMD lockstep where the CPU has AVX2 or AVX-512F
+    /// ([`Tet80Tracer::trace_until_batch_at`] at [`Width::Auto`]).
+    fn trace_until_batch(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+        stop: &[u32],
+        out: &mut [TraceOutcome],
+    ) {
+        self.trace_until_batch_at(rays, starts, stop, out, Width::Auto);
     }
 }

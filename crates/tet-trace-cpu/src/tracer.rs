@@ -81,4 +81,22 @@ pub trait Tracer: Sync {
         let _ = stop;
         self.trace(ray, start)
     }
+
+    /// Many shadow rays toward one light: `out[i]` is
+    /// [`Tracer::trace_until`] of `rays[i]` from `starts[i]` with `stop`,
+    /// over the shortest of the three slices. The default traces them one
+    /// by one; the tet kernels walk them side by side (in SIMD lockstep
+    /// where the CPU has it), as they walk primary rays, with the same
+    /// outcomes bit for bit.
+    fn trace_until_batch(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+        stop: &[u32],
+        out: &mut [TraceOutcome],
+    ) {
+        for ((r, s), o) in rays.iter().zip(starts).zip(out.iter_mut()) {
+            *o = self.trace_until(r, *s, stop);
+        }
+    }
 }

@@ -16,6 +16,14 @@ pub trait Gate<H> {
     const ON: bool;
     /// Whether a walk stops before entering `tet`.
     fn stops_before(&self, tet: u32) -> bool;
+    /// The one tet the gate stops before, when it names only one (a
+    /// shadow ray's light strictly inside a tet): the driver then compares
+    /// all lanes with it at once instead of asking
+    /// [`Gate::stops_before`] lane by lane (the same answers). Default:
+    /// none.
+    fn only(&self) -> Option<u32> {
+        None
+    }
     /// Receives ray `ray`'s walk, stopped before entering a tet it names.
     fn hand_over(&mut self, ray: usize, h: H);
 }
@@ -80,6 +88,8 @@ pub(crate) trait Rounds<L: Lanes> {
     fn events(&self, l: L, feed: &mut Self::Feed, pk: &mut Self::Pack, r: &Self::Round) -> usize;
     /// The tet each lane enters next, and the live lanes as bits.
     fn entering(&self, l: L, pk: &Self::Pack) -> (L::Arr<u32>, u32);
+    /// The live lanes (bits) about to enter `tet`, compared in SIMD.
+    fn entering_is(&self, l: L, pk: &Self::Pack, tet: u32) -> u32;
     /// Hands the lanes of `stop` (bits) to `gate` and refills them,
     /// handing over at once the new walks whose first tet the gate names
     /// too. Returns the number of lanes parked.
@@ -109,6 +119,7 @@ where
     GT: Gate<R::Handover>,
 {
     let mut packs: [(R::Pack, usize); PACKS] = std::array::from_fn(|_| walk.fill(l, feed));
+    let only = if GT::ON { gate.only() } else { None };
     loop {
         let mut any = false;
         for (pk, live) in packs.iter_mut() {
@@ -116,13 +127,19 @@ where
                 continue;
             }
             if GT::ON {
-                let (next, live_bits) = walk.entering(l, pk);
-                let mut stop = 0u32;
-                for k in (0..L::WIDTH).filter(|k| live_bits >> k & 1 != 0) {
-                    if gate.stops_before(next.as_ref()[k]) {
-                        stop |= 1 << k;
+                let stop = match only {
+                    Some(tet) => walk.entering_is(l, pk, tet),
+                    None => {
+                        let (next, live_bits) = walk.entering(l, pk);
+                        let mut stop = 0u32;
+                        for k in (0..L::WIDTH).filter(|k| live_bits >> k & 1 != 0) {
+                            if gate.stops_before(next.as_ref()[k]) {
+                                stop |= 1 << k;
+                            }
+                        }
+                        stop
                     }
-                }
+                };
                 if stop != 0 {
                     let (f, p, g) = (&mut *feed, &mut *pk, &mut *gate);
                     *live -= l.cold(move || walk.hand_over(l, f, p, g, stop));

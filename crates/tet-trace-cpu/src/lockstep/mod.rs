@@ -47,7 +47,11 @@
 //! names, handing its state to the caller, which walks on with the scalar
 //! walk: the iso walk gates on the range test, so the tets on no
 //! isovalue's side are walked in lockstep
-//! ([`crate::iso::IsoWalk::trace_tile`]). The plain walk's gate
+//! ([`crate::iso::IsoWalk::trace_tile`]); batches of shadow rays gate on
+//! the light's tets, where their walks end
+//! ([`crate::secondary::ShadowTracer::trace_until_batch`]). A gate that
+//! names one tet (a light strictly inside a tet) is checked in SIMD, one
+//! compare per pack and round; others lane by lane. The plain walk's gate
 //! ([`NoGate`]) compiles away.
 //!
 //! # Widths

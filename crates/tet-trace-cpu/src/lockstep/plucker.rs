@@ -500,6 +500,15 @@ where
         (tets, l.bits(pk.live))
     }
     #[inline(always)]
+    fn entering_is(&self, l: L, pk: &Pack<L, S>, tet: u32) -> u32 {
+        if tet >= 1 << 30 {
+            // No record has that index (`tet << 2` would wrap).
+            return 0;
+        }
+        let t4 = l.and_i(pk.next, l.splat_i(!3));
+        l.bits(l.and_m(l.eq_i(t4, l.splat_i(tet << 2)), pk.live))
+    }
+    #[inline(always)]
     fn hand_over<GT: Gate<Begun>>(
         &self,
         l: L,

@@ -374,6 +374,10 @@ impl<'a, L: Lanes, G: Projected<L>, X: Records<L>> Rounds<L> for Walk<'a, G, X> 
         (L::i_lanes(pk.next), l.bits(pk.live))
     }
     #[inline(always)]
+    fn entering_is(&self, l: L, pk: &Pack<L, G>, tet: u32) -> u32 {
+        l.bits(l.and_m(l.eq_i(pk.next, l.splat_i(tet)), pk.live))
+    }
+    #[inline(always)]
     fn hand_over<GT: Gate<Handover>>(
         &self,
         l: L,

@@ -57,7 +57,7 @@ impl<T: Topology> Topology for StopAt<'_, T> {
 }
 
 /// True when a walk starting at `start` already starts in a stop tet.
-fn starts_in(start: Start, stop: &[u32]) -> bool {
+pub(crate) fn starts_in(start: Start, stop: &[u32]) -> bool {
     match start {
         Start::Tet(t) => stops_at(stop, t),
         Start::Face { tet, .. } | Start::Entry { tet, .. } => stops_at(stop, tet),
