@@ -21,42 +21,9 @@
 use tet_core::TetMesh;
 
 use crate::exact::ExactTracer;
-use crate::ray::{Failure, Ray, TraceOutcome};
+use crate::ray::{Ray, TraceOutcome};
 use crate::tracer::Tracer;
 use crate::walk::{Start, Starts, step_cap};
-
-/// True when `out` is a walk that lost its way: stopped at its step cap,
-/// or found no start (`Lost`: rounding moved the ray's line off every tet
-/// near its origin).
-fn capped(out: &TraceOutcome) -> bool {
-    matches!(
-        out,
-        TraceOutcome::Failed {
-            failure: Failure::StepCap | Failure::Lost,
-            ..
-        }
-    )
-}
-
-/// `out` with `spent` more tets visited.
-fn with_spent(out: TraceOutcome, spent: u32) -> TraceOutcome {
-    match out {
-        TraceOutcome::Hit(mut h) => {
-            h.tets_visited = h.tets_visited.saturating_add(spent);
-            TraceOutcome::Hit(h)
-        }
-        TraceOutcome::Miss { tets_visited } => TraceOutcome::Miss {
-            tets_visited: tets_visited.saturating_add(spent),
-        },
-        TraceOutcome::Failed {
-            failure,
-            tets_visited,
-        } => TraceOutcome::Failed {
-            failure,
-            tets_visited: tets_visited.saturating_add(spent),
-        },
-    }
-}
 
 /// `out`, or the exact walk's outcome of `ray` from `start` where `out`
 /// reached a step cap `cap` at or above the mesh's default.
@@ -67,10 +34,12 @@ pub(crate) fn exact_if_lost(
     start: Start,
     out: TraceOutcome,
 ) -> TraceOutcome {
-    if !capped(&out) || cap < step_cap(mesh) {
+    if !out.lost_its_way() || cap < step_cap(mesh) {
         return out;
     }
-    with_spent(ExactTracer::new(mesh).trace(ray, start), out.tets_visited())
+    ExactTracer::new(mesh)
+        .trace(ray, start)
+        .with_tets_added(out.tets_visited())
 }
 
 /// [`exact_if_lost`] over a batch: every outcome in `out` that reached a
@@ -84,12 +53,12 @@ pub(crate) fn exact_where_lost(
     starts: Starts<'_>,
     out: &mut [TraceOutcome],
 ) {
-    if cap < step_cap(mesh) || !out.iter().any(capped) {
+    if cap < step_cap(mesh) || !out.iter().any(TraceOutcome::lost_its_way) {
         return;
     }
     let exact = ExactTracer::new(mesh);
     for (i, (ray, o)) in rays.iter().zip(out.iter_mut()).enumerate() {
-        if !capped(o) {
+        if !o.lost_its_way() {
             continue;
         }
         let one = match starts {
@@ -102,13 +71,14 @@ pub(crate) fn exact_where_lost(
         };
         let mut again = [*o];
         exact.trace_batch_from(std::slice::from_ref(ray), one, &mut again);
-        *o = with_spent(again[0], o.tets_visited());
+        *o = again[0].with_tets_added(o.tets_visited());
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ray::Failure;
     use glam::Vec3;
     use tet_core::synthetic::{GridSpec, kuhn_grid};
 

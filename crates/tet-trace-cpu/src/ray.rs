@@ -113,6 +113,41 @@ pub enum TraceOutcome {
 }
 
 impl TraceOutcome {
+    /// True when the walk lost its way: it stopped at its step cap, or
+    /// found no start tet holding the ray's line ([`Failure::Lost`]). The
+    /// tracers then walk the ray again with the exact walk (at the default
+    /// step cap, which no line's walk reaches).
+    pub fn lost_its_way(&self) -> bool {
+        matches!(
+            self,
+            TraceOutcome::Failed {
+                failure: Failure::StepCap | Failure::Lost,
+                ..
+            }
+        )
+    }
+
+    /// This outcome with `spent` more tets visited: the outcome of a walk
+    /// redone after another walk spent `spent` tets on the same ray.
+    pub fn with_tets_added(self, spent: u32) -> TraceOutcome {
+        match self {
+            TraceOutcome::Hit(mut h) => {
+                h.tets_visited = h.tets_visited.saturating_add(spent);
+                TraceOutcome::Hit(h)
+            }
+            TraceOutcome::Miss { tets_visited } => TraceOutcome::Miss {
+                tets_visited: tets_visited.saturating_add(spent),
+            },
+            TraceOutcome::Failed {
+                failure,
+                tets_visited,
+            } => TraceOutcome::Failed {
+                failure,
+                tets_visited: tets_visited.saturating_add(spent),
+            },
+        }
+    }
+
     /// The hit, if any.
     pub fn hit(&self) -> Option<&Hit> {
         match self {

@@ -25,43 +25,11 @@ use std::time::Instant;
 use tet_core::TetMesh;
 use tet_trace_cpu::exact::ExactTracer;
 use tet_trace_cpu::walk::step_cap;
-use tet_trace_cpu::{Failure, Ray, Start, Starts, TraceOutcome, Tracer};
+use tet_trace_cpu::{Ray, Start, Starts, TraceOutcome, Tracer};
 
 use crate::stats::DispatchStats;
 
-/// True when `out` is a walk that lost its way: stopped at its step cap,
-/// or found no start (`Lost`).
-pub(crate) fn lost(out: &TraceOutcome) -> bool {
-    matches!(
-        out,
-        TraceOutcome::Failed {
-            failure: Failure::StepCap | Failure::Lost,
-            ..
-        }
-    )
-}
-
-/// `out` with `spent` more tets visited.
-fn with_spent(out: TraceOutcome, spent: u32) -> TraceOutcome {
-    match out {
-        TraceOutcome::Hit(mut h) => {
-            h.tets_visited = h.tets_visited.saturating_add(spent);
-            TraceOutcome::Hit(h)
-        }
-        TraceOutcome::Miss { tets_visited } => TraceOutcome::Miss {
-            tets_visited: tets_visited.saturating_add(spent),
-        },
-        TraceOutcome::Failed {
-            failure,
-            tets_visited,
-        } => TraceOutcome::Failed {
-            failure,
-            tets_visited: tets_visited.saturating_add(spent),
-        },
-    }
-}
-
-/// Replaces every outcome in `out` that lost its way ([`lost`]) under a
+/// Replaces every outcome in `out` that lost its way ([`TraceOutcome::lost_its_way`]) under a
 /// step cap `cap` at or above the mesh's default by the exact walk's
 /// outcome, with the tets of both walks. `start_of(i)` gives the ray and
 /// start of outcome `i` (the ray as the walk saw it, the start it walked
@@ -76,13 +44,13 @@ pub(crate) fn exact_where_lost(
     stats: &mut DispatchStats,
     mut start_of: impl FnMut(usize) -> Option<(Ray, Start)>,
 ) {
-    if cap < step_cap(mesh) || !out.iter().any(lost) {
+    if cap < step_cap(mesh) || !out.iter().any(TraceOutcome::lost_its_way) {
         return;
     }
     let t0 = Instant::now();
     let (mut index, mut rays, mut starts) = (Vec::new(), Vec::new(), Vec::new());
     for (i, o) in out.iter().enumerate() {
-        if lost(o)
+        if o.lost_its_way()
             && let Some((ray, start)) = start_of(i)
         {
             index.push(i);
@@ -97,7 +65,7 @@ pub(crate) fn exact_where_lost(
     let mut again = vec![TraceOutcome::Miss { tets_visited: 0 }; rays.len()];
     ExactTracer::new(mesh).trace_batch_from(&rays, Starts::Each(&starts), &mut again);
     for (&i, a) in index.iter().zip(again) {
-        out[i] = with_spent(a, out[i].tets_visited());
+        out[i] = a.with_tets_added(out[i].tets_visited());
     }
     stats.host_rewalks += index.len() as u64;
     stats.host_rewalk_ms += t0.elapsed().as_secs_f64() * 1e3;
@@ -108,6 +76,7 @@ mod tests {
     use super::*;
     use glam::Vec3;
     use tet_core::synthetic::{GridSpec, kuhn_grid};
+    use tet_trace_cpu::Failure;
 
     /// A lost walk (step cap or no start) at the default cap gives the
     /// exact walk's outcome with both walks' tets, and is counted; under a
