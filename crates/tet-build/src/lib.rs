@@ -22,7 +22,9 @@
 //! Modules, bottom up (each uses only modules above it in this list):
 //!
 //! * [`scene`]: triangle scenes (OBJ files, `scenes.json`); [`procedural`]:
-//!   scenes made in code; [`source`]: a scene named by a spec string.
+//!   scenes made in code, among them [`flat`] (flat-faced solids),
+//!   [`city`] and [`pipes`] (stand-ins for the paper's Rungholt and Exhaust
+//!   Pipe); [`source`]: a scene named by a spec string.
 //! * [`clean`], [`intersect`], [`bbox`], [`quality`]: cleaning, exact
 //!   self-intersection search, the enclosing box, tet quality;
 //!   [`resolve`]: self-intersecting triangles split along their
@@ -40,12 +42,14 @@
 #![deny(missing_docs)]
 
 pub mod bbox;
+pub mod city;
 pub mod clean;
 pub mod flat;
 pub mod intersect;
 #[cfg(feature = "tetgen")]
 pub mod outofcore;
 pub mod pipeline;
+pub mod pipes;
 pub mod procedural;
 pub mod quality;
 /// Making a self-intersecting triangle soup meet only in shared vertices and edges.

@@ -1,5 +1,6 @@
-//! Procedural scenes that need no files: the paper's torus-knot scenes and
-//! simple shapes for tests.
+//! Procedural scenes that need no files: the paper's torus-knot scenes,
+//! stand-ins for its scenes without a mesh here (Rungholt: [`crate::city`];
+//! Exhaust Pipe: [`crate::pipes`]) and simple shapes for tests.
 //!
 //! ## The torus knot
 //!
@@ -123,6 +124,26 @@ pub const SCENES: &[Procedural] = &[
         build: |_, n| dense_torus_knots(n),
     },
     Procedural {
+        name: "city",
+        about: "Rungholt stand-in: axis-aligned buildings on a street grid, about the paper's 3,580,928 triangles",
+        build: |_, _| crate::city::city(crate::city::RUNGHOLT_TRIANGLES),
+    },
+    Procedural {
+        name: "city:N",
+        about: "the Rungholt stand-in at about N triangles, at least 1,000 (city:200k)",
+        build: |_, n| crate::city::city(n),
+    },
+    Procedural {
+        name: "pipes",
+        about: "Exhaust Pipe stand-in: a bundle of long bent capped tubes, about the paper's 6,244,678 triangles",
+        build: |_, _| crate::pipes::pipes(crate::pipes::EXHAUST_PIPE_TRIANGLES),
+    },
+    Procedural {
+        name: "pipes:N",
+        about: "the Exhaust Pipe stand-in at about N triangles, at least 1,000 (pipes:200k)",
+        build: |_, n| crate::pipes::pipes(n),
+    },
+    Procedural {
         name: "fan-sphere:N",
         about: "a bumpy sphere of about N triangles whose poles are fans of about √N long thin triangles (fan-sphere:1m)",
         build: |name, n| single_object_scene(name, &fan_sphere(&fan_sphere_by_count(n))),
@@ -132,7 +153,9 @@ pub const SCENES: &[Procedural] = &[
 /// Build a procedural scene by name: a name of [`SCENES`], or the `name`
 /// of one ending in `:N` with a count for `N` ([`parse_count`], e.g.
 /// `dense-knots:10m`: [`dense_torus_knots`]; `fan-sphere:N`:
-/// [`fan_sphere_by_count`]).
+/// [`fan_sphere_by_count`]; `city:N`, `pipes:N`: [`crate::city::city`],
+/// [`crate::pipes::pipes`], the stand-ins for the paper's Rungholt and
+/// Exhaust Pipe).
 pub fn by_name(name: &str) -> Option<Scene> {
     if let Some(p) = SCENES
         .iter()
