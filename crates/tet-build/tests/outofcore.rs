@@ -1528,3 +1528,54 @@ fn a_job_plan_gets_the_walls_of_the_default_build() {
     assert!(job_tpr <= 1.05 * walled_tpr, "{job_tpr} vs {walled_tpr}");
     assert!(job_tpr < 0.95 * one_tpr, "{job_tpr} vs {one_tpr}");
 }
+
+/// A part TetGen is stuck on gets its walls moved and the build tried
+/// again. The worker is a wrapper whose first run hangs (as TetGen's
+/// boundary recovery under `-Y` did on a city's fan-triangulated streets)
+/// and whose later runs are the real worker: the build must time the
+/// stuck run out, move that part's walls once, and merge a mesh that
+/// traces like the in-core one.
+#[cfg(unix)]
+#[test]
+fn a_part_tetgen_is_stuck_on_gets_its_walls_moved() {
+    use std::os::unix::fs::PermissionsExt;
+    use tet_build::outofcore::tree::build_tree_with_memory_limit;
+
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("stuck-once.sh");
+    std::fs::write(
+        &script,
+        format!(
+            "#!/bin/sh\nif mkdir '{}' 2>/dev/null; then exec sleep 60; fi\nexec '{}' \"$@\"\n",
+            dir.path().join("stuck").display(),
+            env!("CARGO_BIN_EXE_tet-build-worker"),
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let scene = knot_grid(1, 120, 12);
+    let options = SeamOptions {
+        isolation: Isolation::Worker(WorkerCommand {
+            program: script,
+            args: vec![],
+            timeout: Some(Duration::from_secs(5)),
+        }),
+        parallel_parts: 1,
+        ..SeamOptions::default()
+    };
+    let split = SplitOptions {
+        limit_bytes: u64::MAX,
+        min_depth: 2,
+        ..SplitOptions::default()
+    };
+    let (mesh, report, plan) = build_tree_with_memory_limit(&scene, &split, &options).unwrap();
+    assert!(
+        dir.path().join("stuck").exists(),
+        "the first run was the stuck one"
+    );
+    assert_eq!(plan.plane_moves, 1);
+    assert_eq!(report.part_tets.len(), 4);
+    // The built planes are the planned ones but for the stuck part's walls.
+    assert_ne!(plan.cuts, CutTree::from_split_tree(&plan.plan));
+    check_against_in_core(&scene, &mesh);
+}

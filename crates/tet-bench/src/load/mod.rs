@@ -301,6 +301,14 @@ pub fn build_scene_in(
     Ok((mesh, summary))
 }
 
+/// `--walls auto`: the time limit of one part's TetGen run, seconds (or
+/// `--time-limit` where lower). Its parts are predicted at about 28 MiB
+/// and built in about a second; a run far past that is stuck (TetGen's
+/// boundary recovery under `-Y` can loop), and the build moves the part's
+/// walls and tries again rather than wait out the 600 s default.
+#[cfg(feature = "tetgen")]
+pub const WALLED_PART_TIME_LIMIT_S: f64 = 60.0;
+
 /// `--walls`: a scene built as parts with exact walls between them, in
 /// memory, even when it would fit one TetGen run. The out-of-core
 /// builder's recursive planes (Erkoç et al. 2021) cut the enclosing
@@ -330,10 +338,16 @@ fn build_walled(
     let spinner = spinner(quiet);
     let depth = walls.depth(scene.triangles.len());
     spinner.set_message(format!("building {} in parts with walls", scene.name));
-    let options = tet_build::outofcore::seam::SeamOptions {
+    let mut options = tet_build::outofcore::seam::SeamOptions {
         parallel_parts: std::thread::available_parallelism().map_or(1, |n| n.get()),
         ..seam_options(scene, flags, extra)?
     };
+    if walls == build_flags::Walls::Auto {
+        // Each part is small (a few thousand triangles); one that runs
+        // long has met a configuration TetGen is stuck on, which moving
+        // its walls or the next split or one piece resolves sooner.
+        options.isolation = worker_isolation(flags.time_limit.min(WALLED_PART_TIME_LIMIT_S))?;
+    }
     // `auto`: the parts as the memory planner cuts them for a small
     // target (dense regions split, light ones and empty margins left
     // whole), or, should that build fail, every part split to `depth`.
@@ -351,16 +365,27 @@ fn build_walled(
     };
     let tetgen_start = Instant::now();
     let mut built = None;
-    for split in &splits {
+    // Why a split before the one that built failed (the switches say).
+    let mut note = String::new();
+    for (i, split) in splits.iter().enumerate() {
         match tet_build::outofcore::tree::build_tree_with_memory_limit(scene, split, &options) {
             Ok(b) => {
                 built = Some(Ok(b));
                 break;
             }
-            Err(e) => built = Some(Err(e)),
+            Err(e) => {
+                if !quiet && i + 1 < splits.len() {
+                    eprintln!(
+                        "{}: walls failed: {e}; trying every part cut to depth {depth}",
+                        scene.name
+                    );
+                }
+                note = format!(" (the parts shaped for rays failed: {e})");
+                built = Some(Err(e));
+            }
         }
     }
-    let (mut mesh, report, _) = match built.expect("at least one split is tried") {
+    let (mut mesh, report, plan) = match built.expect("at least one split is tried") {
         Ok(b) => b,
         // `auto` promises a mesh: where no walled build succeeds, the
         // scene is built in one piece, and the switches say why.
@@ -403,9 +428,14 @@ fn build_walled(
         .count();
     let summary = BuildSummary {
         switches: format!(
-            "{} in {} parts",
+            "{} in {} parts{}{note}",
             options.tetgen.switches(),
-            report.part_tets.len()
+            report.part_tets.len(),
+            match plan.plane_moves {
+                0 => String::new(),
+                1 => ", walls moved once".to_string(),
+                n => format!(", walls moved {n} times"),
+            }
         ),
         // The input triangles the mesh holds a face of (cleaning drops
         // degenerate ones).

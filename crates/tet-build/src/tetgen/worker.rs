@@ -281,6 +281,11 @@ fn parse_switches(s: &str) -> Option<TetgenOptions> {
 }
 
 /// Runs TetGen in a child process (input already checked by the caller).
+///
+/// With `TET_WORKER_KEEP=DIR` in the environment, a request that runs past
+/// its time limit is kept as `DIR/timeout-PID.req`, so that a stuck run
+/// can be replayed on its own (`tet-bench tetgen-worker < FILE`) and
+/// reported.
 pub fn run_worker(
     cmd: &WorkerCommand,
     input: &TetgenInput,
@@ -300,6 +305,7 @@ pub fn run_worker(
     let mut stderr = child.stderr.take().expect("piped stderr");
     let switches = options.switches();
     let request = encode_request(input, &switches);
+    let keep = std::env::var_os("TET_WORKER_KEEP").map(|d| (d, request.clone()));
     let writer = std::thread::spawn(move || -> io::Result<()> {
         stdin.write_all(&request)?;
         stdin.flush()
@@ -338,6 +344,10 @@ pub fn run_worker(
             let _ = writer.join();
             let _ = reader.join();
             let _ = err_reader.join();
+            if let Some((dir, request)) = &keep {
+                let path = std::path::Path::new(dir).join(format!("timeout-{}.req", child.id()));
+                let _ = std::fs::write(&path, request);
+            }
             return Err(TetgenError::Timeout {
                 seconds: limit.as_secs_f64(),
             });

@@ -94,7 +94,16 @@ impl CutTree {
         let mut moved = false;
         if *p == plane {
             let v = p.value + step;
-            if v > lo[a] && v < hi[a] && v != p.value {
+            // The planes below and above must stay on their sides of it.
+            let (mut below_hi, mut above_lo) = (hi, lo);
+            below_hi[a] = v;
+            above_lo[a] = v;
+            if v > lo[a]
+                && v < hi[a]
+                && v != p.value
+                && below.inside(lo, below_hi)
+                && above.inside(above_lo, hi)
+            {
                 p.value = v;
                 moved = true;
             }
@@ -105,5 +114,124 @@ impl CutTree {
         moved |= below.nudge(plane, step, lo, mid_hi);
         moved |= above.nudge(plane, step, mid_lo, hi);
         moved
+    }
+
+    /// Whether every plane of the tree lies strictly inside its part's
+    /// box, the box of the whole being `lo..hi`.
+    fn inside(&self, lo: Vec3, hi: Vec3) -> bool {
+        match self {
+            CutTree::Leaf => true,
+            CutTree::Split {
+                plane,
+                below,
+                above,
+            } => {
+                let a = plane.axis;
+                let (mut mid_hi, mut mid_lo) = (hi, lo);
+                mid_hi[a] = plane.value;
+                mid_lo[a] = plane.value;
+                plane.value > lo[a]
+                    && plane.value < hi[a]
+                    && below.inside(lo, mid_hi)
+                    && above.inside(mid_lo, hi)
+            }
+        }
+    }
+
+    /// The planes that bound leaf `part` (leaves counted depth first,
+    /// below before above): on each side of the leaf's box the innermost
+    /// plane on the path to it, i.e. the part's walls between it and its
+    /// neighbours. `None` when there is no such leaf.
+    pub(crate) fn leaf_walls(&self, part: usize) -> Option<Vec<SplitPlane>> {
+        // [axis][0: the lower side, 1: the upper side].
+        let mut sides: [[Option<SplitPlane>; 2]; 3] = [[None; 2]; 3];
+        let (mut node, mut index) = (self, part);
+        loop {
+            match node {
+                CutTree::Leaf => {
+                    let walls = sides.iter().flatten().flatten().copied().collect();
+                    return (index == 0).then_some(walls);
+                }
+                CutTree::Split {
+                    plane,
+                    below,
+                    above,
+                } => {
+                    let n = below.parts();
+                    if index < n {
+                        sides[plane.axis][1] = Some(*plane);
+                        node = below;
+                    } else {
+                        sides[plane.axis][0] = Some(*plane);
+                        index -= n;
+                        node = above;
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plane(axis: usize, value: f32) -> SplitPlane {
+        SplitPlane { axis, value }
+    }
+
+    /// Leaves of a 2×2 grid and of a deeper tree, checked against the
+    /// boxes drawn by hand.
+    #[test]
+    fn leaf_walls_are_the_innermost_planes_around_each_leaf() {
+        // x = 1, then y = 2 in each half: leaves (x<1,y<2), (x<1,y>2),
+        // (x>1,y<2), (x>1,y>2).
+        let grid = CutTree::grid(&[1.0], &[2.0], &[]);
+        assert_eq!(grid.leaf_walls(0), Some(vec![plane(0, 1.0), plane(1, 2.0)]));
+        assert_eq!(grid.leaf_walls(1), Some(vec![plane(0, 1.0), plane(1, 2.0)]));
+        assert_eq!(grid.leaf_walls(3), Some(vec![plane(0, 1.0), plane(1, 2.0)]));
+        assert_eq!(grid.leaf_walls(4), None);
+        // x = 0, its upper half by x = 5, then that lower half by z = 3:
+        // leaf 1 is 0 < x < 5, z < 3: walls x = 0 (below it), x = 5
+        // (above it), z = 3; the outer x = 0 is not replaced by anything
+        // nearer on its side.
+        let tree = CutTree::split(
+            0,
+            0.0,
+            CutTree::Leaf,
+            CutTree::split(
+                0,
+                5.0,
+                CutTree::split(2, 3.0, CutTree::Leaf, CutTree::Leaf),
+                CutTree::Leaf,
+            ),
+        );
+        assert_eq!(tree.leaf_walls(0), Some(vec![plane(0, 0.0)]));
+        assert_eq!(
+            tree.leaf_walls(1),
+            Some(vec![plane(0, 0.0), plane(0, 5.0), plane(2, 3.0)])
+        );
+        assert_eq!(tree.leaf_walls(3), Some(vec![plane(0, 5.0)]));
+        assert_eq!(CutTree::Leaf.leaf_walls(0), Some(vec![]));
+    }
+
+    /// A plane is not moved past a plane of its subtree (that plane would
+    /// leave its part's box); one with room is.
+    #[test]
+    fn nudge_keeps_every_plane_inside_its_box() {
+        let (lo, hi) = (Vec3::splat(-10.0), Vec3::splat(10.0));
+        let tree = CutTree::split(
+            1,
+            0.0,
+            CutTree::split(1, -0.5, CutTree::Leaf, CutTree::Leaf),
+            CutTree::Leaf,
+        );
+        let mut t = tree.clone();
+        assert!(!t.nudge(plane(1, 0.0), -1.0, lo, hi), "would pass y = -0.5");
+        assert_eq!(t, tree);
+        assert!(t.nudge(plane(1, 0.0), -0.25, lo, hi));
+        assert!(t.inside(lo, hi));
+        assert!(t.nudge(plane(1, -0.25), 1.0, lo, hi), "room above");
+        assert!(t.inside(lo, hi));
     }
 }

@@ -61,6 +61,7 @@ use super::stream::{StreamOptions, StreamSummary, ToFile};
 use crate::bbox::EnclosingBox;
 use crate::clean::clean_scene;
 use crate::scene::Scene;
+use crate::tetgen::TetgenError;
 
 pub use cut_tree::CutTree;
 
@@ -252,6 +253,11 @@ pub struct TreePlan {
 /// a degenerate configuration before giving up.
 pub const MAX_PLANE_MOVES: usize = 8;
 
+/// How many times [`build_tree_with_memory_limit`] moves the walls of a
+/// part TetGen failed on or ran past its time limit on (each retry builds
+/// every part again) before giving up.
+pub const MAX_PART_MOVES: usize = 2;
+
 /// The paper's `TETRA` under a memory limit: plans the recursive split of
 /// `scene` ([`super::split::plan_split`], planes avoiding vertices within
 /// TetGen's tolerance) so that every leaf's *predicted* TetGen peak fits
@@ -259,7 +265,9 @@ pub const MAX_PLANE_MOVES: usize = 8;
 /// meets a degenerate configuration only the build can see (a point made
 /// by an earlier cut within tolerance of it, [`SeamError::PlaneNearPoint`]
 /// or [`SeamError::DegenerateCut`]) is moved by 1/4096 of the box's
-/// extent and the build retried, at most [`MAX_PLANE_MOVES`] times.
+/// extent and the build retried, at most [`MAX_PLANE_MOVES`] times; the
+/// walls of a part TetGen fails on or runs past its time limit on are
+/// moved likewise, at most [`MAX_PART_MOVES`] times.
 pub fn build_tree_with_memory_limit(
     scene: &Scene,
     split: &super::split::SplitOptions,
@@ -326,7 +334,7 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
     };
     let mut tree = CutTree::from_split_tree(&plan);
     drop(cleaned);
-    let mut moves = 0;
+    let (mut moves, mut part_moves) = (0, 0);
     loop {
         match build(&tree) {
             Ok(output) => {
@@ -347,6 +355,38 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                 if moves >= MAX_PLANE_MOVES || !tree.nudge(plane, step, b.min, b.max) {
                     return Err(e);
                 }
+                moves += 1;
+            }
+            // TetGen stuck or failing on one part: its walls met the
+            // scene in a configuration TetGen's boundary recovery (`-Y`
+            // adds no point on the walls) cannot take; seen on a city of
+            // fan-triangulated streets, where a wall crossing a fan near
+            // its apex leaves a row of crossings 0.002 apart and TetGen
+            // ran until killed. Move the part's walls and build again.
+            // Likewise where a part's Steiner points flatten tets when
+            // rounded to f32 (seen on Neptune).
+            Err(
+                e @ (SeamError::Tetgen {
+                    part,
+                    source:
+                        TetgenError::Timeout { .. }
+                        | TetgenError::Internal
+                        | TetgenError::SmallFeature
+                        | TetgenError::CloseFacets
+                        | TetgenError::Other(_),
+                }
+                | SeamError::RoundingFlattens { part, .. }),
+            ) => {
+                let step = (b.max - b.min).max_element() / 4096.0;
+                let walls = tree.leaf_walls(part).unwrap_or_default();
+                let mut moved = false;
+                for plane in walls {
+                    moved |= tree.nudge(plane, step, b.min, b.max);
+                }
+                if part_moves >= MAX_PART_MOVES || !moved {
+                    return Err(e);
+                }
+                part_moves += 1;
                 moves += 1;
             }
             Err(e) => return Err(e),
