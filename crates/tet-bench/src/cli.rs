@@ -363,6 +363,13 @@ pub struct TablesArgs {
     /// Default: 1m,10m,30m, or none with `--quick`.
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_size)]
     pub large_models: Option<Vec<u64>>,
+    /// Build Tet20 of the large-model table out of core under this limit
+    /// on the whole process tree (bytes, or with K, M, G), as `build
+    /// --memory-limit` does. Default: in core where TetGen's predicted
+    /// peak fits in half the free memory, else out of core under half the
+    /// free memory.
+    #[arg(long, value_name = "BYTES", value_parser = parse_memory_limit)]
+    pub large_models_limit: Option<u64>,
     /// Sizes of the large out-of-core table (`fan-sphere:N` built in parts
     /// under its builder's share plus a sixteenth of its predicted in-core
     /// peak; `k`/`m` suffixes; `none` for no table). Default: 1m, or none

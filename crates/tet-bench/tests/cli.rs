@@ -486,6 +486,8 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
         obj.to_str().unwrap(),
         "--large-models",
         "1k",
+        "--large-models-limit",
+        "96M",
     ]);
     let sc = doc["scenes"].as_array().unwrap();
     assert_eq!(sc.len(), 4, "three scenes of --scenes, one of --scene");
@@ -605,6 +607,16 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
         assert_eq!(s["render"]["hits"], structures[0]["render"]["hits"], "{s}");
     }
     assert!(structures[0]["render"]["hits"].as_u64().unwrap() > 0);
+    // Tet20 built out of core under the given limit, in parts, the whole
+    // process tree under it; the triangle structures have no build report.
+    let memory = &structures[2]["memory"];
+    assert_eq!(memory["limit_bytes"], 96 << 20, "{memory}");
+    assert!(memory["parts"].as_u64().unwrap() > 1, "{memory}");
+    if let Some(peak) = memory["tree_peak_kib"].as_u64() {
+        assert!(peak * 1024 <= 96 << 20, "{memory}");
+    }
+    assert!(structures[0]["memory"].is_null() && structures[1]["memory"].is_null());
+    assert!(md.contains("out of core under 96 MiB"));
     let bpt = |i: usize| structures[i]["bytes_per_triangle"].as_f64().unwrap();
     assert!(
         bpt(0) < bpt(1),

@@ -330,8 +330,14 @@ pub struct LargeStructure {
     pub bytes: usize,
     /// `bytes` per scene triangle.
     pub bytes_per_triangle: f64,
-    /// Build seconds (tet20: the whole pipeline, TetGen included).
+    /// Build seconds (tet20: the whole pipeline, TetGen included; out of
+    /// core, the build process's wall time, writing and reading back the
+    /// mesh file included).
     pub build_s: f64,
     /// The timed render.
     pub render: RenderDoc,
+    /// Tet20 built out of core: the build's memory report (the limit,
+    /// parts, part and process-tree peaks, merge; `memory` of `build
+    /// --json`); `null` in core and for the triangle structures.
+    pub memory: Option<crate::outofcore::MemoryReport>,
 }

@@ -300,7 +300,8 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
     let isosurfaces = isosurfaces::measure_all(args.quick, &pool);
     let iso_scaling = isosurfaces::measure_scaling(args.quick, &pool);
     let large_sizes = args.large_model_sizes();
-    let large_models = large_models::measure_all(&large_sizes, &opts, frames, &pool);
+    let large_models =
+        large_models::measure_all(&large_sizes, args.large_models_limit, &opts, frames, &pool);
     let large_ooc_sizes = args.large_out_of_core_sizes();
     let large_out_of_core = out_of_core_large::measure_all(&large_ooc_sizes, &opts, frames, &pool);
     let mut doc = TablesDoc {
