@@ -133,10 +133,7 @@ impl<L: Topology, P: BatchWalk> Tracer for WalkTracer<'_, L, P> {
         self.trace_batch_from(rays, Starts::Same(start), out)
     }
     fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
-        let mut n = rays.len().min(out.len());
-        if let Starts::Each(s) = starts {
-            n = n.min(s.len());
-        }
+        let n = starts.batch_len(rays.len(), out.len());
         let (rays, out) = (&rays[..n], &mut out[..n]);
         P::trace_batch(self.batch(rays, starts, out));
         exact_where_lost(self.mesh, self.cap, rays, starts, out);

@@ -194,10 +194,7 @@ fn without_stopped_starts<T: ?Sized>(
         cap,
         out,
     } = batch;
-    let mut n = rays.len().min(out.len());
-    if let Starts::Each(s) = starts {
-        n = n.min(s.len());
-    }
+    let n = starts.batch_len(rays.len(), out.len());
     let (rays, out) = (&rays[..n], &mut out[..n]);
     let stopped =
         |i: usize| rays[i].is_valid() && start_of(starts, i).is_some_and(|s| starts_in(s, stop));

@@ -754,10 +754,7 @@ impl<const CONSISTENT: bool> Tracer for Tet80Tracer<'_, CONSISTENT> {
     /// As [`Tracer::trace_batch`]: in lockstep where the CPU has AVX2 or
     /// AVX-512F, else ray after ray.
     fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
-        let mut n = rays.len().min(out.len());
-        if let Starts::Each(s) = starts {
-            n = n.min(s.len());
-        }
+        let n = starts.batch_len(rays.len(), out.len());
         let (rays, out) = (&rays[..n], &mut out[..n]);
         let batch = self.batch(rays, starts, out);
         if lockstep::trace::<Plucker, _, _>(batch, Width::Auto, &mut NoGate).is_err() {

@@ -339,10 +339,7 @@ impl Tracer for ExactTracer<'_> {
     /// as [`Tracer::trace`], so the same outcomes): their memory loads
     /// overlap.
     fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
-        let mut n = rays.len().min(out.len());
-        if let Starts::Each(s) = starts {
-            n = n.min(s.len());
-        }
+        let n = starts.batch_len(rays.len(), out.len());
         let mut hint = EntryHint::default();
         let mut lanes: [Option<(usize, Walk)>; LANES] = [None; LANES];
         let mut next = 0;

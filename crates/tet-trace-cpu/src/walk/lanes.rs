@@ -28,6 +28,19 @@ pub enum Starts<'a> {
     Outside(&'a BoundaryEntry),
 }
 
+impl Starts<'_> {
+    /// How many rays a batch of `rays` rays and `outs` outcomes walks with
+    /// these starts: the shortest of the three ([`Starts::Same`] and
+    /// [`Starts::Outside`] serve any number).
+    pub fn batch_len(self, rays: usize, outs: usize) -> usize {
+        let n = rays.min(outs);
+        match self {
+            Starts::Each(s) => n.min(s.len()),
+            Starts::Same(_) | Starts::Outside(_) => n,
+        }
+    }
+}
+
 /// One batch of walks, as every batch walk takes it (the scalar
 /// interleaved walk, [`crate::BatchWalk`], the one lockstep entry
 /// [`crate::lockstep::trace`]): ray `rays[i]` walks from its start in
