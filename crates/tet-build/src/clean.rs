@@ -16,7 +16,9 @@
 //! [`CleanMesh::triangle_source`] maps each output triangle to its input.
 
 use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
+use std::hash::{BuildHasherDefault, Hash, Hasher};
+
+use hashbrown::HashTable;
 
 use glam::{Vec2, Vec3};
 use thiserror::Error;
@@ -111,9 +113,11 @@ impl CleanReport {
 /// Cleaned geometry plus the index maps back to the input.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CleanMesh {
-    /// Output vertices (a subset of the input, in input order, unmoved).
+    /// Output vertices (a subset of the input, in input order, unmoved);
+    /// empty from [`clean_scene`], whose scene holds them.
     pub vertices: Vec<Vec3>,
-    /// Output triangles (input order, winding preserved).
+    /// Output triangles (input order, winding preserved); empty from
+    /// [`clean_scene`], whose scene holds them.
     pub triangles: Vec<[u32; 3]>,
     /// Input vertex → output vertex, or [`REMOVED`] (unused). Merged
     /// vertices map to the output vertex of the one they merged into.
@@ -208,22 +212,43 @@ pub fn clean(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Result<CleanMesh, Cle
         ..CleanReport::default()
     };
 
-    // 2. merge exactly-equal positions: rep[i] = lowest input index with that position.
-    let mut first: FxMap<[u32; 3], u32> =
-        FxMap::with_capacity_and_hasher(vertices.len(), Default::default());
+    // 2. merge exactly-equal positions: rep[i] = lowest input index with
+    // that position. The tables hold indices only (4 bytes an entry, the
+    // keys are looked up in the input): what lets a planner clean a scene
+    // of tens of millions of triangles beside the scene itself.
+    let mut first: HashTable<u32> = HashTable::with_capacity(vertices.len());
     let mut rep = Vec::with_capacity(vertices.len());
     for (i, v) in vertices.iter().enumerate() {
-        let r = *first.entry(key(*v)).or_insert(i as u32);
+        let k = key(*v);
+        let r = *first
+            .entry(
+                fx_hash(&k),
+                |&j| key(vertices[j as usize]) == k,
+                |&j| fx_hash(&key(vertices[j as usize])),
+            )
+            .or_insert(i as u32)
+            .get();
         if r != i as u32 {
             report.merged_vertices.push((i as u32, r));
         }
         rep.push(r);
     }
+    drop(first);
 
-    // 3–5. filter triangles.
-    let mut seen: FxMap<[u32; 3], (u32, [u32; 3])> =
-        FxMap::with_capacity_and_hasher(triangles.len(), Default::default());
-    let mut kept: Vec<(u32, [u32; 3])> = Vec::with_capacity(triangles.len());
+    // 3–5. filter triangles: `out.triangles` holds the kept ones with
+    // representative (input) vertex indices until step 6 renumbers them.
+    let mut out = CleanMesh {
+        triangles: Vec::with_capacity(triangles.len()),
+        triangle_source: Vec::with_capacity(triangles.len()),
+        ..CleanMesh::default()
+    };
+    // Kept triangles (indices into `out.triangles`) by sorted vertex set.
+    let mut seen: HashTable<u32> = HashTable::with_capacity(triangles.len());
+    let sorted = |m: [u32; 3]| {
+        let mut s = m;
+        s.sort_unstable();
+        s
+    };
     for (t, tri) in triangles.iter().enumerate() {
         let t = t as u32;
         let m = tri.map(|v| rep[v as usize]);
@@ -236,30 +261,36 @@ pub fn clean(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Result<CleanMesh, Cle
             report.zero_area_triangles.push(t);
             continue;
         }
-        let mut sorted = m;
-        sorted.sort_unstable();
-        match seen.get(&sorted) {
-            Some(&(first_t, first_m)) => report.duplicate_triangles.push(DuplicatePair {
-                kept: first_t,
+        let s = sorted(m);
+        let kept = &out.triangles;
+        match seen.find(fx_hash(&s), |&k| sorted(kept[k as usize]) == s) {
+            Some(&k) => report.duplicate_triangles.push(DuplicatePair {
+                kept: out.triangle_source[k as usize],
                 dropped: t,
-                same_winding: same_cyclic_order(first_m, m),
+                same_winding: same_cyclic_order(kept[k as usize], m),
             }),
             None => {
-                seen.insert(sorted, (t, m));
-                kept.push((t, m));
+                let k = out.triangles.len() as u32;
+                seen.insert_unique(fx_hash(&s), k, |&j| {
+                    fx_hash(&sorted(out.triangles[j as usize]))
+                });
+                out.triangles.push(m);
+                out.triangle_source.push(t);
             }
         }
     }
+    drop(seen);
+    out.triangles.shrink_to_fit();
+    out.triangle_source.shrink_to_fit();
 
     // 6. compact vertices (input order).
     let mut used = vec![false; vertices.len()];
-    for (_, m) in &kept {
+    for m in &out.triangles {
         for &v in m {
             used[v as usize] = true;
         }
     }
     let mut out_index = vec![REMOVED; vertices.len()];
-    let mut out = CleanMesh::default();
     for (i, v) in vertices.iter().enumerate() {
         if rep[i] != i as u32 {
             continue;
@@ -272,13 +303,21 @@ pub fn clean(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Result<CleanMesh, Cle
             report.unused_vertices.push(i as u32);
         }
     }
+    drop(used);
     out.vertex_map = rep.iter().map(|&r| out_index[r as usize]).collect();
-    for (t, m) in kept {
-        out.triangles.push(m.map(|v| out_index[v as usize]));
-        out.triangle_source.push(t);
+    drop(rep);
+    for m in &mut out.triangles {
+        *m = m.map(|v| out_index[v as usize]);
     }
     out.report = report;
     Ok(out)
+}
+
+/// The hash of a key of [`clean`]'s tables.
+fn fx_hash(k: &[u32; 3]) -> u64 {
+    let mut h = FxHasher::default();
+    k.hash(&mut h);
+    h.finish()
 }
 
 fn same_cyclic_order(a: [u32; 3], b: [u32; 3]) -> bool {
@@ -292,7 +331,8 @@ fn same_cyclic_order(a: [u32; 3], b: [u32; 3]) -> bool {
 /// describe the span of output vertices whose source lay in the object's
 /// input range). Merged vertices whose attributes differ are listed in
 /// [`CleanReport::attribute_conflicts`]. Returns the cleaned scene and the
-/// [`CleanMesh`] maps.
+/// [`CleanMesh`] maps (without a second copy of the geometry: its
+/// `vertices` and `triangles` are empty).
 pub fn clean_scene(scene: &Scene) -> Result<(Scene, CleanMesh), CleanError> {
     let mut cm = clean(&scene.vertices, &scene.triangles)?;
     cm.report.attribute_conflicts = cm
@@ -339,7 +379,5 @@ pub fn clean_scene(scene: &Scene) -> Result<(Scene, CleanMesh), CleanError> {
         camera: scene.camera,
         lights: scene.lights.clone(),
     };
-    cm.vertices = cleaned.vertices.clone();
-    cm.triangles = cleaned.triangles.clone();
     Ok((cleaned, cm))
 }

@@ -284,12 +284,46 @@ struct Entry {
     cell: [u32; 3],
 }
 
+/// Entries of the broad phase's grid held at once: at most this many
+/// (about 40 MiB of entries) or a sixteenth of all, whichever is more (so
+/// that the triangles are gone through at most about 16 times), or one z
+/// layer where a layer alone holds more.
+const SLAB_ENTRIES: u64 = 1 << 20;
+
+/// Consecutive runs `[z0, z1)` of z layers, each with at most
+/// [`SLAB_ENTRIES`] entries or a sixteenth of the total (a layer above it
+/// alone), from the entries per layer.
+fn grid_slabs(layers: &[u64], slab_entries: u64) -> Vec<(usize, usize)> {
+    let budget = slab_entries.max(layers.iter().sum::<u64>().div_ceil(16));
+    let mut slabs = Vec::new();
+    let (mut start, mut sum) = (0, 0u64);
+    for (z, &n) in layers.iter().enumerate() {
+        if z > start && sum + n > budget {
+            slabs.push((start, z));
+            (start, sum) = (z, 0);
+        }
+        sum += n;
+    }
+    slabs.push((start, layers.len()));
+    slabs
+}
+
 /// Find all pairs of triangles that meet beyond shared vertices/edges.
 ///
 /// Indices out of range or non-finite coordinates make the affected
 /// triangles count as degenerate (run [`crate::clean::clean`] first for
 /// typed errors).
 pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> IntersectionReport {
+    find_self_intersections_in_slabs(vertices, triangles, SLAB_ENTRIES)
+}
+
+/// [`find_self_intersections`] with the grid's slabs holding at most
+/// `slab_entries` entries (or a sixteenth of all).
+fn find_self_intersections_in_slabs(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    slab_entries: u64,
+) -> IntersectionReport {
     let mut report = IntersectionReport::default();
     let n = triangles.len();
     // Per triangle one byte and one index: the f64 corners and boxes are
@@ -371,9 +405,6 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
             (c.z.max(0.0) as usize).min(nz - 1),
         ]
     };
-    // Counting sort of (cell, triangle) entries.
-    let ncells = nx * ny * nz;
-    let mut counts = vec![0u32; ncells + 1];
     // Each entry carries its triangle's box (exact: the corners are f32)
     // and lowest cell, so that a cell's pairs are tested from contiguous
     // memory.
@@ -388,86 +419,109 @@ pub fn find_self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Int
         };
         (entry, cl, ch)
     };
+    // The grid is filled and tested a slab of z layers at a time
+    // ([`grid_slabs`]): a cell's list is whole within its slab and a pair
+    // is tested only in one cell, so the result is the same as one pass
+    // over the whole grid, in a fraction of its memory (the whole grid's
+    // entries took 80 to 110 bytes per triangle, the planner's peak on
+    // scenes of millions of triangles).
+    let mut layers = vec![0u64; nz];
     for &t in &live {
         let (_, cl, ch) = entry_of(t);
-        for z in cl[2]..=ch[2] {
-            for y in cl[1]..=ch[1] {
-                for x in cl[0]..=ch[0] {
-                    counts[(z * ny + y) * nx + x + 1] += 1;
-                }
-            }
+        let columns = ((ch[0] - cl[0] + 1) * (ch[1] - cl[1] + 1)) as u64;
+        for n in &mut layers[cl[2]..=ch[2]] {
+            *n += columns;
         }
     }
-    for i in 0..ncells {
-        counts[i + 1] += counts[i];
-    }
-    let mut fill = counts.clone();
-    let total = counts[ncells] as usize;
-    let mut entries = vec![
-        Entry {
-            triangle: 0,
-            lo: [0.0; 3],
-            hi: [0.0; 3],
-            cell: [0; 3],
-        };
-        total
-    ];
-    for &t in &live {
-        let (entry, cl, ch) = entry_of(t);
-        for z in cl[2]..=ch[2] {
-            for y in cl[1]..=ch[1] {
-                for x in cl[0]..=ch[0] {
-                    let c = (z * ny + y) * nx + x;
-                    entries[fill[c] as usize] = entry;
-                    fill[c] += 1;
-                }
-            }
-        }
-    }
-    drop(fill);
-    // Every cell's pairs, in parallel (cells are independent).
-    let (candidates, pairs) = (0..ncells)
-        .into_par_iter()
-        .fold(
-            || (0u64, Vec::new()),
-            |(mut candidates, mut pairs), c| {
-                let cell_xyz = [c % nx, c / nx % ny, c / (nx * ny)].map(|i| i as u32);
-                let list = &entries[counts[c] as usize..counts[c + 1] as usize];
-                for (i, s) in list.iter().enumerate() {
-                    for t in &list[i + 1..] {
-                        if (0..3).any(|k| s.lo[k] > t.hi[k] || t.lo[k] > s.hi[k]) {
-                            continue;
-                        }
-                        // Test the pair only in the cell of the overlap's
-                        // lower corner (`cell_of` is monotonic, so that is
-                        // the larger of the two lowest cells per axis).
-                        if (0..3).any(|k| s.cell[k].max(t.cell[k]) != cell_xyz[k]) {
-                            continue;
-                        }
-                        candidates += 1;
-                        let (s, t) = (s.triangle, t.triangle);
-                        let (a, b) = (s.min(t) as usize, s.max(t) as usize);
-                        if let Some(kind) =
-                            classify(&corners(a), axes[a] as usize, &corners(b), axes[b] as usize)
-                        {
-                            pairs.push(IntersectingPair {
-                                first: a as u32,
-                                second: b as u32,
-                                kind,
-                            });
-                        }
+    let (mut candidates, mut pairs) = (0u64, Vec::new());
+    for (z0, z1) in grid_slabs(&layers, slab_entries) {
+        // Counting sort of the slab's (cell, triangle) entries.
+        let ncells = nx * ny * (z1 - z0);
+        let mut counts = vec![0u32; ncells + 1];
+        // Calls `f` with every cell of the slab that triangle `t` covers.
+        let cells = |t: u32, f: &mut dyn FnMut(usize, &Entry)| {
+            let (entry, cl, ch) = entry_of(t);
+            for z in cl[2].max(z0)..=ch[2].min(z1 - 1) {
+                for y in cl[1]..=ch[1] {
+                    for x in cl[0]..=ch[0] {
+                        f(((z - z0) * ny + y) * nx + x, &entry);
                     }
                 }
-                (candidates, pairs)
-            },
-        )
-        .reduce(
-            || (0u64, Vec::new()),
-            |(ca, mut pa), (cb, pb)| {
-                pa.extend(pb);
-                (ca + cb, pa)
-            },
-        );
+            }
+        };
+        for &t in &live {
+            cells(t, &mut |c, _| counts[c + 1] += 1);
+        }
+        for i in 0..ncells {
+            counts[i + 1] += counts[i];
+        }
+        let mut fill = counts.clone();
+        let total = counts[ncells] as usize;
+        let mut entries = vec![
+            Entry {
+                triangle: 0,
+                lo: [0.0; 3],
+                hi: [0.0; 3],
+                cell: [0; 3],
+            };
+            total
+        ];
+        for &t in &live {
+            cells(t, &mut |c, entry| {
+                entries[fill[c] as usize] = *entry;
+                fill[c] += 1;
+            });
+        }
+        drop(fill);
+        // Every cell's pairs, in parallel (cells are independent).
+        let (c, p) = (0..ncells)
+            .into_par_iter()
+            .fold(
+                || (0u64, Vec::new()),
+                |(mut candidates, mut pairs), c| {
+                    let cell_xyz = [c % nx, c / nx % ny, z0 + c / (nx * ny)].map(|i| i as u32);
+                    let list = &entries[counts[c] as usize..counts[c + 1] as usize];
+                    for (i, s) in list.iter().enumerate() {
+                        for t in &list[i + 1..] {
+                            if (0..3).any(|k| s.lo[k] > t.hi[k] || t.lo[k] > s.hi[k]) {
+                                continue;
+                            }
+                            // Test the pair only in the cell of the overlap's
+                            // lower corner (`cell_of` is monotonic, so that is
+                            // the larger of the two lowest cells per axis).
+                            if (0..3).any(|k| s.cell[k].max(t.cell[k]) != cell_xyz[k]) {
+                                continue;
+                            }
+                            candidates += 1;
+                            let (s, t) = (s.triangle, t.triangle);
+                            let (a, b) = (s.min(t) as usize, s.max(t) as usize);
+                            if let Some(kind) = classify(
+                                &corners(a),
+                                axes[a] as usize,
+                                &corners(b),
+                                axes[b] as usize,
+                            ) {
+                                pairs.push(IntersectingPair {
+                                    first: a as u32,
+                                    second: b as u32,
+                                    kind,
+                                });
+                            }
+                        }
+                    }
+                    (candidates, pairs)
+                },
+            )
+            .reduce(
+                || (0u64, Vec::new()),
+                |(ca, mut pa), (cb, pb)| {
+                    pa.extend(pb);
+                    (ca + cb, pa)
+                },
+            );
+        candidates += c;
+        pairs.extend(p);
+    }
     report.candidates = candidates;
     report.pairs = pairs;
     report.pairs.sort_unstable_by_key(|p| (p.first, p.second));
@@ -511,17 +565,90 @@ pub fn find_self_intersections_brute_force(
 mod tests {
     use super::*;
 
+    /// Uniform numbers in [0, 1) from a xorshift generator seeded `state`.
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// The slabs cover the layers in order, each within the budget (a
+    /// sixteenth of all entries at least) or a single layer.
+    #[test]
+    fn grid_slabs_partition_the_layers_within_the_budget() {
+        let layers: Vec<u64> = (0..200u64)
+            .map(|z| (z * 7919) % 97 + (z % 13 == 0) as u64 * 500)
+            .collect();
+        for min in [1u64, 50, 300, 1 << 20] {
+            let slabs = grid_slabs(&layers, min);
+            let budget = min.max(layers.iter().sum::<u64>().div_ceil(16));
+            assert_eq!(slabs.first().unwrap().0, 0);
+            assert_eq!(slabs.last().unwrap().1, layers.len());
+            for w in slabs.windows(2) {
+                assert_eq!(w[0].1, w[1].0);
+            }
+            for &(a, b) in &slabs {
+                let sum: u64 = layers[a..b].iter().sum();
+                assert!(
+                    b > a && (sum <= budget || b == a + 1),
+                    "{a}..{b}: {sum} > {budget}"
+                );
+            }
+            if min == 1 {
+                assert!(slabs.len() >= 16, "{} slabs", slabs.len());
+            }
+        }
+    }
+
+    /// The grid a slab at a time (as small as one z layer, as on a scene
+    /// of millions of triangles) finds the pairs and candidates the whole
+    /// grid finds, and the pairs a look at every pair finds: random
+    /// triangles of many sizes in a box, with shared vertices, crossing
+    /// each other and the layers.
+    #[test]
+    fn slabs_of_the_grid_find_what_the_whole_grid_finds() {
+        let mut rnd = uniform(0x9E37_79B9_7F4A_7C15);
+        for round in 0..20 {
+            let n = 30 + round * 10;
+            let vertices: Vec<Vec3> = (0..n)
+                .map(|_| Vec3::new(rnd() as f32, rnd() as f32, (rnd() * 4.0) as f32))
+                .collect();
+            let triangles: Vec<[u32; 3]> = (0..n)
+                .map(|_| {
+                    let a = (rnd() * n as f64) as u32 % n as u32;
+                    // Mostly small triangles (near neighbours in index order
+                    // are not near in space, so pick by distance).
+                    let mut near: Vec<u32> = (0..n as u32).filter(|&b| b != a).collect();
+                    near.sort_by(|&x, &y| {
+                        let d = |v: u32| vertices[v as usize].distance(vertices[a as usize]);
+                        d(x).total_cmp(&d(y))
+                    });
+                    let k = if rnd() < 0.8 { 6 } else { n - 1 };
+                    let b = near[(rnd() * k as f64) as usize % k];
+                    let c = near[(rnd() * k as f64) as usize % k];
+                    [a, b, c]
+                })
+                .collect();
+            let whole = find_self_intersections_in_slabs(&vertices, &triangles, u64::MAX);
+            let slabs = find_self_intersections_in_slabs(&vertices, &triangles, 1);
+            assert_eq!(slabs.pairs, whole.pairs, "round {round}");
+            assert_eq!(slabs.candidates, whole.candidates, "round {round}");
+            assert_eq!(slabs.degenerate, whole.degenerate, "round {round}");
+            let mut brute = find_self_intersections_brute_force(&vertices, &triangles);
+            brute.sort_unstable_by_key(|p| (p.first, p.second));
+            assert_eq!(whole.pairs, brute, "round {round}");
+        }
+    }
+
     /// The inlined filter gives robust's exact sign on random points and on
     /// points on, or a few ulps off, a plane (where the filter must defer).
     #[test]
     fn filtered_orientation_matches_the_exact_predicate() {
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let mut rnd = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut uniform = uniform(0x2545_F491_4F6C_DD1D);
+        let mut rnd = || uniform() - 0.5;
         let mut deferred = 0;
         for i in 0..20_000 {
             let mut p: [DVec3; 4] =

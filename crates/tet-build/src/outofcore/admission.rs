@@ -67,9 +67,14 @@ impl BuilderModel {
     /// --memory-limit L` (before the first worker starts) on the Stanford
     /// bunny (69 k triangles), Torus Knots in a Box (78 k), Armadillo in a
     /// Box (100 k), Mix in a Box (548 k, crossings resolved) and
-    /// `fan-sphere:1m` (1 M) gave 11.4 MiB + 256 B per triangle, rounded
-    /// up here: 1.07–1.25× every sample (the table is in the README,
-    /// "Lowest memory limit per scene"). It covers tree plans; slabs,
+    /// `fan-sphere:1m` (1 M) gave 17.95 MiB + 165.7 B per triangle,
+    /// rounded up here (since the planner holds the scene once, cleans
+    /// with index tables and checks self-intersections a slab of the grid
+    /// at a time; before: 11.4 MiB + 256 B). Mix in a Box, an OBJ whose
+    /// crossings are resolved, needs the most per triangle (99.6 MiB);
+    /// `fan-sphere:1m` 118.6 MiB and `dense-knots:10m` (not in the fit)
+    /// 105 B per triangle are well under it (docs/results.md, "Lowest
+    /// memory limit per scene" and "The planner's memory"). It covers tree plans; slabs,
     /// which hold the pieces of every triangle they cut, can exceed it
     /// (Armadillo in a Box in 94 slabs: 1.06×; `fan-sphere:1m` in slabs
     /// under 352 MiB: 2.1×). The ignored test
@@ -133,13 +138,13 @@ impl BuilderModel {
 /// The fixed part of a local builder's own memory
 /// ([`BuilderModel::FITTED`]; `tet-bench` alone, before it loads a scene,
 /// is about 7 MiB resident).
-pub const BUILDER_BASE_BYTES: u64 = 12 << 20;
+pub const BUILDER_BASE_BYTES: u64 = 18 << 20;
 
 /// A local builder's own memory per scene triangle
 /// ([`BuilderModel::FITTED`]): measured as the planning peak less the
-/// base, 220 bytes per triangle on `fan-sphere:1m` and 270–300 on the
-/// 69–548 k-triangle scenes, whose OBJ loading leaves more behind.
-pub const BUILDER_BYTES_PER_TRIANGLE: u64 = 260;
+/// base, 100 bytes per triangle on `fan-sphere:1m` and 150 on Mix in a
+/// Box, whose OBJ loading and resolved crossings leave more behind.
+pub const BUILDER_BYTES_PER_TRIANGLE: u64 = 170;
 
 /// What a local build of a scene of `triangles` triangles sets aside for
 /// itself from a limit on its whole process tree, before the workers'

@@ -13,9 +13,9 @@ use super::parts::{PartFacets, PartMesh, PartStats, SeamOptions, SeamReport, run
 use super::plane::{SplitPlane, key};
 
 /// The parts of a split, ready for TetGen.
-pub(super) struct PartInputs {
+pub(super) struct PartInputs<'a> {
     /// Each part's PLC facets, made when the part is taken up.
-    pub(super) parts: Box<dyn PartFacets>,
+    pub(super) parts: Box<dyn PartFacets + 'a>,
     /// Input scene triangle of each cleaned one.
     pub(super) triangle_source: Vec<u32>,
     /// Input scene triangles.
@@ -61,7 +61,7 @@ pub(super) trait Merge: Sync {
 /// Runs TetGen on every part ([`run_parts`]), hands each finished part to
 /// `merge`, fills the per-part fields of `report` and merges.
 pub(super) fn finish_parts<M: Merge>(
-    inputs: PartInputs,
+    inputs: PartInputs<'_>,
     mut report: SeamReport,
     options: &SeamOptions,
     merge: &M,

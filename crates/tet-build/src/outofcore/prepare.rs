@@ -4,6 +4,8 @@
 //! matters: a crossing that a cut plane separates into two parts would
 //! otherwise reach each part's TetGen run as half a crossing.
 
+use std::borrow::Cow;
+
 use super::error::SeamError;
 use super::parts::SeamOptions;
 use crate::clean::clean_scene;
@@ -12,9 +14,11 @@ use crate::resolve::ResolveReport;
 use crate::scene::Scene;
 
 /// The scene the parts are cut from.
-pub(super) struct Prepared {
-    /// Cleaned (and resolved) scene.
-    pub scene: Scene,
+pub(super) struct Prepared<'a> {
+    /// Cleaned (and resolved) scene: the input itself when cleaning and
+    /// resolving changed nothing (the common case for generated scenes),
+    /// so that a planner holds one copy of the scene, not two.
+    pub scene: Cow<'a, Scene>,
     /// Input scene triangle of each cleaned one (pieces name their input
     /// triangle); the rest of the cleaning's map, a second copy of the
     /// scene, is not kept.
@@ -25,24 +29,32 @@ pub(super) struct Prepared {
 
 /// Cleans `scene` and resolves its self-intersections when
 /// `options.resolve` asks; [`SeamError::EmptyScene`] when nothing is left.
-pub(super) fn prepare(scene: &Scene, options: &SeamOptions) -> Result<Prepared, SeamError> {
-    let (cleaned, map) = clean_scene(scene)?;
+pub(super) fn prepare<'a>(
+    scene: &'a Scene,
+    options: &SeamOptions,
+) -> Result<Prepared<'a>, SeamError> {
+    let (cleaned, mut map) = clean_scene(scene)?;
+    // Of the map, the resolution reads the triangles' sources only: the
+    // vertex maps go now, before the self-intersection check.
+    map.vertex_map = Vec::new();
     if cleaned.triangles.is_empty() {
         return Err(SeamError::EmptyScene);
     }
-    Ok(match &options.resolve {
+    let (prepared, triangle_source, resolve) = match &options.resolve {
         Some(o) => {
             let (scene, map, report) = resolve_cleaned(cleaned, map, o)?;
-            Prepared {
-                scene,
-                triangle_source: map.triangle_source,
-                resolve: Some(report),
-            }
+            (scene, map.triangle_source, Some(report))
         }
-        None => Prepared {
-            scene: cleaned,
-            triangle_source: map.triangle_source,
-            resolve: None,
+        None => (cleaned, map.triangle_source, None),
+    };
+    let unchanged = prepared.vertices == scene.vertices && prepared.triangles == scene.triangles;
+    Ok(Prepared {
+        scene: if unchanged {
+            Cow::Borrowed(scene)
+        } else {
+            Cow::Owned(prepared)
         },
+        triangle_source,
+        resolve,
     })
 }

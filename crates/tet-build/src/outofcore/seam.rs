@@ -113,12 +113,12 @@ fn build_slabs_with<M: Merge>(
 /// Every slab's PLC of `scene` cut by the planes `x[axis] = values[i]`
 /// (see [`build_slabs`]), in slab order, and the report's seam fields; no
 /// TetGen run.
-pub(super) fn slab_part_inputs(
-    scene: &Scene,
+pub(super) fn slab_part_inputs<'a>(
+    scene: &'a Scene,
     axis: usize,
     values: &[f32],
     options: &SeamOptions,
-) -> Result<(PartInputs, SeamReport), SeamError> {
+) -> Result<(PartInputs<'a>, SeamReport), SeamError> {
     let Prepared {
         scene: cleaned,
         triangle_source,
@@ -292,12 +292,12 @@ pub(super) fn slab_part_inputs(
 }
 
 /// A triangle inside one slab: itself (fanned as a cut piece would be).
-struct SlabWhole {
+struct SlabWhole<'a> {
     /// The cleaned (and resolved) scene.
-    scene: Scene,
+    scene: std::borrow::Cow<'a, Scene>,
 }
 
-impl WholeTriangle for SlabWhole {
+impl WholeTriangle for SlabWhole<'_> {
     fn facets(&self, t: u32) -> Result<Vec<[Vec3; 3]>, SeamError> {
         let v = self.scene.triangles[t as usize].map(|i| self.scene.vertices[i as usize]);
         Ok(fan(&v))

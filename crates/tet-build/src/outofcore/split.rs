@@ -121,6 +121,18 @@ impl SplitTree {
         }
     }
 
+    /// Empties every leaf's triangle list (the rest is kept): a plan kept
+    /// beside its build no longer holds 4 bytes per scene triangle.
+    pub(crate) fn forget_triangles(&mut self) {
+        match self {
+            SplitTree::Leaf { triangles, .. } => *triangles = Vec::new(),
+            SplitTree::Split { below, above, .. } => {
+                below.forget_triangles();
+                above.forget_triangles();
+            }
+        }
+    }
+
     /// The leaves, left (below) first.
     pub fn leaves(&self) -> Vec<&SplitTree> {
         match self {

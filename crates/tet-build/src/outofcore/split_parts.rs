@@ -58,8 +58,27 @@ pub(super) trait WholeTriangle: Send + Sync {
     fn facets(&self, t: u32) -> Result<Vec<[Vec3; 3]>, SeamError>;
 }
 
+/// The seam (or wall) triangles on each part's faces.
+pub(super) trait PartWalls: Send + Sync {
+    /// How many of them part `k` has.
+    fn count(&self, k: usize) -> usize;
+    /// Part `k`'s.
+    fn of(&self, k: usize) -> Vec<([Vec3; 3], FacetKind)>;
+}
+
+/// Every part's wall triangles, made ahead (the slabs': a slab's two
+/// seams only).
+impl PartWalls for Vec<Vec<([Vec3; 3], FacetKind)>> {
+    fn count(&self, k: usize) -> usize {
+        self[k].len()
+    }
+    fn of(&self, k: usize) -> Vec<([Vec3; 3], FacetKind)> {
+        self[k].clone()
+    }
+}
+
 /// The parts of a split (see the module docs).
-pub(super) struct SplitParts<W> {
+pub(super) struct SplitParts<W, L> {
     /// Makes the facets of the triangles inside a part.
     pub(super) whole: W,
     /// The triangles inside each part.
@@ -68,19 +87,19 @@ pub(super) struct SplitParts<W> {
     /// triangle (in scene order) and triangulation.
     pub(super) clipped: Vec<Vec<(u32, Vec<[Vec3; 3]>)>>,
     /// Per part: the seam (or wall) triangles on its faces.
-    pub(super) walls: Vec<Vec<([Vec3; 3], FacetKind)>>,
+    pub(super) walls: L,
     /// Per part: its box faces (unmarked facets).
     pub(super) box_faces: Vec<Vec<[Vec3; 3]>>,
 }
 
-impl<W: WholeTriangle> PartFacets for SplitParts<W> {
+impl<W: WholeTriangle, L: PartWalls> PartFacets for SplitParts<W, L> {
     fn len(&self) -> usize {
-        self.walls.len()
+        self.box_faces.len()
     }
 
     fn size(&self, k: usize) -> usize {
         let clipped: usize = self.clipped[k].iter().map(|(_, f)| f.len()).sum();
-        self.inside.of(k).len() + clipped + self.walls[k].len() + self.box_faces[k].len()
+        self.inside.of(k).len() + clipped + self.walls.count(k) + self.box_faces[k].len()
     }
 
     /// The scene pieces in scene order (the part's own triangles and the
@@ -106,7 +125,7 @@ impl<W: WholeTriangle> PartFacets for SplitParts<W> {
                 facets.extend(tris.iter().map(|&f| (f, FacetKind::Scene(*s))));
             }
         }
-        facets.extend_from_slice(&self.walls[k]);
+        facets.extend(self.walls.of(k));
         Ok(PartFacetList {
             facets,
             box_faces: self.box_faces[k].clone(),

@@ -161,8 +161,6 @@ fn rebuild(cleaned: Cleaned, resolved: Resolved) -> Cleaned {
         .map(|&p| map.triangle_source[p as usize])
         .collect();
     map.vertex_source.resize(resolved.vertices.len(), REMOVED);
-    map.vertices = resolved.vertices.clone();
-    map.triangles = triangles.clone();
     let scene = Scene {
         vertices: resolved.vertices,
         triangles,

@@ -201,7 +201,18 @@ pub(super) fn run_clipping(
         }
     }
     let mut reg = Registry::default();
-    let mut lines = Lines::with_scene(vertices, triangles);
+    let mut planes: [Vec<f32>; 3] = std::array::from_fn(|a| vec![lo[a], hi[a]]);
+    for node in &nodes {
+        if let Some((plane, ..)) = node.split {
+            planes[plane.axis].push(plane.value);
+        }
+    }
+    let mut lines = Lines::with_scene(
+        vertices,
+        triangles,
+        [&planes[0][..], &planes[1][..], &planes[2][..]],
+    );
+    drop(planes);
     let mut pieces: Vec<Vec<Poly>> = (0..nodes.len()).map(|_| Vec::new()).collect();
     let mut triangles_cut = HashSet::new();
     let mut triangles_in_plane = HashSet::new();
@@ -294,11 +305,8 @@ pub(super) fn run_clipping(
         stack.push((below, lo_p, lo_g));
         stack.push((above, hi_p, hi_g));
     }
-    for (_, list) in reg.points.iter() {
-        for &(_, x) in list {
-            lines.insert(x);
-        }
-    }
+    reg.freeze();
+    lines.add_crossings(reg.points());
     Ok(Cut {
         nodes,
         walls,

@@ -75,10 +75,16 @@ pub(super) struct Wall {
     pub(super) triangles: Vec<WallTriangle>,
 }
 
-/// Registered crossing points per root: `(t, point)`.
+/// Registered crossing points: `(root, t, point)`. While the clipping
+/// runs, every crossing is appended (a crossing two pieces share is there
+/// twice); [`Registry::freeze`] then sorts them by root and `t`, each
+/// point once per root, which is what the walls and pieces look up. One
+/// flat array rather than a map of lists: 48 bytes per crossing instead of
+/// about 170 per root (a map entry, a list and its allocation), the
+/// planner's largest item on scenes cut into many parts.
 #[derive(Default)]
 pub(super) struct Registry {
-    pub(super) points: HashMap<RootId, Vec<(f64, Vec3)>>,
+    points: Vec<(RootId, f64, Vec3)>,
 }
 
 impl Registry {
@@ -101,11 +107,35 @@ impl Registry {
                 what: "the crossing lies outside its segment",
             });
         }
-        let list = self.points.entry(root.id()).or_default();
-        if !list.iter().any(|(_, p)| key(*p) == key(x)) {
-            list.push((t, x));
-        }
+        self.points.push((root.id(), t, x));
         Ok(x)
+    }
+
+    /// Sorts the crossings by root, then `t`, each point (by exact bits)
+    /// once per root; called once, after the clipping.
+    pub(super) fn freeze(&mut self) {
+        let p = &mut self.points;
+        p.sort_unstable_by(|a, b| {
+            a.0.cmp(&b.0)
+                .then(key(a.2).cmp(&key(b.2)))
+                .then(a.1.total_cmp(&b.1))
+        });
+        p.dedup_by(|a, b| a.0 == b.0 && key(a.2) == key(b.2));
+        p.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        p.shrink_to_fit();
+    }
+
+    /// Every registered point (a point on several roots once per root).
+    pub(super) fn points(&self) -> impl Iterator<Item = Vec3> + '_ {
+        self.points.iter().map(|p| p.2)
+    }
+
+    /// The crossings on `root`, ordered by `t` (after [`Registry::freeze`]).
+    pub(super) fn on_root(&self, root: Root) -> &[(RootId, f64, Vec3)] {
+        let id = root.id();
+        let start = self.points.partition_point(|p| p.0 < id);
+        let len = self.points[start..].partition_point(|p| p.0 == id);
+        &self.points[start..start + len]
     }
 
     /// Parameter of `p` along `root`.
@@ -116,24 +146,24 @@ impl Registry {
         if key(p) == key(root.b) {
             return Some(1.0);
         }
-        self.points
-            .get(&root.id())?
+        self.on_root(root)
             .iter()
-            .find(|(_, q)| key(*q) == key(p))
-            .map(|(t, _)| *t)
+            .find(|(_, _, q)| key(*q) == key(p))
+            .map(|(_, t, _)| *t)
     }
 }
 
-/// Points on axis-parallel lines, found exactly: the scene's vertices,
-/// sorted once per free axis by (the other two coordinates' bits, the free
-/// coordinate), and the few points the cut makes (crossings, wall corners
-/// and trace crossings) in buckets `(free axis, the other two coordinates'
-/// bits)`. The scene's vertices are kept as three sorted copies rather
-/// than hashed: a tenth of the memory, which is what lets a planner hold a
-/// large scene.
+/// Points on axis-parallel lines, found exactly: the scene's vertices and
+/// the crossings the cut makes, each sorted once per free axis by (the
+/// other two coordinates' bits, the free coordinate), and the few points
+/// the walls add later (wall corners and trace crossings) in buckets
+/// `(free axis, the other two coordinates' bits)`. Sorted copies rather
+/// than hashed: a tenth of the memory, which is what lets a planner hold
+/// a large scene (and a scene cut into many parts).
 #[derive(Default)]
 pub(super) struct Lines {
     scene: [Vec<Vec3>; 3],
+    crossings: [Vec<Vec3>; 3],
     seen: HashSet<[u32; 3]>,
     buckets: HashMap<(usize, [u32; 2]), Vec<Vec3>>,
 }
@@ -147,33 +177,76 @@ fn line_of(f: usize, p: Vec3) -> [u32; 2] {
 }
 
 impl Lines {
-    /// Lines holding every vertex of `triangles`.
-    pub(super) fn with_scene(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Lines {
+    /// Lines holding the vertices of `triangles` that a segment of the cut
+    /// can pass through: for free axis `f`, a vertex that shares its line
+    /// with another vertex, or one of whose two other coordinates is a
+    /// plane value of that axis (`planes[a]`: the tree's planes and the
+    /// enclosing box's faces on axis `a`).
+    ///
+    /// Why that is all [`Lines::between`] needs: an axis-parallel segment
+    /// of the cut lies on a scene edge (whose two ends are vertices on its
+    /// line), on a cut segment or in-plane scene edge (every point of which
+    /// has the plane's coordinate), or on a wall's boundary or trace (two
+    /// plane coordinates). A vertex strictly between its ends shares their
+    /// line, so it is kept. On a curved scene almost no vertex is, where
+    /// three sorted copies of every vertex were 18 bytes per triangle of
+    /// the planner's memory.
+    pub(super) fn with_scene(
+        vertices: &[Vec3],
+        triangles: &[[u32; 3]],
+        planes: [&[f32]; 3],
+    ) -> Lines {
         let mut used = vec![false; vertices.len()];
         for t in triangles {
             for &v in t {
                 used[v as usize] = true;
             }
         }
-        let points: Vec<Vec3> = vertices
-            .iter()
-            .zip(&used)
-            .filter_map(|(p, &u)| u.then_some(*p))
+        let mut indices: Vec<u32> = (0..vertices.len() as u32)
+            .filter(|&v| used[v as usize])
             .collect();
         drop(used);
-        let sorted = |f: usize| {
-            let mut v = points.clone();
-            v.sort_unstable_by(|a, b| {
-                line_of(f, *a)
-                    .cmp(&line_of(f, *b))
-                    .then(a[f].total_cmp(&b[f]))
-            });
+        let mut planes = planes.map(|p| {
+            let mut v: Vec<u32> = p.iter().map(|&x| (x + 0.0).to_bits()).collect();
+            v.sort_unstable();
             v
-        };
+        });
+        for p in &mut planes {
+            p.dedup();
+        }
+        let on_plane = |p: Vec3, a: usize| planes[a].binary_search(&(p[a] + 0.0).to_bits()).is_ok();
+        let scene = std::array::from_fn(|f| {
+            let at = |v: u32| vertices[v as usize];
+            indices.sort_unstable_by(|&a, &b| {
+                line_of(f, at(a))
+                    .cmp(&line_of(f, at(b)))
+                    .then(at(a)[f].total_cmp(&at(b)[f]))
+            });
+            let (i, j) = ((f + 1) % 3, (f + 2) % 3);
+            let mut kept = Vec::new();
+            for run in indices.chunk_by(|&a, &b| line_of(f, at(a)) == line_of(f, at(b))) {
+                for &v in run {
+                    let p = at(v);
+                    if run.len() > 1 || on_plane(p, i) || on_plane(p, j) {
+                        kept.push(p);
+                    }
+                }
+            }
+            kept.shrink_to_fit();
+            kept
+        });
         Lines {
-            scene: [sorted(0), sorted(1), sorted(2)],
+            scene,
             ..Lines::default()
         }
+    }
+
+    /// Adds the crossings of the cut (all at once, after the clipping).
+    pub(super) fn add_crossings(&mut self, points: impl Iterator<Item = Vec3>) {
+        let mut v: Vec<Vec3> = points.collect();
+        v.sort_unstable_by_key(|p| key(*p));
+        v.dedup_by_key(|p| key(*p));
+        self.crossings = sorted_per_axis(v);
     }
 
     pub(super) fn insert(&mut self, p: Vec3) {
@@ -190,15 +263,18 @@ impl Lines {
     pub(super) fn between(&self, p: Vec3, q: Vec3, f: usize) -> Vec<Vec3> {
         let line = line_of(f, p);
         let (lo, hi) = (p[f].min(q[f]), p[f].max(q[f]));
-        let scene = &self.scene[f];
-        let start = scene.partition_point(|x| line_of(f, *x) < line);
-        let len = scene[start..].partition_point(|x| line_of(f, *x) == line);
+        fn on_line(sorted: &[Vec3], f: usize, line: [u32; 2]) -> &[Vec3] {
+            let start = sorted.partition_point(|x| line_of(f, *x) < line);
+            let len = sorted[start..].partition_point(|x| line_of(f, *x) == line);
+            &sorted[start..start + len]
+        }
         let made = self
             .buckets
             .get(&(f, line))
             .map_or(&[][..], |b| b.as_slice());
-        let mut v: Vec<Vec3> = scene[start..start + len]
+        let mut v: Vec<Vec3> = on_line(&self.scene[f], f, line)
             .iter()
+            .chain(on_line(&self.crossings[f], f, line))
             .chain(made)
             .copied()
             .filter(|x| x[f] > lo && x[f] < hi)
@@ -211,6 +287,21 @@ impl Lines {
         v.dedup_by(|a, b| key(*a) == key(*b));
         v
     }
+}
+
+/// `points` in three copies, the `f`-th sorted by (the line with free axis
+/// `f`, the free coordinate).
+fn sorted_per_axis(points: Vec<Vec3>) -> [Vec<Vec3>; 3] {
+    let sorted = |f: usize, mut v: Vec<Vec3>| {
+        v.sort_unstable_by(|a, b| {
+            line_of(f, *a)
+                .cmp(&line_of(f, *b))
+                .then(a[f].total_cmp(&b[f]))
+        });
+        v
+    };
+    let (x, y) = (sorted(0, points.clone()), sorted(1, points.clone()));
+    [x, y, sorted(2, points)]
 }
 
 /// The free axis of an axis-parallel segment (two coordinates equal).
@@ -246,21 +337,16 @@ pub(super) fn subdivide(
     let tp = reg.t_of(root, p).ok_or_else(|| missing(p))?;
     let tq = reg.t_of(root, q).ok_or_else(|| missing(q))?;
     let (lo, hi) = (tp.min(tq), tp.max(tq));
-    let mut v: Vec<(f64, Vec3)> = reg
-        .points
-        .get(&root.id())
-        .map(|l| {
-            l.iter()
-                .copied()
-                .filter(|(t, _)| *t > lo && *t < hi)
-                .collect()
-        })
-        .unwrap_or_default();
-    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut v: Vec<Vec3> = reg
+        .on_root(root)
+        .iter()
+        .filter(|(_, t, _)| *t > lo && *t < hi)
+        .map(|(_, _, x)| *x)
+        .collect();
     if tp > tq {
         v.reverse();
     }
-    Ok(v.into_iter().map(|(_, x)| x).collect())
+    Ok(v)
 }
 
 /// The full outline of a polygon (every edge subdivided).
@@ -392,25 +478,104 @@ mod tests {
     }
 
     proptest! {
+        /// After the freeze, a root's crossings are the distinct points
+        /// registered on it, ordered by `t`, and `t_of` finds each (and
+        /// the root's ends), whatever the order they were registered in
+        /// and however often.
+        #[test]
+        fn registry_lists_each_roots_crossings_once_in_order(
+            ends in prop::collection::vec((point(), point()), 1..6),
+            crossings in prop::collection::vec((0usize..6, 0usize..3, 0.05f32..0.95), 1..40),
+        ) {
+            let roots: Vec<Root> = ends
+                .iter()
+                .filter(|(p, q)| (0..3).all(|a| p[a] != q[a]))
+                .map(|&(p, q)| Root::new(p, q))
+                .collect();
+            prop_assume!(!roots.is_empty());
+            let mut reg = Registry::default();
+            let mut expected: Vec<Vec<(f64, [u32; 3])>> = vec![Vec::new(); roots.len()];
+            for &(r, axis, s) in &crossings {
+                let k = r % roots.len();
+                let root = roots[k];
+                let (a, b) = (root.a[axis], root.b[axis]);
+                let plane = SplitPlane { axis, value: a + (b - a) * s };
+                let Ok(x) = reg.cross(root, plane, 0) else { continue };
+                let t = (plane.value as f64 - a as f64) / (b as f64 - a as f64);
+                if !expected[k].iter().any(|e| e.1 == key(x)) {
+                    expected[k].push((t, key(x)));
+                }
+            }
+            reg.freeze();
+            for (k, &root) in roots.iter().enumerate() {
+                // Roots with the same ends share their crossings.
+                let mut want: Vec<(f64, [u32; 3])> = roots
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, r)| r.id() == root.id())
+                    .flat_map(|(j, _)| expected[j].clone())
+                    .collect();
+                want.sort_by_key(|w| w.1);
+                want.dedup_by(|a, b| a.1 == b.1);
+                want.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let got: Vec<[u32; 3]> = reg.on_root(root).iter().map(|p| key(p.2)).collect();
+                let want_keys: Vec<[u32; 3]> = want.iter().map(|w| w.1).collect();
+                prop_assert_eq!(&got, &want_keys, "root {}", k);
+                for p in reg.on_root(root) {
+                    prop_assert_eq!(reg.t_of(root, p.2), Some(p.1));
+                }
+                prop_assert_eq!(reg.t_of(root, root.a), Some(0.0));
+                prop_assert_eq!(reg.t_of(root, root.b), Some(1.0));
+            }
+        }
+
         /// The scene's sorted vertices and the inserted points together
         /// give exactly the points a look at every point finds, in order,
-        /// each once, whichever of the two holds a point (or both).
+        /// each once, whichever of the two holds a point (or both), for
+        /// every segment the cut can make: one ending at a scene vertex,
+        /// or one with a coordinate on a plane.
         #[test]
         fn points_between_match_a_look_at_every_point(
             scene in prop::collection::vec(point(), 3..40),
             made in prop::collection::vec(point(), 0..20),
-            ends in prop::collection::vec((point(), 0usize..3, coordinate()), 1..20),
+            planes in prop::collection::vec((0usize..3, coordinate()), 0..6),
+            ends in prop::collection::vec(
+                (point(), 0usize..3, coordinate(), 0usize..40, 0usize..4),
+                1..20,
+            ),
         ) {
             let n = scene.len() as u32;
             // Every scene vertex but the last is used by a triangle.
             let triangles: Vec<[u32; 3]> = (0..n - 1).map(|i| [i, (i + 1) % (n - 1), 0]).collect();
             let used: Vec<Vec3> = scene[..scene.len() - 1].to_vec();
-            let mut lines = Lines::with_scene(&scene, &triangles);
-            for &x in &made {
+            let by_axis: [Vec<f32>; 3] = std::array::from_fn(|a| {
+                planes.iter().filter(|p| p.0 == a).map(|p| p.1).collect()
+            });
+            let mut lines = Lines::with_scene(
+                &scene,
+                &triangles,
+                [&by_axis[0][..], &by_axis[1][..], &by_axis[2][..]],
+            );
+            // The crossings come all at once, the walls' points one by one.
+            let (crossings, late) = made.split_at(made.len() / 2);
+            lines.add_crossings(crossings.iter().copied());
+            for &x in late {
                 lines.insert(x);
             }
             let all: Vec<Vec3> = used.iter().chain(&made).copied().collect();
-            for &(p, f, other) in &ends {
+            for &(p, f, other, vertex, how) in &ends {
+                // The end: a used scene vertex, or a point with one of its
+                // coordinates across `f` on a plane of that axis.
+                let p = match how {
+                    0 | 1 => used[vertex % used.len()],
+                    _ => {
+                        let a = (f + 1 + how % 2) % 3;
+                        let Some(&value) = by_axis[a].first() else { continue };
+                        let mut p = p;
+                        p[a] = value;
+                        p
+                    }
+                };
                 let mut q = p;
                 q[f] = other;
                 let got: Vec<[u32; 3]> = lines.between(p, q, f).into_iter().map(key).collect();

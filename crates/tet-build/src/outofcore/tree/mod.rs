@@ -44,15 +44,14 @@
 //! | repair of overlapping vertices/edges   | none: shared roots and walls      |
 //! | `MERGE` by centroid hashing            | exact dedup + `TetMesh::assemble` |
 
-use glam::Vec3;
 use tet_core::TetMesh;
 
 use self::clip::{Cut, run_clipping};
-use self::leaf_parts::{TreeWhole, piece_facets};
+use self::leaf_parts::{LeafWalls, TreeWhole, leaf_faces, piece_facets};
 use self::walls::{prepare_walls, triangulate_wall};
 use super::error::SeamError;
 use super::merge::{InMemory, Merge, PartInputs, finish_parts};
-use super::parts::{FacetKind, SeamOptions, SeamReport};
+use super::parts::{SeamOptions, SeamReport};
 use super::plane::key;
 use super::prepare::{Prepared, prepare};
 use super::split::SplitTree;
@@ -113,11 +112,11 @@ fn build_tree_with<M: Merge>(
 
 /// Every leaf's PLC of `scene` split by `tree` (see the module docs), in
 /// leaf order, and the report's seam fields; no TetGen run.
-pub(in crate::outofcore) fn tree_part_inputs(
-    scene: &Scene,
+pub(in crate::outofcore) fn tree_part_inputs<'a>(
+    scene: &'a Scene,
     tree: &CutTree,
     options: &SeamOptions,
-) -> Result<(PartInputs, SeamReport), SeamError> {
+) -> Result<(PartInputs<'a>, SeamReport), SeamError> {
     let Prepared {
         scene: cleaned,
         triangle_source,
@@ -166,13 +165,16 @@ pub(in crate::outofcore) fn tree_part_inputs(
     let mut clipped = Vec::with_capacity(leaves.len());
     let mut walls = Vec::with_capacity(leaves.len());
     for &id in &leaves {
-        let mut pieces = Vec::with_capacity(cut.pieces[id].len());
-        for poly in &cut.pieces[id] {
+        // Each leaf's pieces are dropped as their facets are made, so the
+        // two are not held whole at once.
+        let polys = std::mem::take(&mut cut.pieces[id]);
+        let mut pieces = Vec::with_capacity(polys.len());
+        for poly in &polys {
             let facets = piece_facets(poly, &cleaned, &cut.registry, &cut.lines)?;
             pieces.push((poly.source, facets));
         }
         clipped.push(pieces);
-        walls.push(leaf_wall_facets(&cut, id));
+        walls.push(leaf_faces(&cut, id));
     }
     let mut part_of_node = vec![None; cut.nodes.len()];
     for (k, &id) in leaves.iter().enumerate() {
@@ -184,8 +186,12 @@ pub(in crate::outofcore) fn tree_part_inputs(
         cut.leaf_of.len(),
     );
     let Cut {
-        registry, lines, ..
+        registry,
+        lines,
+        walls: cut_walls,
+        ..
     } = cut;
+    let walls = LeafWalls::new(cut_walls.into_iter().map(|w| w.triangles).collect(), walls);
     let parts = SplitParts {
         whole: TreeWhole {
             scene: cleaned,
@@ -194,7 +200,7 @@ pub(in crate::outofcore) fn tree_part_inputs(
         },
         inside,
         clipped,
-        box_faces: vec![Vec::new(); walls.len()],
+        box_faces: vec![Vec::new(); leaves.len()],
         walls,
     };
     let inputs = PartInputs {
@@ -205,43 +211,12 @@ pub(in crate::outofcore) fn tree_part_inputs(
     Ok((inputs, report))
 }
 
-/// The facets of leaf `id`'s six faces: the triangles of the walls they
-/// lie on that lie inside them.
-fn leaf_wall_facets(cut: &Cut, id: usize) -> Vec<([Vec3; 3], FacetKind)> {
-    let node = &cut.nodes[id];
-    let mut facets = Vec::new();
-    for axis in 0..3 {
-        for value in [node.lo[axis], node.hi[axis]] {
-            let (mut flo, mut fhi) = (node.lo, node.hi);
-            flo[axis] = value;
-            fhi[axis] = value;
-            let wall = cut
-                .walls
-                .iter()
-                .find(|w| {
-                    w.plane.axis == axis
-                        && w.plane.value == value
-                        && (0..3).all(|a| w.lo[a] <= flo[a] && fhi[a] <= w.hi[a])
-                })
-                .expect("every leaf face lies on a seam or on the enclosing box");
-            for (t, s) in &wall.triangles {
-                let inside = t
-                    .iter()
-                    .all(|p| (0..3).all(|a| p[a] >= flo[a] && p[a] <= fhi[a]));
-                if inside {
-                    facets.push((*t, s.map_or(FacetKind::Seam, FacetKind::Scene)));
-                }
-            }
-        }
-    }
-    facets
-}
-
 /// The plan [`build_tree_with_memory_limit`] built.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TreePlan {
     /// The planner's tree (estimates per leaf, triangles cut per node),
-    /// with the planes as planned.
+    /// with the planes as planned; its leaves' triangle lists are dropped
+    /// once the cut tree is made.
     pub plan: SplitTree,
     /// The planes as built (after any moves).
     pub cuts: CutTree,
@@ -327,12 +302,13 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
     } else {
         super::split::plan_split_within(vertices, triangles, (b.min, b.max), split)
     };
-    let Some(plan) = plan else {
+    let Some(mut plan) = plan else {
         return Err(SeamError::LimitTooSmall {
             limit_bytes: split.limit_bytes,
         });
     };
     let mut tree = CutTree::from_split_tree(&plan);
+    plan.forget_triangles();
     drop(cleaned);
     let (mut moves, mut part_moves) = (0, 0);
     loop {
@@ -397,7 +373,7 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
 #[cfg(test)]
 mod tests {
     use super::geometry::triangulate_outline;
-    use super::*;
+    use glam::Vec3;
 
     /// A piece nearly parallel to a wall (z = 0) whose chain A–D–C on the
     /// wall is not exactly straight: the ear at B would leave the sliver
