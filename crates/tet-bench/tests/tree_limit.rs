@@ -143,8 +143,11 @@ fn a_job_planner_stays_under_the_builders_share() {
 }
 
 /// How far above a measured builder peak its model may be
-/// (`tet_build::outofcore::admission::BuilderModel::FITTED`).
-const WITHIN: f64 = 1.3;
+/// (`tet_build::outofcore::admission::BuilderModel::FITTED`). One line
+/// through scenes that need different amounts per triangle (Mix in a
+/// Box, an OBJ with resolved crossings, 150 B; `fan-sphere:1m` 100 B)
+/// is 1.07–1.52× its samples, the small scenes here about 1.35×.
+const WITHIN: f64 = 1.6;
 
 /// The resident memory of `pid` under `key` (`VmHWM:`, `VmRSS:`), KiB.
 fn status_kib(pid: u32, key: &str) -> Option<u64> {
