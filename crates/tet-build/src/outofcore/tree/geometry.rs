@@ -217,11 +217,7 @@ impl Lines {
         let on_plane = |p: Vec3, a: usize| planes[a].binary_search(&(p[a] + 0.0).to_bits()).is_ok();
         let scene = std::array::from_fn(|f| {
             let at = |v: u32| vertices[v as usize];
-            indices.sort_unstable_by(|&a, &b| {
-                line_of(f, at(a))
-                    .cmp(&line_of(f, at(b)))
-                    .then(at(a)[f].total_cmp(&at(b)[f]))
-            });
+            indices.sort_unstable_by(|&a, &b| line_order(f, at(a), at(b)));
             let (i, j) = ((f + 1) % 3, (f + 2) % 3);
             let mut kept = Vec::new();
             for run in indices.chunk_by(|&a, &b| line_of(f, at(a)) == line_of(f, at(b))) {
@@ -289,15 +285,19 @@ impl Lines {
     }
 }
 
+/// The order of points on lines with free axis `f`: by line, then by the
+/// free coordinate.
+fn line_order(f: usize, a: Vec3, b: Vec3) -> std::cmp::Ordering {
+    line_of(f, a)
+        .cmp(&line_of(f, b))
+        .then(a[f].total_cmp(&b[f]))
+}
+
 /// `points` in three copies, the `f`-th sorted by (the line with free axis
 /// `f`, the free coordinate).
 fn sorted_per_axis(points: Vec<Vec3>) -> [Vec<Vec3>; 3] {
     let sorted = |f: usize, mut v: Vec<Vec3>| {
-        v.sort_unstable_by(|a, b| {
-            line_of(f, *a)
-                .cmp(&line_of(f, *b))
-                .then(a[f].total_cmp(&b[f]))
-        });
+        v.sort_unstable_by(|a, b| line_order(f, *a, *b));
         v
     };
     let (x, y) = (sorted(0, points.clone()), sorted(1, points.clone()));

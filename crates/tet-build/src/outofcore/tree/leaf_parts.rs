@@ -57,14 +57,8 @@ pub(super) type LeafFace = (usize, Vec3, Vec3);
 pub(super) fn leaf_faces(cut: &Cut, id: usize) -> [LeafFace; 6] {
     let node = &cut.nodes[id];
     std::array::from_fn(|f| {
-        let (axis, value) = (
-            f / 2,
-            if f % 2 == 0 {
-                node.lo[f / 2]
-            } else {
-                node.hi[f / 2]
-            },
-        );
+        let axis = f / 2;
+        let value = if f % 2 == 0 { node.lo } else { node.hi }[axis];
         let (mut flo, mut fhi) = (node.lo, node.hi);
         flo[axis] = value;
         fhi[axis] = value;
