@@ -18,6 +18,7 @@ use crate::methods::method::{Method, Precision};
 use crate::outofcore::options::{
     MemPerPart, MergeMode, Planner, parse_mem_per_part, parse_memory_limit,
 };
+use crate::timing::ray_kinds::RayKinds;
 
 /// Ray tracing through constrained Delaunay tetrahedralizations: build,
 /// inspect, render, measure accuracy and reproduce the papers' tables.
@@ -267,9 +268,16 @@ pub struct RenderArgs {
     /// Write a heat map of tets (or nodes) visited per pixel (PNG).
     #[arg(long)]
     pub heatmap: Option<PathBuf>,
-    /// Trace shadow rays to the point lights.
+    /// Trace shadow rays to the point lights (the same as `--rays shadow`,
+    /// or `mixed` with `--rays ao`).
     #[arg(long)]
     pub shadows: bool,
+    /// The rays of a frame: primary rays only, or per primary hit also one
+    /// ambient-occlusion ray (`ao`; cosine-distributed, a tenth of the
+    /// scene's diagonal long), shadow rays to the point lights (`shadow`),
+    /// or both (`mixed`). Each kind's rays and speed are reported apart.
+    #[arg(long, value_enum, default_value_t = RayKinds::Primary)]
+    pub rays: RayKinds,
     /// View (overrides the scene's camera).
     #[command(flatten)]
     pub view: ViewArgs,

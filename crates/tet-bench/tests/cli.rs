@@ -1117,3 +1117,44 @@ fn walls_build_parts_that_trace_like_the_in_core_mesh() {
     ]);
     assert!(err.contains("--walls and --memory-limit"), "{err}");
 }
+
+/// `render --rays`: each kind's rays are cast and reported apart, the
+/// same rays for a tet walk and a BVH (same hits, so the same AO rays),
+/// and `--shadows` adds shadow rays to the kinds asked for.
+#[test]
+fn render_reports_each_kind_of_ray_apart() {
+    let mut ao_rays = Vec::new();
+    for method in ["tet20", "obvhs"] {
+        for kind in ["primary", "ao", "shadow", "mixed"] {
+            let r = render_json("torus-knot", method, &["--rays", kind]);
+            assert_eq!(r["rays_kind"], kind, "{r}");
+            let by = &r["by_kind"];
+            assert_eq!(by["primary"]["rays"], 48 * 36, "{r}");
+            let hits = r["hits"].as_u64().unwrap();
+            let ao = by["ao"]["rays"].as_u64().unwrap();
+            let shadow = by["shadow"]["rays"].as_u64().unwrap();
+            let with_ao = kind == "ao" || kind == "mixed";
+            let with_shadows = kind == "shadow" || kind == "mixed";
+            assert_eq!(ao > 0, with_ao, "{r}");
+            assert!(ao <= hits, "{r}");
+            assert_eq!(shadow > 0, with_shadows, "{r}");
+            assert_eq!(shadow, r["shadow_rays"].as_u64().unwrap(), "{r}");
+            for k in ["primary", "ao", "shadow"] {
+                let rays = by[k]["rays"].as_u64().unwrap();
+                let speed = by[k]["mrays_per_s"].as_f64().unwrap();
+                assert_eq!(speed > 0.0, rays > 0, "{k}: {r}");
+            }
+            // Tets per AO ray: counted for the walk, not for the BVH.
+            assert_eq!(
+                by["ao"]["tets_per_ray"].is_null(),
+                method == "obvhs" || !with_ao
+            );
+            if with_ao {
+                ao_rays.push(ao);
+            }
+        }
+    }
+    assert!(ao_rays.iter().all(|&n| n == ao_rays[0]), "{ao_rays:?}");
+    let both = render_json("torus-knot", "tet20", &["--rays", "ao", "--shadows"]);
+    assert_eq!(both["rays_kind"], "mixed");
+}

@@ -8,6 +8,7 @@ use crate::cli::RenderArgs;
 use crate::load::{load, require_tets};
 use crate::output::{outln, print_json};
 use crate::timing::gpu::time_gpu;
+use crate::timing::ray_kinds::{KindDoc, RayKinds};
 use crate::timing::{pool, time_method};
 
 /// `tet-bench render`.
@@ -15,15 +16,19 @@ pub fn run(args: &RenderArgs, json: bool) -> Result<()> {
     let mut loaded = load(&args.scene, &args.build, json)?;
     loaded.set_view(&args.view)?;
     require_tets(&loaded)?;
+    let kinds = args.rays.with_shadows(args.shadows);
     let opts = RenderOptions {
         width: args.width,
         height: args.height,
-        shadows: args.shadows,
+        shadows: kinds.shadows(),
+        ambient_occlusion: kinds.ao(),
         ..RenderOptions::default()
     };
     let doc = if args.method.is_gpu() {
-        if args.output.is_some() || args.heatmap.is_some() || args.shadows {
-            bail!("GPU methods report timings only: use a CPU method for images and shadows");
+        if args.output.is_some() || args.heatmap.is_some() || kinds != RayKinds::Primary {
+            bail!(
+                "GPU methods report timings of primary rays only: use a CPU method for images and secondary rays"
+            );
         }
         time_gpu(&loaded, args.method, args.width, args.height, args.frames)?
     } else {
@@ -58,6 +63,24 @@ pub fn run(args: &RenderArgs, json: bool) -> Result<()> {
             doc.hits,
             doc.failures
         )?;
+        if doc.rays_kind != RayKinds::Primary {
+            let k = &doc.by_kind;
+            let line = |name: &str, kind: &KindDoc| {
+                let tets = kind
+                    .tets_per_ray
+                    .map_or(String::new(), |t| format!(", {t:.1} tets/ray"));
+                format!(
+                    "{name} {} rays {:.2} Mrays/s{tets}",
+                    kind.rays, kind.mrays_per_s
+                )
+            };
+            outln!(
+                "  by kind (fastest frame, tracing time only): {}; {}; {}",
+                line("primary", &k.primary),
+                line("ao", &k.ao),
+                line("shadow", &k.shadow)
+            )?;
+        }
     }
     Ok(())
 }

@@ -10,7 +10,9 @@
 //!   from one start, a camera tile, in a coherent context, other rays in an
 //!   incoherent one);
 //! * `embree8`: `rtcIntersect8` on packets of eight consecutive rays of a
-//!   batch (the renderer's batches are 16×16 tiles, so packets are coherent).
+//!   batch (the renderer's batches are 16×16 tiles, so packets are
+//!   coherent), secondary rays included: a tile's AO rays and its shadow
+//!   rays toward one light go in packets of eight too.
 //!
 //! Hits are returned through the same record as every other method
 //! ([`super::bvh::input_hit`]: t from Embree, barycentrics and sides
@@ -200,13 +202,23 @@ impl Tracer for EmbreeTracer<'_> {
         match starts {
             tet_trace_cpu::Starts::Outside(_) => self.trace_batch(rays, Start::Tet(0), out),
             tet_trace_cpu::Starts::Same(s) => self.trace_batch(rays, s, out),
-            tet_trace_cpu::Starts::Each(s) => {
-                for ((r, s), o) in rays.iter().zip(s).zip(out.iter_mut()) {
-                    *o = self.trace(r, *s);
-                }
-            }
+            tet_trace_cpu::Starts::Each(s) => self.trace_each(rays, s, out),
         }
     }
+
+    /// A batch of shadow rays: Embree has no tets to stop at, so each runs
+    /// to its `t_max` (the light's distance), in packets for `embree8`.
+    fn trace_until_batch(
+        &self,
+        rays: &[Ray],
+        starts: &[Start],
+        _stop: &[u32],
+        out: &mut [TraceOutcome],
+    ) {
+        let n = rays.len().min(starts.len()).min(out.len());
+        self.trace_each(&rays[..n], &starts[..n], &mut out[..n]);
+    }
+
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
         let from_face = matches!(start, Start::Face { .. });
         if !self.packets || from_face {
@@ -222,8 +234,42 @@ impl Tracer for EmbreeTracer<'_> {
             }
             return;
         }
-        let mut ctx = IntersectContext::coherent();
-        for (chunk, outs) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+        self.packets(IntersectContext::coherent(), rays, |_| u32::MAX, out);
+    }
+}
+
+impl EmbreeTracer<'_> {
+    /// Rays with a start each (a tile's secondary rays): single rays, or
+    /// packets for `embree8`; a ray that starts on a face never reports
+    /// that face's input triangle.
+    fn trace_each(&self, rays: &[Ray], starts: &[Start], out: &mut [TraceOutcome]) {
+        let skip = |i: usize| {
+            starts[i]
+                .on_face()
+                .and_then(|f| self.inputs.of_face(f))
+                .unwrap_or(u32::MAX)
+        };
+        if !self.packets {
+            let mut ctx = IntersectContext::incoherent();
+            for (i, (r, o)) in rays.iter().zip(out.iter_mut()).enumerate() {
+                *o = self.trace_in(&mut ctx, r, starts[i]);
+            }
+            return;
+        }
+        self.packets(IntersectContext::incoherent(), rays, skip, out);
+    }
+
+    /// `rtcIntersect8` on packets of eight consecutive rays in `ctx`; ray
+    /// `i` must not report input triangle `skip(i)` (`u32::MAX`: none): a
+    /// lane that does is traced again alone, past it ([`Self::trace_one`]).
+    fn packets(
+        &self,
+        mut ctx: IntersectContext,
+        rays: &[Ray],
+        skip: impl Fn(usize) -> u32,
+        out: &mut [TraceOutcome],
+    ) {
+        for (c, (chunk, outs)) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)).enumerate() {
             let mut packet = embree3::sys::RTCRayHit8 {
                 ray: embree3::Ray8::empty(),
                 hit: embree3::Hit8::new(),
@@ -251,7 +297,13 @@ impl Tracer for EmbreeTracer<'_> {
                         tets_visited: 0,
                     }
                 } else if packet.hit.geomID[i] != INVALID_ID {
-                    self.outcome(r, packet.hit.primID[i], packet.ray.tfar[i])
+                    let prim = packet.hit.primID[i];
+                    let s = skip(c * PACKET + i);
+                    if prim == s {
+                        self.trace_one(&mut ctx, r, s)
+                    } else {
+                        self.outcome(r, prim, packet.ray.tfar[i])
+                    }
                 } else {
                     TraceOutcome::Miss { tets_visited: 0 }
                 };
@@ -283,6 +335,7 @@ mod tests {
         let packets = EmbreeTracer::new(&mesh, true).unwrap();
         let mut rng = SplitMix64(3);
         let (mut checked, mut hits, mut secondary) = (0, 0, 0);
+        let (mut conts, mut starts, mut singles) = (Vec::new(), Vec::new(), Vec::new());
         for aim in [Aim::Random, Aim::Vertex, Aim::EdgeMidpoint] {
             // Rays of one batch share a start tet, as in a render tile.
             let (r0, t0) = random_ray(&mesh, &mut rng, aim);
@@ -313,16 +366,25 @@ mod tests {
                 );
                 // Continue through the face: never the same face again.
                 let cont = Ray::new(ray.at(h.t), ray.direction);
-                let out = single.trace(
-                    &cont,
-                    Start::Face {
-                        face: h.face,
-                        tet: h.far_tet,
-                    },
-                );
+                let start = Start::Face {
+                    face: h.face,
+                    tet: h.far_tet,
+                };
+                let out = single.trace(&cont, start);
                 assert_ne!(out.hit().map(|x| x.face), Some(h.face));
                 secondary += 1;
+                conts.push(cont);
+                starts.push(start);
+                singles.push(out);
             }
+        }
+        // The same secondary rays in packets (a start each): the single
+        // rays' faces, never the face a ray starts on.
+        let mut packed = vec![TraceOutcome::Miss { tets_visited: 0 }; conts.len()];
+        packets.trace_batch_from(&conts, tet_trace_cpu::Starts::Each(&starts), &mut packed);
+        for ((p, s), start) in packed.iter().zip(&singles).zip(&starts) {
+            assert_eq!(p.hit().map(|h| h.face), s.hit().map(|h| h.face));
+            assert_ne!(p.hit().map(|h| h.face), start.on_face());
         }
         assert!(
             checked > 400 && hits > 200 && secondary > 200,

@@ -63,6 +63,15 @@ pub fn time_gpu(
         hits: best.hits,
         failures: best.failures,
         shadow_rays: 0,
+        rays_kind: super::ray_kinds::RayKinds::Primary,
+        by_kind: super::ray_kinds::ByKind {
+            primary: super::ray_kinds::KindDoc {
+                rays: best.rays,
+                mrays_per_s: best.mrays_per_s(),
+                tets_per_ray: None,
+            },
+            ..Default::default()
+        },
         setup_s,
         hot_bytes,
         target_features: crate::timing::target_features(),

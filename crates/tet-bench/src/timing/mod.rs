@@ -7,6 +7,7 @@
 
 pub mod exitface;
 pub mod gpu;
+pub mod ray_kinds;
 
 use std::time::Instant;
 
@@ -21,6 +22,7 @@ use crate::methods::bvh::BvhTracer;
 use crate::methods::layouts::{layout_bytes, strips_bytes};
 use crate::methods::method::Method;
 use crate::methods::tracer;
+use ray_kinds::{ByKind, RayKinds};
 
 /// Timings of one method on one scene (JSON document of `render`, and rows
 /// of the `tables` render table).
@@ -60,6 +62,11 @@ pub struct RenderDoc {
     pub failures: u64,
     /// Shadow rays per frame.
     pub shadow_rays: u64,
+    /// The rays each frame cast (`render --rays`).
+    pub rays_kind: RayKinds,
+    /// Rays and speed of each kind in the fastest frame (the top-level
+    /// `mrays_per_s` is the whole frame's primary rays per second).
+    pub by_kind: ByKind,
     /// Seconds to encode the layout or build the BVH.
     pub setup_s: f64,
     /// Hot bytes of the method's structure: the tet records and points of
@@ -167,6 +174,8 @@ pub fn time_method(
         hits: best.hits,
         failures: best.failures,
         shadow_rays: best.shadow_rays,
+        rays_kind: RayKinds::of(opts),
+        by_kind: ByKind::of(&best, pool.current_num_threads()),
         setup_s,
         hot_bytes,
         target_features: target_features(),

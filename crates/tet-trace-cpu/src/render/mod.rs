@@ -42,6 +42,13 @@
 //! those of tracing each ray alone
 //! ([`crate::secondary::PerRay`] keeps that as the reference). Area
 //! lights' sample rays are still traced one by one.
+//!
+//! Ambient occlusion ([`RenderOptions::ambient_occlusion`], [`ambient`]):
+//! one AO ray per primary hit, a tile's traced in one batch by the primary
+//! tracer after its primary rays; an open hit adds
+//! [`AO_AMBIENT`] to its pixel. The time spent tracing each kind of ray
+//! is kept apart in [`FrameStats`], so that a frame of primary, AO and
+//! shadow rays reports the speed of each.
 
 use std::io::Write;
 use std::path::Path;
@@ -58,11 +65,23 @@ use crate::boundary_entry::{Viewpoint, ViewpointError};
 use crate::kernel::Tracer;
 use crate::locate::LocateError;
 use crate::ray::{Hit, Ray, TraceOutcome};
-use crate::secondary::{LightTarget, OwnShadows, ShadowTracer, face_normal, shadow_ray};
-use crate::walk::Start;
+use crate::secondary::{LightTarget, OwnShadows, ShadowTracer, face_normal};
+
+pub mod ambient;
+mod shadows;
+
+use ambient::{Ao, TileAo, ao_length};
+use shadows::{Shadow, TileShadows, light_cos};
 
 /// Tile edge in pixels.
 pub const TILE: u32 = 16;
+
+/// What an open ambient-occlusion ray adds to its pixel (grey level).
+pub const AO_AMBIENT: f32 = 0.25;
+
+/// Default length of the AO rays, as a share of the scene's diagonal
+/// ([`ambient::ao_length`]).
+pub const AO_SHARE: f32 = 0.1;
 
 /// Rendering errors.
 #[derive(Debug, Error)]
@@ -130,8 +149,13 @@ pub struct RenderOptions {
     /// Samples per hit and area light (rounded up to a full stratification
     /// grid, see [`crate::area_light::strata`]).
     pub area_samples: u32,
-    /// Seed of the area-light sample jitter (mixed with the pixel index).
+    /// Seed of the area-light sample jitter and the AO directions (mixed
+    /// with the pixel index).
     pub seed: u64,
+    /// Cast one ambient-occlusion ray per primary hit ([`ambient`]).
+    pub ambient_occlusion: bool,
+    /// Length of the AO rays as a share of the scene's diagonal.
+    pub ao_share: f32,
 }
 
 impl Default for RenderOptions {
@@ -145,6 +169,8 @@ impl Default for RenderOptions {
             headlight: false,
             area_samples: 16,
             seed: 0,
+            ambient_occlusion: false,
+            ao_share: AO_SHARE,
         }
     }
 }
@@ -152,7 +178,8 @@ impl Default for RenderOptions {
 /// Per-frame statistics.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameStats {
-    /// Wall time of the whole frame (primary + shadow rays + shading), ms.
+    /// Wall time of the whole frame (primary, AO and shadow rays,
+    /// shading), ms.
     pub ms: f64,
     /// Primary rays cast.
     pub rays: u64,
@@ -166,12 +193,56 @@ pub struct FrameStats {
     pub shadow_rays: u64,
     /// Shadow rays whose walk failed (counted as lit).
     pub shadow_failures: u64,
+    /// Ambient-occlusion rays cast.
+    pub ao_rays: u64,
+    /// AO rays whose walk failed (counted as open).
+    pub ao_failures: u64,
+    /// Tets visited by AO rays (0 for tracers without tets).
+    pub ao_tets_visited: u64,
+    /// Time spent tracing the primary rays, summed over the worker
+    /// threads, ms.
+    pub primary_trace_ms: f64,
+    /// Time spent tracing the AO rays, summed over the worker threads, ms.
+    pub ao_trace_ms: f64,
+    /// Time spent tracing the shadow rays (point lights' batches, area
+    /// lights' samples), summed over the worker threads, ms.
+    pub shadow_trace_ms: f64,
 }
 
 impl FrameStats {
-    /// Million primary rays per second.
+    /// Million primary rays per second of the whole frame.
     pub fn mrays_per_s(&self) -> f64 {
         self.rays as f64 / (self.ms * 1e3)
+    }
+
+    /// Million rays per second of `threads` workers tracing one kind of
+    /// ray: `rays` over its tracing time per thread (`trace_ms`, summed
+    /// over the threads, divided by `threads`); 0 when none were traced.
+    pub fn kind_mrays_per_s(rays: u64, trace_ms: f64, threads: usize) -> f64 {
+        if rays == 0 || trace_ms <= 0.0 {
+            return 0.0;
+        }
+        rays as f64 * threads.max(1) as f64 / (trace_ms * 1e3)
+    }
+
+    /// Every count and time of two parts of a frame together (`ms` is
+    /// the frame's, set apart).
+    fn sum(self, b: FrameStats) -> FrameStats {
+        FrameStats {
+            ms: 0.0,
+            rays: self.rays + b.rays,
+            hits: self.hits + b.hits,
+            tets_visited: self.tets_visited + b.tets_visited,
+            failures: self.failures + b.failures,
+            shadow_rays: self.shadow_rays + b.shadow_rays,
+            shadow_failures: self.shadow_failures + b.shadow_failures,
+            ao_rays: self.ao_rays + b.ao_rays,
+            ao_failures: self.ao_failures + b.ao_failures,
+            ao_tets_visited: self.ao_tets_visited + b.ao_tets_visited,
+            primary_trace_ms: self.primary_trace_ms + b.primary_trace_ms,
+            ao_trace_ms: self.ao_trace_ms + b.ao_trace_ms,
+            shadow_trace_ms: self.shadow_trace_ms + b.shadow_trace_ms,
+        }
     }
 }
 
@@ -267,6 +338,8 @@ struct Pixel {
     failed: bool,
     shadow_rays: u32,
     shadow_failures: u32,
+    /// Time spent on the area lights' shadow rays, ms.
+    area_ms: f64,
 }
 
 /// The lights of a scene: point lights and area / mesh lights.
@@ -400,6 +473,11 @@ pub fn render_scene_into<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
         areas: lights.areas,
     };
     let cam = PinholeCamera::new(camera, w, h, opts.pixel_centers);
+    let ao_len = if opts.ambient_occlusion && !opts.headlight {
+        ao_length(mesh, opts.ao_share)
+    } else {
+        0.0
+    };
     let n = (w * h) as usize;
     // Every pixel is written below: buffers of the right size are reused
     // as they are.
@@ -426,6 +504,7 @@ pub fn render_scene_into<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
             let mut ids = Vec::with_capacity((TILE * TILE) as usize);
             let mut outcomes = Vec::with_capacity((TILE * TILE) as usize);
             let mut shadows = TileShadows::default();
+            let mut ao = TileAo::default();
             let y0 = ty as u32 * TILE;
             let y1 = (y0 + TILE).min(h);
             for x0 in (0..w).step_by(TILE as usize) {
@@ -439,11 +518,31 @@ pub fn render_scene_into<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
                 }
                 outcomes.clear();
                 outcomes.resize(rays.len(), TraceOutcome::Miss { tets_visited: 0 });
+                let clock = Instant::now();
                 view.trace_batch(tracer, &rays, &mut outcomes);
+                let clock = lap(clock, &mut stats.primary_trace_ms);
+                let (ao_rays, ao_tets) =
+                    ao.trace(tracer, mesh, &rays, &outcomes, &ids, ao_len, opts);
+                stats.ao_rays += ao_rays;
+                stats.ao_tets_visited += ao_tets;
+                let clock = lap(clock, &mut stats.ao_trace_ms);
                 shadows.trace(shadow, mesh, &rays, &outcomes, &frame_lights, opts);
+                lap(clock, &mut stats.shadow_trace_ms);
                 for (at, ((ray, o), &k)) in rays.iter().zip(&outcomes).zip(&ids).enumerate() {
                     let found = shadows.of(at);
-                    let p = shade(shadow, mesh, ray, o, k, &frame_lights, found, opts);
+                    let occlusion = ao.of(at);
+                    stats.ao_failures += (occlusion == Ao::Failed) as u64;
+                    let p = shade(
+                        shadow,
+                        mesh,
+                        ray,
+                        o,
+                        k,
+                        &frame_lights,
+                        (found, occlusion),
+                        opts,
+                    );
+                    stats.shadow_trace_ms += p.area_ms;
                     let local = k as usize - (y0 * w) as usize;
                     color[local] = p.color;
                     tets[local] = p.tets;
@@ -458,18 +557,17 @@ pub fn render_scene_into<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
             }
             stats
         })
-        .reduce(FrameStats::default, |a, b| FrameStats {
-            ms: 0.0,
-            rays: a.rays + b.rays,
-            hits: a.hits + b.hits,
-            tets_visited: a.tets_visited + b.tets_visited,
-            failures: a.failures + b.failures,
-            shadow_rays: a.shadow_rays + b.shadow_rays,
-            shadow_failures: a.shadow_failures + b.shadow_failures,
-        });
+        .reduce(FrameStats::default, FrameStats::sum);
     frame.stats = stats;
     frame.stats.ms = t0.elapsed().as_secs_f64() * 1e3;
     Ok(())
+}
+
+/// Adds the time since `clock` to `ms` and returns the time now.
+fn lap(clock: Instant, ms: &mut f64) -> Instant {
+    let now = Instant::now();
+    *ms += (now - clock).as_secs_f64() * 1e3;
+    now
 }
 
 /// Per-pixel seed of the area-light jitter: the frame seed mixed with the
@@ -481,124 +579,10 @@ fn pixel_seed(seed: u64, pixel: u32) -> u64 {
     z ^ (z >> 31)
 }
 
-/// What the shadow ray of a pixel toward one point light found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Shadow {
-    /// No ray cast: shadows off, no hit, or the light behind the surface.
-    NotCast,
-    /// Unoccluded: the walk reached the light (or left the mesh), or no
-    /// tet lies on the light's side of the hit face (no ray to walk).
-    Lit,
-    /// A constrained face lies between the hit point and the light.
-    Occluded,
-    /// The walk failed (the pixel counts as lit).
-    Failed,
-}
-
-/// The Lambert cosine of point light `light` at surface point `p` with
-/// normal `n` (0 when the light is behind the surface).
-fn light_cos(n: Vec3, p: Vec3, light: &PointLight) -> f32 {
-    let l = (light.position - p).normalize_or_zero();
-    n.dot(l).clamp(0.0, 1.0)
-}
-
-/// The shadow rays of one tile toward one point light, in one batch.
-#[derive(Default)]
-struct LightRays {
-    rays: Vec<Ray>,
-    starts: Vec<Start>,
-    /// The tile pixel of each ray.
-    pixels: Vec<usize>,
-    out: Vec<TraceOutcome>,
-}
-
-/// A tile's shadow rays toward the point lights: the rays `shade` casts
-/// (one per hit pixel and light in front of its surface, from
-/// [`shadow_ray`]), traced light by light in one batch each
-/// ([`ShadowTracer::trace_until_batch`]: a tet kernel walks them side by
-/// side, as it walks the primary rays), and what each found. The buffers
-/// are reused from tile to tile.
-#[derive(Default)]
-struct TileShadows {
-    per_light: Vec<LightRays>,
-    /// `found[pixel · lights + light]`.
-    found: Vec<Shadow>,
-    lights: usize,
-}
-
-impl TileShadows {
-    /// Casts and traces the shadow rays of the tile whose primary `rays`
-    /// had `outcomes` (nothing without [`RenderOptions::shadows`], or with
-    /// [`RenderOptions::headlight`]).
-    fn trace<S: ShadowTracer + ?Sized>(
-        &mut self,
-        shadow: &S,
-        mesh: &TetMesh,
-        rays: &[Ray],
-        outcomes: &[TraceOutcome],
-        lights: &FrameLights<'_>,
-        opts: &RenderOptions,
-    ) {
-        let nl = lights.points.len();
-        self.lights = nl;
-        self.found.clear();
-        self.found.resize(rays.len() * nl, Shadow::NotCast);
-        if !opts.shadows || opts.headlight || nl == 0 {
-            return;
-        }
-        self.per_light.resize_with(nl, LightRays::default);
-        for batch in &mut self.per_light {
-            batch.rays.clear();
-            batch.starts.clear();
-            batch.pixels.clear();
-        }
-        for (k, (ray, o)) in rays.iter().zip(outcomes).enumerate() {
-            let TraceOutcome::Hit(hit) = o else {
-                continue;
-            };
-            let n = shading_normal(mesh, hit);
-            let p = ray.at(hit.t);
-            for (li, (light, _)) in lights.points.iter().enumerate() {
-                if light_cos(n, p, light) <= 0.0 {
-                    continue;
-                }
-                match shadow_ray(mesh, hit, light.position) {
-                    Some((r, s)) => {
-                        let batch = &mut self.per_light[li];
-                        batch.rays.push(r);
-                        batch.starts.push(s);
-                        batch.pixels.push(k);
-                    }
-                    None => self.found[k * nl + li] = Shadow::Lit,
-                }
-            }
-        }
-        for (li, ((_, target), batch)) in lights.points.iter().zip(&mut self.per_light).enumerate()
-        {
-            batch.out.clear();
-            batch
-                .out
-                .resize(batch.rays.len(), TraceOutcome::Miss { tets_visited: 0 });
-            shadow.trace_until_batch(&batch.rays, &batch.starts, target.tets(), &mut batch.out);
-            for (&k, o) in batch.pixels.iter().zip(&batch.out) {
-                self.found[k * nl + li] = match o {
-                    TraceOutcome::Hit(_) => Shadow::Occluded,
-                    TraceOutcome::Failed { .. } => Shadow::Failed,
-                    TraceOutcome::Miss { .. } => Shadow::Lit,
-                };
-            }
-        }
-    }
-
-    /// What tile pixel `k`'s shadow rays found, light by light.
-    fn of(&self, k: usize) -> &[Shadow] {
-        &self.found[k * self.lights..(k + 1) * self.lights]
-    }
-}
-
 /// Shades one pixel: its primary ray's outcome `out`, with `found` the
-/// outcomes of its shadow rays toward the point lights ([`TileShadows`]);
-/// area lights sample their shadow rays here, one by one.
+/// outcomes of its shadow rays toward the point lights ([`TileShadows`])
+/// and of its AO ray ([`TileAo`]); area lights sample their shadow rays
+/// here, one by one.
 #[allow(clippy::too_many_arguments)]
 fn shade<S: ShadowTracer + ?Sized>(
     shadow: &S,
@@ -607,7 +591,7 @@ fn shade<S: ShadowTracer + ?Sized>(
     out: &TraceOutcome,
     pixel: u32,
     lights: &FrameLights<'_>,
-    found: &[Shadow],
+    (found, occlusion): (&[Shadow], Ao),
     opts: &RenderOptions,
 ) -> Pixel {
     let mut px = Pixel {
@@ -618,6 +602,7 @@ fn shade<S: ShadowTracer + ?Sized>(
         failed: out.is_failure(),
         shadow_rays: 0,
         shadow_failures: 0,
+        area_ms: 0.0,
     };
     let TraceOutcome::Hit(hit) = out else {
         return px;
@@ -651,6 +636,7 @@ fn shade<S: ShadowTracer + ?Sized>(
         }
         c += light.color * light.intensity * cos;
     }
+    let clock = (opts.shadows && !lights.areas.is_empty()).then(Instant::now);
     for (k, light) in lights.areas.iter().enumerate() {
         let seed = pixel_seed(
             opts.seed ^ (k as u64).wrapping_mul(0xD6E8_FEB8_6659_FD93),
@@ -664,6 +650,12 @@ fn shade<S: ShadowTracer + ?Sized>(
         px.shadow_rays += e.rays;
         px.shadow_failures += e.failures;
         c += e.irradiance * std::f32::consts::FRAC_1_PI;
+    }
+    if let Some(clock) = clock {
+        lap(clock, &mut px.area_ms);
+    }
+    if matches!(occlusion, Ao::Open | Ao::Failed) {
+        c += Vec3::splat(AO_AMBIENT);
     }
     px.color = c;
     px
