@@ -283,9 +283,9 @@ fn parse_switches(s: &str) -> Option<TetgenOptions> {
 /// Runs TetGen in a child process (input already checked by the caller).
 ///
 /// With `TET_WORKER_KEEP=DIR` in the environment, a request that runs past
-/// its time limit is kept as `DIR/timeout-PID.req`, so that a stuck run
-/// can be replayed on its own (`tet-bench tetgen-worker < FILE`) and
-/// reported.
+/// its time limit is kept as `DIR/timeout-PID.req`, and one whose worker
+/// dies (a crash in TetGen) as `DIR/crash-PID.req`, so that the run can be
+/// replayed on its own (`tet-bench tetgen-worker < FILE`) and reported.
 pub fn run_worker(
     cmd: &WorkerCommand,
     input: &TetgenInput,
@@ -362,6 +362,10 @@ pub fn run_worker(
         .map_err(|e| io_err("read reply", e))?;
     let stderr_tail = String::from_utf8_lossy(&err_reader.join().unwrap_or_default()).into_owned();
     if !status.success() || reply.len() < REPLY_MAGIC.len() {
+        if let Some((dir, request)) = &keep {
+            let path = std::path::Path::new(dir).join(format!("crash-{}.req", child.id()));
+            let _ = std::fs::write(&path, request);
+        }
         return Err(TetgenError::WorkerDied {
             status: status.to_string(),
             stderr: stderr_tail
