@@ -514,6 +514,18 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
     for r in sc[0]["renders"].as_array().unwrap() {
         assert_eq!(r["nodes_per_ray"].is_null(), r["method"] != "obvhs", "{r}");
     }
+    // Secondary rays on the first scene only (quick): every method casts
+    // the same AO rays, one per hit at most, and its shadow rays.
+    let secondary = sc[0]["secondary"].as_array().unwrap();
+    assert!(secondary.len() >= 3, "{secondary:?}");
+    for r in secondary {
+        assert_eq!(r["rays_kind"], "mixed", "{r}");
+        let ao = &r["by_kind"]["ao"]["rays"];
+        assert_eq!(ao, &secondary[0]["by_kind"]["ao"]["rays"], "{r}");
+        assert!(ao.as_u64().unwrap() <= r["hits"].as_u64().unwrap(), "{r}");
+    }
+    assert!(secondary[0]["by_kind"]["ao"]["rays"].as_u64().unwrap() > 0);
+    assert!(sc[1]["secondary"].as_array().unwrap().is_empty());
     // The build-choice tables time the default mesh again beside the
     // variant: the same mesh and rays as the render table's tet20 row.
     for s in sc {

@@ -51,6 +51,10 @@ pub struct SceneResult {
     pub bvh_build_s: Option<f64>,
     /// One row per method.
     pub renders: Vec<RenderDoc>,
+    /// Primary, AO and shadow rays (`render --rays mixed`) of tet20,
+    /// tet16, obvhs and Embree where built with it: every scene in the full
+    /// run, the first in the quick one.
+    pub secondary: Vec<RenderDoc>,
     /// tet20 on the unsorted (TetGen order) mesh, for Figure 8.
     pub unsorted_tet20: Option<RenderDoc>,
     /// tet20 on the default (Hilbert-sorted) mesh, timed in alternating

@@ -60,6 +60,7 @@ mod quality;
 mod render_speed;
 mod report;
 mod robustness;
+mod secondary;
 mod sorting;
 mod speed_accuracy;
 mod strips_vs_bvh;
@@ -115,6 +116,12 @@ fn measure_scene(
     let (info, bvh_build_s) = construction::measure(&loaded)?;
     let renders = render_speed::measure(spec, &loaded, opts, frames, pool)?;
     let ray_strips = Some(strips_vs_bvh::measure(spec, &loaded, opts, frames, pool)?);
+    // Secondary rays: every scene in the full run, the first in the quick.
+    let secondary = if args.quick && !planned.first {
+        Vec::new()
+    } else {
+        secondary::measure(spec, &loaded, opts, frames, pool)?
+    };
     let accuracy = robustness::measure(
         spec,
         &loaded,
@@ -197,6 +204,7 @@ fn measure_scene(
         info: Some(info),
         bvh_build_s: Some(bvh_build_s),
         renders,
+        secondary,
         unsorted_tet20,
         sorted_tet20,
         wide_box_tet20,
@@ -260,6 +268,7 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
                     info: None,
                     bvh_build_s: None,
                     renders: Vec::new(),
+                    secondary: Vec::new(),
                     unsorted_tet20: None,
                     sorted_tet20: None,
                     wide_box_tet20: None,

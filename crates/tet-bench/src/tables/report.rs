@@ -11,8 +11,8 @@ use anyhow::{Context, Result};
 use super::doc::TablesDoc;
 use super::{
     construction, entry, exit_face, gpu, isosurfaces, large_models, memory, out_of_core,
-    out_of_core_large, quality, render_speed, robustness, sorting, speed_accuracy, strips_vs_bvh,
-    zoom,
+    out_of_core_large, quality, render_speed, robustness, secondary, sorting, speed_accuracy,
+    strips_vs_bvh, zoom,
 };
 
 /// The Markdown report (`tables.md`, and stdout without `--json`).
@@ -53,6 +53,7 @@ pub fn markdown(doc: &TablesDoc) -> String {
 
     construction::markdown(&mut m, doc);
     render_speed::markdown(&mut m, doc);
+    secondary::markdown(&mut m, doc);
     memory::markdown(&mut m, doc);
     strips_vs_bvh::markdown(&mut m, doc);
     sorting::markdown(&mut m, doc);
