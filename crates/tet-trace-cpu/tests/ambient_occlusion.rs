@@ -215,11 +215,7 @@ fn renders_with_ao_add_the_ambient_term_where_the_ray_is_open() {
                 "{}",
                 t.name()
             );
-            let s = (with.stats, alone.stats);
-            assert_eq!(
-                (s.0.ao_rays, s.0.ao_failures, s.0.ao_tets_visited),
-                (s.1.ao_rays, s.1.ao_failures, s.1.ao_tets_visited)
-            );
+            assert_eq!(with.stats.counts(), alone.stats.counts(), "{}", t.name());
             let without = render(t, &cam, &lights, &plain).unwrap();
             assert_eq!(without.stats.ao_rays, 0);
             let (mut open, mut cast) = (0, 0);

@@ -225,6 +225,19 @@ impl FrameStats {
         rays as f64 * threads.max(1) as f64 / (trace_ms * 1e3)
     }
 
+    /// These statistics with every time set to 0: the counts, which two
+    /// renders of the same frame share exactly (tracing ray by ray or in
+    /// batches, on any machine).
+    pub fn counts(self) -> FrameStats {
+        FrameStats {
+            ms: 0.0,
+            primary_trace_ms: 0.0,
+            ao_trace_ms: 0.0,
+            shadow_trace_ms: 0.0,
+            ..self
+        }
+    }
+
     /// Every count and time of two parts of a frame together (`ms` is
     /// the frame's, set apart).
     fn sum(self, b: FrameStats) -> FrameStats {
