@@ -514,8 +514,8 @@ fn tables_share_meshes_and_draw_one_mark_per_data_point() {
     for r in sc[0]["renders"].as_array().unwrap() {
         assert_eq!(r["nodes_per_ray"].is_null(), r["method"] != "obvhs", "{r}");
     }
-    // Secondary rays on the first scene only (quick): every method casts
-    // the same AO rays, one per hit at most, and its shadow rays.
+    // Secondary rays (quick: not on a scene sharing an earlier scene's
+    // mesh): every method casts the same AO rays, one per hit at most.
     let secondary = sc[0]["secondary"].as_array().unwrap();
     assert!(secondary.len() >= 3, "{secondary:?}");
     for r in secondary {

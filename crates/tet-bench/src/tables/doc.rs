@@ -53,7 +53,8 @@ pub struct SceneResult {
     pub renders: Vec<RenderDoc>,
     /// Primary, AO and shadow rays (`render --rays mixed`) of tet20,
     /// tet16, obvhs and Embree where built with it: every scene in the full
-    /// run, the first in the quick one.
+    /// run; in the quick one, none for a scene sharing an earlier scene's
+    /// mesh.
     pub secondary: Vec<RenderDoc>,
     /// tet20 on the unsorted (TetGen order) mesh, for Figure 8.
     pub unsorted_tet20: Option<RenderDoc>,

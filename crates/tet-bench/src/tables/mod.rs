@@ -116,7 +116,8 @@ fn measure_scene(
     let (info, bvh_build_s) = construction::measure(&loaded)?;
     let renders = render_speed::measure(spec, &loaded, opts, frames, pool)?;
     let ray_strips = Some(strips_vs_bvh::measure(spec, &loaded, opts, frames, pool)?);
-    // Secondary rays: every scene in the full run, the first in the quick.
+    // Secondary rays: every scene in the full run; in the quick one, one
+    // scene per mesh (not the scenes sharing an earlier scene's mesh).
     let secondary = if args.quick && !planned.first {
         Vec::new()
     } else {
