@@ -79,7 +79,7 @@ impl<'m, L: Topology, P: Projection> WalkTracer<'m, L, P> {
     where
         P: BatchWalk,
     {
-        let n = rays.len().min(starts.len()).min(out.len());
+        let n = Starts::Each(starts).batch_len(rays.len(), out.len());
         let (rays, starts, out) = (&rays[..n], &starts[..n], &mut out[..n]);
         // The step cap of `Tracer::trace_until`: the mesh's default.
         let cap = step_cap(self.mesh);

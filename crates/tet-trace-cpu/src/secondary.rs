@@ -391,7 +391,7 @@ impl ShadowTracer for MeshWalker<'_> {
         stop: &[u32],
         out: &mut [TraceOutcome],
     ) {
-        let n = rays.len().min(starts.len()).min(out.len());
+        let n = Starts::Each(starts).batch_len(rays.len(), out.len());
         let topo = MeshTopology(self.mesh);
         let batch = Batch {
             mesh: self.mesh,

@@ -525,7 +525,7 @@ impl<const CONSISTENT: bool> Tet80Tracer<'_, CONSISTENT> {
         out: &mut [TraceOutcome],
         width: Width,
     ) -> bool {
-        let n = rays.len().min(starts.len()).min(out.len());
+        let n = Starts::Each(starts).batch_len(rays.len(), out.len());
         let (rays, starts, out) = (&rays[..n], &starts[..n], &mut out[..n]);
         let batch = self.batch(rays, Starts::Each(starts), out);
         let ran = shadow_batch::plucker(batch, stop, width);

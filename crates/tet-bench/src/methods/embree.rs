@@ -215,8 +215,7 @@ impl Tracer for EmbreeTracer<'_> {
         _stop: &[u32],
         out: &mut [TraceOutcome],
     ) {
-        let n = rays.len().min(starts.len()).min(out.len());
-        self.trace_each(&rays[..n], &starts[..n], &mut out[..n]);
+        self.trace_each(rays, starts, out);
     }
 
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
@@ -239,10 +238,12 @@ impl Tracer for EmbreeTracer<'_> {
 }
 
 impl EmbreeTracer<'_> {
-    /// Rays with a start each (a tile's secondary rays): single rays, or
-    /// packets for `embree8`; a ray that starts on a face never reports
-    /// that face's input triangle.
+    /// Rays with a start each (a tile's secondary rays), over the shortest
+    /// of the three slices: single rays, or packets for `embree8`; a ray
+    /// that starts on a face never reports that face's input triangle.
     fn trace_each(&self, rays: &[Ray], starts: &[Start], out: &mut [TraceOutcome]) {
+        let n = tet_trace_cpu::Starts::Each(starts).batch_len(rays.len(), out.len());
+        let (rays, starts, out) = (&rays[..n], &starts[..n], &mut out[..n]);
         let skip = |i: usize| {
             starts[i]
                 .on_face()

@@ -306,6 +306,13 @@ pub fn run_worker(
     let switches = options.switches();
     let request = encode_request(input, &switches);
     let keep = std::env::var_os("TET_WORKER_KEEP").map(|d| (d, request.clone()));
+    // Keeps the request as `DIR/{what}-PID.req` (see above).
+    let keep_as = |what: &str, pid: u32| {
+        if let Some((dir, request)) = &keep {
+            let path = std::path::Path::new(dir).join(format!("{what}-{pid}.req"));
+            let _ = std::fs::write(&path, request);
+        }
+    };
     let writer = std::thread::spawn(move || -> io::Result<()> {
         stdin.write_all(&request)?;
         stdin.flush()
@@ -344,10 +351,7 @@ pub fn run_worker(
             let _ = writer.join();
             let _ = reader.join();
             let _ = err_reader.join();
-            if let Some((dir, request)) = &keep {
-                let path = std::path::Path::new(dir).join(format!("timeout-{}.req", child.id()));
-                let _ = std::fs::write(&path, request);
-            }
+            keep_as("timeout", child.id());
             return Err(TetgenError::Timeout {
                 seconds: limit.as_secs_f64(),
             });
@@ -362,10 +366,7 @@ pub fn run_worker(
         .map_err(|e| io_err("read reply", e))?;
     let stderr_tail = String::from_utf8_lossy(&err_reader.join().unwrap_or_default()).into_owned();
     if !status.success() || reply.len() < REPLY_MAGIC.len() {
-        if let Some((dir, request)) = &keep {
-            let path = std::path::Path::new(dir).join(format!("crash-{}.req", child.id()));
-            let _ = std::fs::write(&path, request);
-        }
+        keep_as("crash", child.id());
         return Err(TetgenError::WorkerDied {
             status: status.to_string(),
             stderr: stderr_tail

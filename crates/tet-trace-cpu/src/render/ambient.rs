@@ -18,7 +18,7 @@ use glam::Vec3;
 use tet_core::TetMesh;
 use tet_core::synthetic::SplitMix64;
 
-use super::RenderOptions;
+use super::{FrameStats, RenderOptions};
 use crate::kernel::Tracer;
 use crate::ray::{Hit, Ray, TraceOutcome};
 use crate::secondary::{face_normal, hit_point, start_beyond};
@@ -127,8 +127,9 @@ impl TileAo {
     /// Casts and traces the AO rays of the tile whose primary `rays` (of
     /// image pixels `ids`) had `outcomes`; nothing without
     /// [`RenderOptions::ambient_occlusion`] or with
-    /// [`RenderOptions::headlight`]. Returns the rays cast and the tets
-    /// their walks visited (0 for a tracer without tets).
+    /// [`RenderOptions::headlight`]. Adds the rays cast, the tets their
+    /// walks visited (0 for a tracer without tets) and their failures to
+    /// `stats`.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn trace<T: Tracer + ?Sized>(
         &mut self,
@@ -139,14 +140,15 @@ impl TileAo {
         ids: &[u32],
         length: f32,
         opts: &RenderOptions,
-    ) -> (u64, u64) {
+        stats: &mut FrameStats,
+    ) {
         self.found.clear();
         self.found.resize(rays.len(), Ao::Off);
         self.rays.clear();
         self.starts.clear();
         self.pixels.clear();
         if !opts.ambient_occlusion || opts.headlight {
-            return (0, 0);
+            return;
         }
         for (k, ((ray, o), &id)) in rays.iter().zip(outcomes).zip(ids).enumerate() {
             let TraceOutcome::Hit(hit) = o else {
@@ -165,16 +167,16 @@ impl TileAo {
         self.out
             .resize(self.rays.len(), TraceOutcome::Miss { tets_visited: 0 });
         tracer.trace_batch_from(&self.rays, Starts::Each(&self.starts), &mut self.out);
-        let mut tets = 0;
+        stats.ao_rays += self.rays.len() as u64;
         for (&k, o) in self.pixels.iter().zip(&self.out) {
-            tets += o.tets_visited() as u64;
+            stats.ao_tets_visited += o.tets_visited() as u64;
+            stats.ao_failures += o.is_failure() as u64;
             self.found[k] = match o {
                 TraceOutcome::Hit(_) => Ao::Occluded,
                 TraceOutcome::Failed { .. } => Ao::Failed,
                 TraceOutcome::Miss { .. } => Ao::Open,
             };
         }
-        (self.rays.len() as u64, tets)
     }
 
     /// What tile pixel `k`'s AO ray found.

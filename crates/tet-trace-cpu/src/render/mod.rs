@@ -534,17 +534,15 @@ pub fn render_scene_into<T: Tracer + ?Sized, S: ShadowTracer + ?Sized>(
                 let clock = Instant::now();
                 view.trace_batch(tracer, &rays, &mut outcomes);
                 let clock = lap(clock, &mut stats.primary_trace_ms);
-                let (ao_rays, ao_tets) =
-                    ao.trace(tracer, mesh, &rays, &outcomes, &ids, ao_len, opts);
-                stats.ao_rays += ao_rays;
-                stats.ao_tets_visited += ao_tets;
+                ao.trace(
+                    tracer, mesh, &rays, &outcomes, &ids, ao_len, opts, &mut stats,
+                );
                 let clock = lap(clock, &mut stats.ao_trace_ms);
                 shadows.trace(shadow, mesh, &rays, &outcomes, &frame_lights, opts);
                 lap(clock, &mut stats.shadow_trace_ms);
                 for (at, ((ray, o), &k)) in rays.iter().zip(&outcomes).zip(&ids).enumerate() {
                     let found = shadows.of(at);
                     let occlusion = ao.of(at);
-                    stats.ao_failures += (occlusion == Ao::Failed) as u64;
                     let p = shade(
                         shadow,
                         mesh,
