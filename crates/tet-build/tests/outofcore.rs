@@ -1594,3 +1594,63 @@ fn first_run_fails_then_walls_move(first: &str) {
     assert_ne!(plan.cuts, CutTree::from_split_tree(&plan.plan));
     check_against_in_core(&scene, &mesh);
 }
+
+/// A retry runs TetGen only on the parts whose input the moved walls
+/// changed, and merges the very mesh a fresh build of the final planes
+/// gives. The worker crashes on its sixth run (five parts finished, of
+/// eight); the parts whose PLC the moved walls left as they were come
+/// back from the first attempt.
+#[cfg(unix)]
+#[test]
+fn a_retry_rebuilds_only_the_parts_whose_input_changed() {
+    use std::os::unix::fs::PermissionsExt;
+    use tet_build::outofcore::tree::build_tree_with_memory_limit;
+
+    let dir = tempfile::tempdir().unwrap();
+    let (script, runs) = (dir.path().join("crashes-once.sh"), dir.path().join("runs"));
+    std::fs::write(
+        &script,
+        format!(
+            "#!/bin/sh\necho run >> '{runs}'\n\
+             if [ \"$(wc -l < '{runs}')\" -eq 6 ]; then cat >/dev/null; kill -SEGV $$; fi\n\
+             exec '{worker}' \"$@\"\n",
+            runs = runs.display(),
+            worker = env!("CARGO_BIN_EXE_tet-build-worker"),
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let worker = |program: std::path::PathBuf| SeamOptions {
+        isolation: Isolation::Worker(WorkerCommand {
+            program,
+            args: vec![],
+            timeout: Some(Duration::from_secs(30)),
+        }),
+        parallel_parts: 1,
+        ..SeamOptions::default()
+    };
+    let scene = knot_grid(1, 120, 12);
+    let split = SplitOptions {
+        limit_bytes: u64::MAX,
+        min_depth: 3,
+        ..SplitOptions::default()
+    };
+    let (mesh, report, plan) =
+        build_tree_with_memory_limit(&scene, &split, &worker(script)).unwrap();
+    let runs = std::fs::read_to_string(&runs).unwrap().lines().count();
+    assert_eq!(plan.plane_moves, 1, "one crash, one move");
+    assert_eq!(report.part_tets.len(), 8);
+    eprintln!("{runs} worker runs, {} parts reused", report.parts_reused);
+    assert!(
+        (1..=5).contains(&report.parts_reused),
+        "{} parts reused",
+        report.parts_reused
+    );
+    // Every part ran at least once per attempt it was not reused in.
+    assert!(runs >= 6 + 8 - report.parts_reused, "{runs} runs");
+    let real = std::path::PathBuf::from(env!("CARGO_BIN_EXE_tet-build-worker"));
+    let (fresh, fresh_report) = build_tree(&scene, &plan.cuts, &worker(real)).unwrap();
+    assert_eq!(fresh_report.parts_reused, 0);
+    assert!(mesh == fresh, "the retry's mesh is not the fresh build's");
+    check_against_in_core(&scene, &mesh);
+}

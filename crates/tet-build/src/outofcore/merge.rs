@@ -9,6 +9,7 @@ use glam::Vec3;
 use tet_core::{TetMesh, face_key};
 
 use super::error::SeamError;
+use super::part_cache::PartCache;
 use super::parts::{PartFacets, PartMesh, PartStats, SeamOptions, SeamReport, run_parts};
 use super::plane::{SplitPlane, key};
 
@@ -59,21 +60,24 @@ pub(super) trait Merge: Sync {
 }
 
 /// Runs TetGen on every part ([`run_parts`]), hands each finished part to
-/// `merge`, fills the per-part fields of `report` and merges.
+/// `merge`, fills the per-part fields of `report` and merges. With a
+/// `cache`, parts whose PLC it kept from an earlier attempt are not run
+/// again, and on failure the finished parts are kept there.
 pub(super) fn finish_parts<M: Merge>(
     inputs: PartInputs<'_>,
     mut report: SeamReport,
     options: &SeamOptions,
     merge: &M,
+    cache: Option<&PartCache<M::Part>>,
 ) -> Result<(M::Output, SeamReport), SeamError> {
     let ctx = MergeContext {
         triangle_source: &inputs.triangle_source,
         triangle_count: inputs.triangle_count,
         seams: &report.seams,
     };
-    let parts = run_parts(inputs.parts.as_ref(), options, &|k, mesh| {
-        merge.part(k, mesh, &ctx)
-    })?;
+    let finish = |k, mesh| merge.part(k, mesh, &ctx);
+    let parts = run_parts(inputs.parts.as_ref(), options, &finish, cache)?;
+    report.parts_reused = cache.map_or(0, PartCache::reused);
     let stats: Vec<PartStats> = parts.iter().map(M::stats).collect();
     let output = merge.merge(parts, &ctx)?;
     for s in &stats {

@@ -111,6 +111,7 @@ pub mod facet_faces;
 pub mod job;
 pub mod memory_model;
 mod merge;
+mod part_cache;
 mod parts;
 pub mod plane;
 mod prepare;

@@ -11,6 +11,7 @@ use super::admission::Admission;
 use super::error::SeamError;
 pub(super) use super::facet_faces::FacetKind;
 use super::facet_faces::{TetgenFaces, constrained_faces};
+use super::part_cache::{PartCache, PlcPrint};
 use super::plane::{SplitPlane, key};
 use crate::bbox::BoxSpec;
 use crate::pipeline::rounding::{
@@ -58,6 +59,9 @@ pub struct SeamReport {
     /// What resolving the whole scene's self-intersections did, before it
     /// was split (`None` when [`SeamOptions::resolve`] is off).
     pub resolve: Option<ResolveReport>,
+    /// Parts a retry took as an earlier attempt built them, their input
+    /// unchanged by the planes the retry moved (0 without a retry).
+    pub parts_reused: usize,
 }
 
 /// Options of [`build_slabs`](super::seam::build_slabs).
@@ -370,11 +374,14 @@ pub(super) fn self_intersection(
 /// start last), which keeps both threads busy when parts differ in size.
 /// Each part is handed to `finish` on its thread as soon as its TetGen
 /// run returns. Results are in part order; the first error (in part order)
-/// is returned.
+/// is returned. With a `cache`, a part whose PLC is one the cache kept is
+/// taken from it instead of run, and when a part fails, the parts
+/// finished are kept there for the next attempt ([`PartCache`]).
 pub(super) fn run_parts<T: Send>(
     parts: &dyn PartFacets,
     options: &SeamOptions,
     finish: &(dyn Fn(usize, PartMesh) -> Result<T, SeamError> + Sync),
+    cache: Option<&PartCache<T>>,
 ) -> Result<Vec<T>, SeamError> {
     use std::sync::Mutex;
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -382,8 +389,8 @@ pub(super) fn run_parts<T: Send>(
     let width = options.parallel_parts.max(1).min(count.max(1));
     let mut order: Vec<usize> = (0..count).collect();
     order.sort_by_key(|&k| std::cmp::Reverse(parts.size(k)));
-    let results: Vec<Mutex<Option<Result<T, SeamError>>>> =
-        (0..count).map(|_| Mutex::new(None)).collect();
+    type Finished<T> = Result<(Option<PlcPrint>, T), SeamError>;
+    let results: Vec<Mutex<Option<Finished<T>>>> = (0..count).map(|_| Mutex::new(None)).collect();
     let next = AtomicUsize::new(0);
     let failed = AtomicBool::new(false);
     let admission = Admission::new(options.tree_limit_bytes);
@@ -395,11 +402,18 @@ pub(super) fn run_parts<T: Send>(
             }
             let k = order[i];
             let r = parts.facets(k).and_then(|list| {
+                let print = cache.map(|_| PlcPrint::of(&list));
+                if let (Some(c), Some(p)) = (cache, print)
+                    && let Some(kept) = c.take(k, p)
+                {
+                    return Ok((print, kept));
+                }
                 let plc = PartPlc::new(&list.facets, &list.box_faces);
                 // Held until the part is handed on: this process's share
                 // of the result counts as long as the worker's.
                 let _ticket = admission.enter(plc.predicted_peak_bytes());
-                run_plc(k, &list.facets, plc, options).and_then(|m| finish(k, m))
+                let part = run_plc(k, &list.facets, plc, options).and_then(|m| finish(k, m))?;
+                Ok((print, part))
             });
             if r.is_err() {
                 failed.store(true, Ordering::Relaxed);
@@ -419,9 +433,9 @@ pub(super) fn run_parts<T: Send>(
     }
     let mut out = Vec::with_capacity(count);
     let mut first_error = None;
-    for r in results {
+    for (k, r) in results.into_iter().enumerate() {
         match r.into_inner().unwrap_or_else(|e| e.into_inner()) {
-            Some(Ok(m)) => out.push(m),
+            Some(Ok(m)) => out.push((k, m)),
             Some(Err(e)) => {
                 first_error.get_or_insert(e);
             }
@@ -429,7 +443,16 @@ pub(super) fn run_parts<T: Send>(
         }
     }
     match first_error {
-        Some(e) => Err(e),
-        None => Ok(out),
+        Some(e) => {
+            if let Some(c) = cache {
+                for (k, (print, part)) in out {
+                    if let Some(p) = print {
+                        c.keep(k, p, part);
+                    }
+                }
+            }
+            Err(e)
+        }
+        None => Ok(out.into_iter().map(|(_, (_, part))| part).collect()),
     }
 }

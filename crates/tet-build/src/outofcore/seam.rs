@@ -107,7 +107,7 @@ fn build_slabs_with<M: Merge>(
     merge: &M,
 ) -> Result<(M::Output, SeamReport), SeamError> {
     let (inputs, report) = slab_part_inputs(scene, axis, values, options)?;
-    finish_parts(inputs, report, options, merge)
+    finish_parts(inputs, report, options, merge, None)
 }
 
 /// Every slab's PLC of `scene` cut by the planes `x[axis] = values[i]`

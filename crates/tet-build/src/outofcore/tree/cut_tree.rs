@@ -81,7 +81,22 @@ impl CutTree {
 impl CutTree {
     /// Moves every plane equal to `plane` by `step` along its axis, if the
     /// moved plane stays strictly inside its part's box.
+    #[cfg(test)]
     pub(crate) fn nudge(&mut self, plane: SplitPlane, step: f32, lo: Vec3, hi: Vec3) -> bool {
+        self.move_plane(plane, lo, hi, &mut |p, _, _| Some(p.value + step))
+    }
+
+    /// Moves every plane equal to `plane` to the value `to` gives it (from
+    /// the plane and its node's box, `lo..hi` being the whole's box), if
+    /// the moved plane stays strictly inside its node's box and the planes
+    /// below it stay inside theirs. Whether any plane moved.
+    pub(crate) fn move_plane(
+        &mut self,
+        plane: SplitPlane,
+        lo: Vec3,
+        hi: Vec3,
+        to: &mut dyn FnMut(SplitPlane, Vec3, Vec3) -> Option<f32>,
+    ) -> bool {
         let CutTree::Split {
             plane: p,
             below,
@@ -92,8 +107,9 @@ impl CutTree {
         };
         let a = p.axis;
         let mut moved = false;
-        if *p == plane {
-            let v = p.value + step;
+        if *p == plane
+            && let Some(v) = to(*p, lo, hi)
+        {
             // The planes below and above must stay on their sides of it.
             let (mut below_hi, mut above_lo) = (hi, lo);
             below_hi[a] = v;
@@ -111,8 +127,8 @@ impl CutTree {
         let (mut mid_hi, mut mid_lo) = (hi, lo);
         mid_hi[a] = p.value;
         mid_lo[a] = p.value;
-        moved |= below.nudge(plane, step, lo, mid_hi);
-        moved |= above.nudge(plane, step, mid_lo, hi);
+        moved |= below.move_plane(plane, lo, mid_hi, to);
+        moved |= above.move_plane(plane, mid_lo, hi, to);
         moved
     }
 

@@ -46,13 +46,15 @@
 
 use tet_core::TetMesh;
 
+use self::clear::ClearPositions;
 use self::clip::{Cut, run_clipping};
 use self::leaf_parts::{LeafWalls, TreeWhole, leaf_faces, piece_facets};
 use self::walls::{prepare_walls, triangulate_wall};
 use super::error::SeamError;
 use super::merge::{InMemory, Merge, PartInputs, finish_parts};
+use super::part_cache::PartCache;
 use super::parts::{SeamOptions, SeamReport};
-use super::plane::key;
+use super::plane::{NEAR_PLANE, SplitPlane, key};
 use super::prepare::{Prepared, prepare};
 use super::split::SplitTree;
 use super::split_parts::{PartTriangles, SplitParts};
@@ -64,6 +66,7 @@ use crate::tetgen::TetgenError;
 
 pub use cut_tree::CutTree;
 
+mod clear;
 mod clip;
 mod cut_tree;
 mod geometry;
@@ -82,7 +85,7 @@ pub fn build_tree(
     tree: &CutTree,
     options: &SeamOptions,
 ) -> Result<(TetMesh, SeamReport), SeamError> {
-    build_tree_with(scene, tree, options, &InMemory)
+    build_tree_with(scene, tree, options, &InMemory, None)
 }
 
 /// [`build_tree`] with the parts written to part files as they finish and
@@ -96,18 +99,20 @@ pub fn build_tree_to_file(
     options: &SeamOptions,
     stream: &StreamOptions,
 ) -> Result<(StreamSummary, SeamReport), SeamError> {
-    build_tree_with(scene, tree, options, &ToFile::new(stream)?)
+    build_tree_with(scene, tree, options, &ToFile::new(stream)?, None)
 }
 
-/// [`build_tree`] with the parts finished and merged by `merge`.
+/// [`build_tree`] with the parts finished and merged by `merge`, and
+/// taken from `cache` where an earlier attempt built the same PLC.
 fn build_tree_with<M: Merge>(
     scene: &Scene,
     tree: &CutTree,
     options: &SeamOptions,
     merge: &M,
+    cache: Option<&PartCache<M::Part>>,
 ) -> Result<(M::Output, SeamReport), SeamError> {
     let (inputs, report) = tree_part_inputs(scene, tree, options)?;
-    finish_parts(inputs, report, options, merge)
+    finish_parts(inputs, report, options, merge, cache)
 }
 
 /// Every leaf's PLC of `scene` split by `tree` (see the module docs), in
@@ -239,10 +244,14 @@ pub const MAX_PART_MOVES: usize = 2;
 /// `split.limit_bytes`, then builds it ([`build_tree`]). A plane that
 /// meets a degenerate configuration only the build can see (a point made
 /// by an earlier cut within tolerance of it, [`SeamError::PlaneNearPoint`]
-/// or [`SeamError::DegenerateCut`]) is moved by 1/4096 of the box's
-/// extent and the build retried, at most [`MAX_PLANE_MOVES`] times; the
-/// walls of a part TetGen fails on or runs past its time limit on are
-/// moved likewise, at most [`MAX_PART_MOVES`] times.
+/// or [`SeamError::DegenerateCut`]) is moved to the nearest position
+/// clear of that point and of the scene's vertices in its box, and the
+/// build retried, at most [`MAX_PLANE_MOVES`] times; the walls of a part
+/// TetGen fails on or runs past its time limit on are moved by about
+/// 1/4096 of the box's extent (to the nearest clear position), at most
+/// [`MAX_PART_MOVES`] times. A retry runs TetGen only on the parts whose
+/// input the moves changed: the others are kept from the attempt before
+/// (see `part_cache`).
 pub fn build_tree_with_memory_limit(
     scene: &Scene,
     split: &super::split::SplitOptions,
@@ -269,8 +278,9 @@ fn build_tree_with_memory_limit_with<M: Merge>(
     options: &SeamOptions,
     merge: &M,
 ) -> Result<(M::Output, SeamReport, TreePlan), SeamError> {
+    let cache = PartCache::default();
     let ((output, report), plan) = plan_tree_with_moves(scene, split, options, |tree| {
-        build_tree_with(scene, tree, options, merge)
+        build_tree_with(scene, tree, options, merge, Some(&cache))
     })?;
     Ok((output, report, plan))
 }
@@ -311,6 +321,10 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
     plan.forget_triangles();
     drop(cleaned);
     let (mut moves, mut part_moves) = (0, 0);
+    let tolerance = NEAR_PLANE * (b.max - b.min).max_element() as f64;
+    let mut clear = ClearPositions::new(&scene.vertices, tolerance);
+    // A part's walls move by this much (to the nearest clear value).
+    let step = (b.max - b.min).max_element() as f64 / 4096.0;
     loop {
         match build(&tree) {
             Ok(output) => {
@@ -323,12 +337,20 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                     },
                 ));
             }
+            // The plane moves to the nearest value clear of the point and
+            // of every scene vertex in its box.
             Err(
-                e @ (SeamError::PlaneNearPoint { plane, .. }
-                | SeamError::DegenerateCut { plane, .. }),
+                e @ (SeamError::PlaneNearPoint { plane, point, .. }
+                | SeamError::DegenerateCut { plane, point, .. }),
             ) => {
-                let step = (b.max - b.min).max_element() / 4096.0;
-                if moves >= MAX_PLANE_MOVES || !tree.nudge(plane, step, b.min, b.max) {
+                clear.avoid(point);
+                // Where no gap is wide enough in the whole box (only the
+                // pieces crossing the node are checked), the fixed step.
+                let mut to = |p: SplitPlane, lo, hi| {
+                    let v = clear.value(p, lo, hi, p.value as f64);
+                    v.or(Some((p.value as f64 + step) as f32))
+                };
+                if moves >= MAX_PLANE_MOVES || !tree.move_plane(plane, b.min, b.max, &mut to) {
                     return Err(e);
                 }
                 moves += 1;
@@ -356,11 +378,14 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                 }
                 | SeamError::RoundingFlattens { part, .. }),
             ) => {
-                let step = (b.max - b.min).max_element() / 4096.0;
                 let walls = tree.leaf_walls(part).unwrap_or_default();
                 let mut moved = false;
+                let mut to = |p: SplitPlane, lo, hi| {
+                    let want = p.value as f64 + step;
+                    clear.value(p, lo, hi, want).or(Some(want as f32))
+                };
                 for plane in walls {
-                    moved |= tree.nudge(plane, step, b.min, b.max);
+                    moved |= tree.move_plane(plane, b.min, b.max, &mut to);
                 }
                 if part_moves >= MAX_PART_MOVES || !moved {
                     return Err(e);
