@@ -288,6 +288,9 @@ fn memory_limit_builds_in_parts_that_trace_like_the_in_core_mesh() {
     assert_eq!(m["own_bytes"].as_u64().unwrap(), builder);
     assert!(builder + at_once * (largest + largest / 4) <= limit, "{m}");
     assert!(m["tree_peak_kib"].as_u64().unwrap() * 1024 <= limit, "{m}");
+    // No retry on this scene: nothing moved, nothing reused.
+    assert_eq!(m["plane_moves"].as_u64(), Some(0), "{m}");
+    assert_eq!(m["parts_reused"].as_u64(), Some(0), "{m}");
     let part_tets: u64 = m["part_tets"]
         .as_array()
         .unwrap()

@@ -19,7 +19,7 @@ pub use crate::tracer::Tracer;
 pub use crate::walk::LANES;
 use crate::walk::{
     Batch, BoundaryEntry, EntryHint, Projection, Start, Starts, Topology, prefetch_index, step_cap,
-    trace, trace_interleaved, trace_until,
+    trace, trace_interleaved, trace_until, trace_within,
 };
 
 /// A projected-walk kernel: layout `L` (a [`Topology`]) walked with
@@ -90,6 +90,7 @@ impl<'m, L: Topology, P: Projection> WalkTracer<'m, L, P> {
             starts: Starts::Each(starts),
             cap,
             out: &mut *out,
+            bounded: false,
         };
         let ran = P::trace_until_batch(batch, stop, width);
         exact_where_lost(self.mesh, cap, rays, Starts::Each(starts), out);
@@ -111,6 +112,7 @@ impl<'m, L: Topology, P: Projection> WalkTracer<'m, L, P> {
             starts,
             cap: self.cap,
             out,
+            bounded: false,
         }
     }
 }
@@ -136,6 +138,23 @@ impl<L: Topology, P: BatchWalk> Tracer for WalkTracer<'_, L, P> {
         let n = starts.batch_len(rays.len(), out.len());
         let (rays, out) = (&rays[..n], &mut out[..n]);
         P::trace_batch(self.batch(rays, starts, out));
+        exact_where_lost(self.mesh, self.cap, rays, starts, out);
+    }
+    /// The bounded walk ([`trace_within`]), the exact walk where it
+    /// reaches the step cap.
+    fn trace_within(&self, ray: &Ray, start: Start) -> TraceOutcome {
+        let out = trace_within::<P, L>(self.mesh, &self.layout, ray, start, self.cap);
+        exact_if_lost(self.mesh, self.cap, ray, start, out)
+    }
+    /// In SIMD lockstep where the CPU has it, each walk bounded as
+    /// [`Tracer::trace_within`] bounds it.
+    fn trace_batch_within(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
+        let n = starts.batch_len(rays.len(), out.len());
+        let (rays, out) = (&rays[..n], &mut out[..n]);
+        P::trace_batch(Batch {
+            bounded: true,
+            ..self.batch(rays, starts, out)
+        });
         exact_where_lost(self.mesh, self.cap, rays, starts, out);
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
@@ -184,6 +203,19 @@ impl<L: Topology, P: BatchWalk> Tracer for Interleaved<'_, '_, L, P> {
         let w = self.0;
         let starts = Starts::Same(start);
         trace_interleaved::<P, L, LANES>(w.batch(rays, starts, out));
+        exact_where_lost(w.mesh, w.cap, rays, starts, out);
+    }
+    fn trace_within(&self, ray: &Ray, start: Start) -> TraceOutcome {
+        self.0.trace_within(ray, start)
+    }
+    fn trace_batch_within(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
+        let w = self.0;
+        let n = starts.batch_len(rays.len(), out.len());
+        let (rays, out) = (&rays[..n], &mut out[..n]);
+        trace_interleaved::<P, L, LANES>(Batch {
+            bounded: true,
+            ..w.batch(rays, starts, out)
+        });
         exact_where_lost(w.mesh, w.cap, rays, starts, out);
     }
 }

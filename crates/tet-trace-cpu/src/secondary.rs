@@ -400,6 +400,7 @@ impl ShadowTracer for MeshWalker<'_> {
             starts: Starts::Each(&starts[..n]),
             cap: self.cap,
             out: &mut out[..n],
+            bounded: false,
         };
         shadow_batch::interleaved::<DuffF32, _>(batch, stop);
     }

@@ -92,6 +92,7 @@ where
         starts,
         cap,
         out,
+        bounded,
     } = batch;
     let mut gate = StopGate {
         stop,
@@ -105,6 +106,8 @@ where
         starts,
         cap,
         out: &mut *out,
+        // The gate's handover does not carry a bound.
+        bounded: false,
     };
     if lockstep::trace::<G, T, _>(inner, width, &mut gate).is_err() {
         // Nothing traced: the same batch, given back whole.
@@ -115,6 +118,7 @@ where
             starts,
             cap,
             out,
+            bounded,
         });
     }
     for (i, o) in gate.ended {
@@ -193,6 +197,7 @@ fn without_stopped_starts<T: ?Sized>(
         starts,
         cap,
         out,
+        bounded,
     } = batch;
     let n = starts.batch_len(rays.len(), out.len());
     let (rays, out) = (&rays[..n], &mut out[..n]);
@@ -206,6 +211,7 @@ fn without_stopped_starts<T: ?Sized>(
             starts,
             cap,
             out,
+            bounded,
         });
     }
     let mut keep = Vec::with_capacity(n);
@@ -227,6 +233,7 @@ fn without_stopped_starts<T: ?Sized>(
         starts: Starts::Each(&sub_starts),
         cap,
         out: &mut sub_out,
+        bounded,
     });
     for (&i, o) in keep.iter().zip(sub_out) {
         out[i] = o;
@@ -257,6 +264,7 @@ fn walk_interleaved<P: Projection, T: Topology>(batch: Batch<'_, T>, stop: &[u32
         starts: batch.starts,
         cap: batch.cap,
         out: batch.out,
+        bounded: batch.bounded,
     });
 }
 
@@ -342,6 +350,7 @@ pub(crate) fn plucker<W: PluckerUntil>(batch: Batch<'_, W>, stop: &[u32], width:
         starts,
         cap,
         out,
+        bounded,
     } = batch;
     let until = Until { walk: topo, stop };
     let batch = Batch {
@@ -351,6 +360,7 @@ pub(crate) fn plucker<W: PluckerUntil>(batch: Batch<'_, W>, stop: &[u32], width:
         starts,
         cap,
         out,
+        bounded,
     };
     gated::<Plucker, _>(batch, stop, width, |b| plucker_end(b, cap)).is_ok()
 }

@@ -223,6 +223,7 @@ impl<'m, const CONSISTENT: bool> Tet80Tracer<'m, CONSISTENT> {
             starts,
             cap: self.cap,
             out,
+            bounded: false,
         }
     }
 

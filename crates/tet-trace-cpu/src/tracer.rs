@@ -45,6 +45,24 @@ pub trait Tracer: Sync {
         }
     }
 
+    /// [`Tracer::trace`] for a ray that only asks what lies within its
+    /// `t_max` (an ambient-occlusion ray): a tet walk may end as a miss
+    /// as soon as it is past `t_max` ([`crate::walk::trace_within`]). The
+    /// same hit or miss as [`Tracer::trace`] (a walk that would fail
+    /// past `t_max` may end as a miss instead), in fewer tets; the
+    /// default is [`Tracer::trace`].
+    fn trace_within(&self, ray: &Ray, start: Start) -> TraceOutcome {
+        self.trace(ray, start)
+    }
+
+    /// [`Tracer::trace_batch_from`] of rays that only ask what lies within
+    /// their `t_max`: the results equal [`Tracer::trace_within`] ray by
+    /// ray. The default is [`Tracer::trace_batch_from`] (right for a
+    /// tracer whose [`Tracer::trace_within`] is [`Tracer::trace`]).
+    fn trace_batch_within(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
+        self.trace_batch_from(rays, starts, out)
+    }
+
     /// How a ray whose origin lies outside the mesh begins (see
     /// [`BoundaryEntry::start_with`]): the entering boundary face decided
     /// with this tracer's own edge test, so that entry and walk agree on

@@ -38,6 +38,17 @@ impl Tracer for OneByOne<'_> {
     fn trace(&self, ray: &Ray, start: Start) -> TraceOutcome {
         self.0.trace(ray, start)
     }
+    fn trace_within(&self, ray: &Ray, start: Start) -> TraceOutcome {
+        self.0.trace_within(ray, start)
+    }
+    fn trace_batch_within(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
+        let Starts::Each(s) = starts else {
+            unreachable!("AO rays start on their faces")
+        };
+        for ((r, &s), o) in rays.iter().zip(s).zip(out.iter_mut()) {
+            *o = self.0.trace_within(r, s);
+        }
+    }
     fn start_outside(
         &self,
         entry: &BoundaryEntry,
@@ -108,7 +119,8 @@ fn ao_directions_are_cosine_distributed() {
 
 /// Every kernel's AO verdicts, batched per tile as a render traces them,
 /// against the f64 brute force, and bit for bit against the same rays
-/// traced one by one.
+/// traced one by one; the walks bounded by the rays' length (as the
+/// renderer traces them) find what the whole walks find, in fewer tets.
 #[test]
 fn ao_rays_agree_with_the_brute_force_and_with_single_rays() {
     let m = grid(6, 0.1, 0.08, true, 9);
@@ -120,6 +132,8 @@ fn ao_rays_agree_with_the_brute_force_and_with_single_rays() {
     let length = ao_length(&m, 0.3);
     assert!(length > 1.0 && length < 4.0, "{length}");
     let (mut checked, mut occluded) = (0, 0);
+    // Tets walked by each tracer: bounded, whole.
+    let mut tets = [(0u64, 0u64); 4];
     for position in [Vec3::new(0.6, 1.1, 5.4), Vec3::new(8.0, 7.0, 9.5)] {
         let cam = PinholeCamera::new(&camera(position), 48, 40, false);
         let view = Viewpoint::locate(&m, position).unwrap();
@@ -142,14 +156,22 @@ fn ao_rays_agree_with_the_brute_force_and_with_single_rays() {
             }
         }
         assert!(rays.len() > 500, "{} AO rays", rays.len());
-        for t in tracers {
+        for (t, tets) in tracers.into_iter().zip(&mut tets) {
             let mut batched = vec![TraceOutcome::Miss { tets_visited: 0 }; rays.len()];
-            t.trace_batch_from(&rays, Starts::Each(&starts), &mut batched);
+            t.trace_batch_within(&rays, Starts::Each(&starts), &mut batched);
             let mut single = batched.clone();
-            OneByOne(t).trace_batch_from(&rays, Starts::Each(&starts), &mut single);
+            OneByOne(t).trace_batch_within(&rays, Starts::Each(&starts), &mut single);
             let b: Vec<_> = batched.iter().map(bits).collect();
             let s: Vec<_> = single.iter().map(bits).collect();
             assert_eq!(b, s, "{}", t.name());
+            let mut whole = batched.clone();
+            t.trace_batch_from(&rays, Starts::Each(&starts), &mut whole);
+            for (w, o) in whole.iter().zip(&batched) {
+                assert_eq!(w.hit(), o.hit(), "{}: bounded {o:?}, whole {w:?}", t.name());
+                assert!(o.tets_visited() <= w.tets_visited(), "{}", t.name());
+                tets.0 += o.tets_visited() as u64;
+                tets.1 += w.tets_visited() as u64;
+            }
             for ((ray, o), &f) in rays.iter().zip(&batched).zip(&from) {
                 assert!(!o.is_failure(), "{}: {o:?}", t.name());
                 let Some(want) = reference_occluded(&m, ray, f) else {
@@ -163,6 +185,17 @@ fn ao_rays_agree_with_the_brute_force_and_with_single_rays() {
                 checked += 1;
                 occluded += want as usize;
             }
+        }
+    }
+    // The projected walks (Tet20, Tet16, ScTP) stop past the length; Tet80
+    // walks whole.
+    for (k, &(bounded, whole)) in tets.iter().enumerate() {
+        eprintln!(
+            "{}: {bounded} tets bounded, {whole} whole",
+            tracers[k].name()
+        );
+        if k < 3 {
+            assert!(bounded < whole, "{bounded} vs {whole}");
         }
     }
     assert!(

@@ -66,6 +66,8 @@ struct Shape {
     planner: &'static str,
     /// Depth of the split.
     depth: usize,
+    /// How many times planes were moved and the build retried.
+    plane_moves: usize,
 }
 
 /// How the parts were merged, for the report.
@@ -217,6 +219,8 @@ impl Limited<'_> {
             part_peak_kib: vec![build.worker_peak_kib],
             max_part_peak_kib: build.worker_peak_kib,
             part_split_pieces: vec![0],
+            plane_moves: 0,
+            parts_reused: 0,
             total_s: start.elapsed().as_secs_f64(),
             merge: "in-core".to_string(),
             merge_s: None,
@@ -425,6 +429,7 @@ impl Limited<'_> {
                     cuts,
                     planner: "tree",
                     depth: built.plan.depth(),
+                    plane_moves: built.plane_moves,
                 };
                 Ok((out, report, shape))
             }
@@ -434,6 +439,7 @@ impl Limited<'_> {
                     cuts: s.values.iter().map(|&v| (s.axis, v)).collect(),
                     planner: "slabs",
                     depth: (s.values.len() + 1).next_power_of_two().trailing_zeros() as usize,
+                    plane_moves: 0,
                 };
                 Ok((out, report, shape))
             }
@@ -479,6 +485,8 @@ impl Limited<'_> {
             plane_axes: shape.cuts.iter().map(|c| c.0).collect(),
             planner: shape.planner.to_string(),
             depth: shape.depth,
+            plane_moves: shape.plane_moves,
+            parts_reused: report.parts_reused,
             triangles_cut: report.triangles_cut,
             part_points: report.part_points,
             part_triangles: report.part_triangles,

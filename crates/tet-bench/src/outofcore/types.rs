@@ -113,6 +113,12 @@ pub struct MemoryReport {
     /// workers' shares (a model of its own memory from the scene's
     /// triangles: `tet_build::outofcore::admission::builder_bytes`), bytes.
     pub own_bytes: u64,
+    /// How many times the build moved planes and tried again (a cut too
+    /// near a point, or TetGen failing on a part); 0 for slabs.
+    pub plane_moves: usize,
+    /// Parts the retries took as the attempt before built them (their
+    /// input unchanged by the moves), summed over retries.
+    pub parts_reused: usize,
     /// Peak resident memory of the whole process tree during the build
     /// (this process and every TetGen worker together, sampled every
     /// 2 ms), KiB: what the limit bounds; `null` without `/proc`.

@@ -20,6 +20,9 @@ use super::lanes::Lanes;
 use crate::walk::after_stop::{AfterStop, after_stop};
 use crate::walk::lanes::{Batch, Feed};
 use crate::walk::projection::Projection;
+use crate::walk::reach::GAMMA;
+#[cfg(doc)]
+use crate::walk::reach::Reach;
 use crate::walk::start::Lane;
 use crate::walk::stop::{Advance, Stopped};
 use crate::walk::topology::Topology;
@@ -80,6 +83,13 @@ struct Pack<L: Lanes, G: Projected<L>> {
     /// Index of each lane's ray in the batch.
     ray_index: L::Arr<usize>,
     cold: L::Arr<G::Cold>,
+    /// Lanes of bounded walks ([`crate::walk::reach`]).
+    bounded: L::M,
+    /// Their planes past `t_max`: origin, direction, its absolute
+    /// values (x, y, z each) and the threshold ([`Reach`]).
+    reach: [L::F; 10],
+    /// Per entry-face slot, the lanes whose vertex there lies past it.
+    beyond: [L::M; 3],
 }
 
 impl<L: Lanes, G: Projected<L>> Pack<L, G> {
@@ -99,6 +109,9 @@ impl<L: Lanes, G: Projected<L>> Pack<L, G> {
             live: l.mask_of_bits(0),
             ray_index: L::arr(0),
             cold: L::arr(G::Cold::default()),
+            bounded: l.mask_of_bits(0),
+            reach: [l.splat_f(0.0); 10],
+            beyond: [l.mask_of_bits(0); 3],
         }
     }
 
@@ -114,6 +127,30 @@ impl<L: Lanes, G: Projected<L>> Pack<L, G> {
         self.visited = l.set_i(self.visited, k, lane.st.visited);
         self.live = l.or_m(self.live, l.mask_of_bits(1 << k));
         self.ray_index.as_mut()[k] = ray;
+        let bit = l.mask_of_bits(1 << k);
+        self.bounded = l.andnot_m(bit, self.bounded);
+        if let Some(r) = &lane.reach {
+            self.bounded = l.or_m(self.bounded, bit);
+            let values = [
+                r.origin.x,
+                r.origin.y,
+                r.origin.z,
+                r.dir.x,
+                r.dir.y,
+                r.dir.z,
+                r.dir_abs.x,
+                r.dir_abs.y,
+                r.dir_abs.z,
+                r.threshold,
+            ];
+            for (x, v) in self.reach.iter_mut().zip(values) {
+                *x = l.set_f(*x, k, v);
+            }
+        }
+        for (s, b) in self.beyond.iter_mut().enumerate() {
+            let on = l.mask_of_bits(((lane.beyond >> s & 1) as u32) << k);
+            *b = l.or_m(l.andnot_m(bit, *b), on);
+        }
     }
 
     /// The entry face's vertex ids of lane `k`.
@@ -157,6 +194,8 @@ struct Round<L: Lanes> {
     events: u32,
     lost: u32,
     capped: u32,
+    /// Lanes whose exit face lies wholly past `t_max` (bounded walks).
+    beyond: u32,
     raw: L::Arr<u32>,
 }
 
@@ -220,7 +259,22 @@ fn step<L: Lanes, G: Projected<L>, X: Records<L>>(
         pk.face[k] = G::select(l, sel, v, pk.face[k]);
     }
     pk.visited = l.inc(pk.visited, go);
-    let moving = l.and_m(go, l.lt_u(link, l.splat_i(Link::BOUNDARY.0)));
+    // Bounded walks: the new vertex's side of the plane past `t_max`
+    // replaces the exiting one's; a face wholly past it ends the walk.
+    let mut past = l.mask_of_bits(0);
+    if l.any(pk.bounded) {
+        let b = l.and_m(go, pk.bounded);
+        let far = beyond(l, &pk.reach, p);
+        for (k, s) in [s0, s1, s2].into_iter().enumerate() {
+            let sel = l.and_m(b, s);
+            pk.beyond[k] = l.or_m(l.and_m(sel, far), l.andnot_m(sel, pk.beyond[k]));
+        }
+        past = l.and_m(
+            b,
+            l.and_m(pk.beyond[0], l.and_m(pk.beyond[1], pk.beyond[2])),
+        );
+    }
+    let moving = l.andnot_m(past, l.and_m(go, l.lt_u(link, l.splat_i(Link::BOUNDARY.0))));
     pk.entry = l.select_i(moving, pk.next, pk.entry);
     pk.next = l.select_i(moving, link, pk.next);
     x.prefetch(l, link);
@@ -232,8 +286,38 @@ fn step<L: Lanes, G: Projected<L>, X: Records<L>>(
         events: l.bits(events),
         lost: l.bits(lost),
         capped: l.bits(capped),
+        beyond: l.bits(past),
         raw: L::i_lanes(link),
     })
+}
+
+/// [`Reach::beyond`] on every lane: the same f32 operations in the same
+/// order (`|q|` by a select, which differs from `abs` only in the sign of
+/// a zero, which no comparison sees).
+#[inline(always)]
+fn beyond<L: Lanes>(l: L, r: &[L::F; 10], p: [L::F; 3]) -> L::M {
+    let zero = l.splat_f(0.0);
+    let q = [
+        l.sub_f(p[0], r[0]),
+        l.sub_f(p[1], r[1]),
+        l.sub_f(p[2], r[2]),
+    ];
+    // No closures over lane operations (see `ties`).
+    let abs = [
+        l.select_f(l.gt_f(zero, q[0]), l.sub_f(zero, q[0]), q[0]),
+        l.select_f(l.gt_f(zero, q[1]), l.sub_f(zero, q[1]), q[1]),
+        l.select_f(l.gt_f(zero, q[2]), l.sub_f(zero, q[2]), q[2]),
+    ];
+    let s = l.add_f(
+        l.add_f(l.mul_f(q[0], r[3]), l.mul_f(q[1], r[4])),
+        l.mul_f(q[2], r[5]),
+    );
+    let err = l.add_f(
+        l.add_f(l.mul_f(abs[0], r[6]), l.mul_f(abs[1], r[7])),
+        l.mul_f(abs[2], r[8]),
+    );
+    let err = l.mul_f(err, l.splat_f(GAMMA));
+    l.gt_f(l.sub_f(s, err), r[9])
 }
 
 /// The scalar tie rule for the lanes of `tie` (their edge tests replaced).
@@ -281,7 +365,7 @@ fn events<L: Lanes, G: Projected<L>>(
         let bit = |b: u32| b >> k & 1 != 0;
         let link = r.raw.as_ref()[k];
         let stopped = Stopped {
-            adv: Advance::stopped(bit(r.capped), bit(r.lost)),
+            adv: Advance::stopped(bit(r.capped), bit(r.lost), bit(r.beyond)),
             ids: pk.ids_of(l, k),
             tet: l.get_i(pk.next, k),
             visited: l.get_i(pk.visited, k),
@@ -495,9 +579,10 @@ where
         starts,
         cap,
         out,
+        bounded,
         ..
     } = batch;
-    let mut feed = Feed::new(mesh, rays, starts, out);
+    let mut feed = Feed::new(mesh, rays, starts, out, bounded);
     if mesh.points.is_empty() {
         // No walk starts without points (a start tet has vertices): the
         // feed stores every ray's outcome.

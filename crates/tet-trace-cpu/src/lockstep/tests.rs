@@ -376,3 +376,90 @@ fn gated_walks_hand_over_exactly_where_the_gate_says() {
     }
     assert!(handed > 100, "{handed} walks handed over");
 }
+
+/// Bounded walks ([`crate::walk::reach`]) in lockstep, on 3 portable lanes
+/// and at every width the CPU has, equal the scalar bounded walk bit for
+/// bit; each ends as the whole walk does (hit or miss; a step-cap failure
+/// may become a miss) and visits no more tets. Rays with a short `t_max`
+/// make the stop frequent.
+#[test]
+fn bounded_walks_in_lockstep_equal_the_scalar_bounded_walk() {
+    let mut stopped_short = 0;
+    for (mesh, cap) in meshes() {
+        let cap = cap.unwrap_or(crate::walk::step_cap(&mesh));
+        let t20 = Tet20Tracer::<DuffF32>::new(&mesh)
+            .unwrap()
+            .with_step_cap(cap);
+        let sctp = SctpTracer::<TripleF32>::new(&mesh)
+            .unwrap()
+            .with_step_cap(cap);
+        let mut rng = SplitMix64(41);
+        for (mut rays, start) in cases(&mesh, 31) {
+            for r in rays.iter_mut() {
+                if !rng.next_u64().is_multiple_of(3) {
+                    r.t_max = rng.range_f32(0.05, 1.5);
+                }
+            }
+            let starts = Starts::Same(start);
+            let within = |r: &Ray| {
+                crate::walk::trace_within::<DuffF32, _>(&mesh, &t20.layout, r, start, cap)
+            };
+            let want: Vec<String> = rays.iter().map(|r| bits(&within(r))).collect();
+            for (r, w) in rays.iter().zip(&want) {
+                let whole = crate::walk::trace::<DuffF32, _>(&mesh, &t20.layout, r, start, cap);
+                let bounded = within(r);
+                if !matches!(whole, TraceOutcome::Failed { .. }) {
+                    assert_eq!(bounded.hit(), whole.hit(), "{r:?}: {w} vs {whole:?}");
+                }
+                assert!(bounded.tets_visited() <= whole.tets_visited(), "{r:?}");
+                stopped_short += (bounded.tets_visited() < whole.tets_visited()) as usize;
+            }
+            let widths = [None, Some(Width::Avx2), Some(Width::Avx512)];
+            for width in widths {
+                let mut got = fresh(rays.len());
+                let batch = Batch {
+                    bounded: true,
+                    ..t20.batch(&rays, starts, &mut got)
+                };
+                let ran = match width {
+                    None => <Planar as Geometry<_>>::walk::<Portable<3>, _, 1>(
+                        Portable,
+                        batch,
+                        &mut NoGate,
+                    )
+                    .is_ok(),
+                    Some(w) => trace::<Planar, _, _>(batch, w, &mut NoGate).is_ok(),
+                };
+                if !ran {
+                    continue;
+                }
+                for (i, r) in rays.iter().enumerate() {
+                    assert_eq!(bits(&got[i]), want[i], "tet20 {width:?}: {r:?}");
+                }
+            }
+            // ScTP: its own projection, the same rule.
+            let want: Vec<String> = rays
+                .iter()
+                .map(|r| {
+                    bits(&crate::walk::trace_within::<TripleF32, _>(
+                        &mesh,
+                        &sctp.layout,
+                        r,
+                        start,
+                        cap,
+                    ))
+                })
+                .collect();
+            let mut got = fresh(rays.len());
+            let batch = Batch {
+                bounded: true,
+                ..sctp.batch(&rays, starts, &mut got)
+            };
+            portable::<Triple, _, 3>(batch);
+            for (i, r) in rays.iter().enumerate() {
+                assert_eq!(bits(&got[i]), want[i], "sctp: {r:?}");
+            }
+        }
+    }
+    assert!(stopped_short > 50, "{stopped_short} walks stopped short");
+}

@@ -166,7 +166,9 @@ impl TileAo {
         self.out.clear();
         self.out
             .resize(self.rays.len(), TraceOutcome::Miss { tets_visited: 0 });
-        tracer.trace_batch_from(&self.rays, Starts::Each(&self.starts), &mut self.out);
+        // An AO ray asks only what lies within its length: a tet walk
+        // ends once it is past it ([`Tracer::trace_batch_within`]).
+        tracer.trace_batch_within(&self.rays, Starts::Each(&self.starts), &mut self.out);
         stats.ao_rays += self.rays.len() as u64;
         for (&k, o) in self.pixels.iter().zip(&self.out) {
             stats.ao_tets_visited += o.tets_visited() as u64;

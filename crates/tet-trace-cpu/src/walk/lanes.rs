@@ -62,6 +62,10 @@ pub struct Batch<'a, T: ?Sized> {
     pub cap: u32,
     /// The outcomes, ray by ray.
     pub out: &'a mut [TraceOutcome],
+    /// Bounded walks ([`super::trace_within`]): a walk ends as a miss as
+    /// soon as the face it leaves through lies wholly past its ray's
+    /// `t_max`. Not for gated walks (their handover does not carry it).
+    pub bounded: bool,
 }
 
 /// Walks interleaved per thread by the scalar batch walk
@@ -84,6 +88,8 @@ pub(crate) struct Feed<'a> {
     /// and its origin: rays from one viewpoint share it.
     same_scale: Option<(Vec3, f32)>,
     pub(crate) out: &'a mut [TraceOutcome],
+    /// Walks are bounded ([`Batch::bounded`]).
+    bounded: bool,
 }
 
 impl<'a> Feed<'a> {
@@ -95,6 +101,7 @@ impl<'a> Feed<'a> {
         rays: &'a [Ray],
         start: Starts<'a>,
         out: &'a mut [TraceOutcome],
+        bounded: bool,
     ) -> Feed<'a> {
         let n = rays.len().min(out.len());
         Feed {
@@ -105,6 +112,7 @@ impl<'a> Feed<'a> {
             hint: EntryHint::default(),
             same_scale: None,
             out: &mut out[..n],
+            bounded,
         }
     }
 
@@ -121,6 +129,10 @@ impl<'a> Feed<'a> {
                 Starts::Same(s) => begin_same::<P>(mesh, ray, s, &mut self.same_scale),
                 Starts::Each(s) => begin::<P>(mesh, ray, s[i]),
                 Starts::Outside(entry) => begin_outside::<P>(mesh, ray, entry, &mut self.hint),
+            };
+            let lane = match lane {
+                Ok(l) if self.bounded => l.bounded(mesh, ray),
+                other => other,
             };
             match lane {
                 Ok(l) => return Some((i, l)),
@@ -146,8 +158,9 @@ pub fn trace_interleaved<P: Projection, T: Topology, const K: usize>(batch: Batc
         starts,
         cap,
         out,
+        bounded,
     } = batch;
-    let mut feed = Feed::new(mesh, rays, starts, out);
+    let mut feed = Feed::new(mesh, rays, starts, out, bounded);
     let points = &mesh.points[..];
     // Lanes in flight, each with its ray index; a finished lane is replaced
     // in place by the next ray, or removed when none is left.

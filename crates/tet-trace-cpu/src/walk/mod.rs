@@ -156,6 +156,7 @@ pub(crate) mod after_stop;
 pub(crate) mod entry;
 pub(crate) mod lanes;
 pub(crate) mod projection;
+pub(crate) mod reach;
 pub(crate) mod start;
 pub(crate) mod step;
 pub(crate) mod stop;
@@ -174,7 +175,7 @@ pub use projection::{
     DuffF32, DuffF64, Face2, OriginF32, Projection, TripleF32, duff_basis, walk_scale,
 };
 pub use start::{Start, start_exit_face, start_scale};
-pub use step::{EXIT_SLOT, exit_slot, step_cap, trace};
+pub use step::{EXIT_SLOT, exit_slot, step_cap, trace, trace_within};
 pub(crate) use stop::degenerate_crossing;
 pub use stop::face_hit;
 pub use topology::{Topology, prefetch_index};

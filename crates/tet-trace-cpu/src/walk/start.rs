@@ -8,6 +8,7 @@ use tet_core::predicates::orient3d;
 use tet_core::{FACE_VERTICES, Link, NO_TET, TetMesh};
 
 use super::projection::{Projection, walk_scale};
+use super::reach::Reach;
 use super::stop::{Resolved, resolve_constrained};
 use crate::locate::star;
 use crate::ray::{Failure, Ray, TraceOutcome};
@@ -323,6 +324,32 @@ pub(crate) struct Lane<P: Projection> {
     pub(crate) st: State<P>,
     pub(crate) next: u32,
     pub(crate) entry_raw: u32,
+    /// A bounded walk's plane past `t_max` ([`Lane::bounded`]), `None`
+    /// for the plain walk.
+    pub(crate) reach: Option<Reach>,
+    /// Bit `k`: vertex `st.ids[k]` lies past the plane of `reach`.
+    pub(crate) beyond: u8,
+}
+
+impl<P: Projection> Lane<P> {
+    /// This lane as a bounded walk of `ray` ([`super::reach`]), which
+    /// ends as a miss once its exit face lies wholly past `t_max`: `Err`
+    /// (that miss) when its current face does already. A ray without a
+    /// usable bound ([`Reach::of`]) walks as before.
+    #[inline(always)]
+    pub(crate) fn bounded(mut self, mesh: &TetMesh, ray: &Ray) -> Result<Self, TraceOutcome> {
+        if let Some(r) = Reach::of(ray) {
+            let at = |i: u32| mesh.points.get(i as usize).copied().unwrap_or(Vec3::NAN);
+            self.beyond = r.beyond_mask(self.st.ids.map(at));
+            self.reach = Some(r);
+            if self.beyond == 7 {
+                return Err(TraceOutcome::Miss {
+                    tets_visited: self.st.visited,
+                });
+            }
+        }
+        Ok(self)
+    }
 }
 
 /// Everything before the hot loop: ray checks, projection set-up, the start
@@ -453,6 +480,8 @@ pub(crate) fn begin_with<P: Projection>(
             st,
             next: n,
             entry_raw,
+            reach: None,
+            beyond: 0,
         });
     }
     match resolve_face(mesh, ray, &st, link) {
@@ -464,6 +493,8 @@ pub(crate) fn begin_with<P: Projection>(
                 st,
                 next: n,
                 entry_raw,
+                reach: None,
+                beyond: 0,
             })
         }
     }
@@ -495,6 +526,8 @@ fn enter_through<P: Projection>(
         st,
         next: tet,
         entry_raw: behind.0,
+        reach: None,
+        beyond: 0,
     }
 }
 

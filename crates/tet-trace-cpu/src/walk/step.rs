@@ -48,10 +48,38 @@ pub fn trace<P: Projection, T: Topology>(
     start: Start,
     cap: u32,
 ) -> TraceOutcome {
-    let mut lane = match begin::<P>(mesh, ray, start) {
-        Ok(lane) => lane,
-        Err(out) => return out,
-    };
+    match begin::<P>(mesh, ray, start) {
+        Ok(lane) => walk_on(mesh, topo, ray, lane, cap),
+        Err(out) => out,
+    }
+}
+
+/// [`trace`] as a bounded walk ([`super::reach`]): it ends as a miss as
+/// soon as the face it leaves through lies wholly past `ray.t_max`. The
+/// same hit or miss as [`trace`] (a walk that would reach the step cap
+/// past `t_max` ends as a miss instead), in fewer tets.
+pub fn trace_within<P: Projection, T: Topology>(
+    mesh: &TetMesh,
+    topo: &T,
+    ray: &Ray,
+    start: Start,
+    cap: u32,
+) -> TraceOutcome {
+    match begin::<P>(mesh, ray, start).and_then(|lane| lane.bounded(mesh, ray)) {
+        Ok(lane) => walk_on(mesh, topo, ray, lane, cap),
+        Err(out) => out,
+    }
+}
+
+/// The hot loop of [`trace`] from a started lane.
+#[inline(always)]
+fn walk_on<P: Projection, T: Topology>(
+    mesh: &TetMesh,
+    topo: &T,
+    ray: &Ray,
+    mut lane: Lane<P>,
+    cap: u32,
+) -> TraceOutcome {
     let points = &mesh.points[..];
     loop {
         let adv = advance(points, topo, &mut lane, cap);
@@ -97,6 +125,15 @@ pub(crate) fn advance<P: Projection, T: Topology>(
     st.ids[slot] = d;
     P::set_point(&mut st.p, slot, pd);
     st.visited += 1;
+    if let Some(r) = &lane.reach {
+        let b = lane.beyond & !(1 << slot) | (r.beyond(pd3) as u8) << slot;
+        lane.beyond = b;
+        if b == 7 {
+            st.tet = next;
+            st.link = raw;
+            return Advance::Beyond;
+        }
+    }
     if raw < Link::BOUNDARY.0 {
         topo.prefetch(raw);
         lane.entry_raw = next;

@@ -202,6 +202,9 @@ pub(crate) enum Advance {
     /// Entered a tet whose exit link is not a tet (constrained face or
     /// boundary): `finish_step` resolves it.
     Face,
+    /// Entered a tet whose exit face lies wholly past the ray's `t_max`
+    /// (a bounded walk, [`super::reach`]): a miss.
+    Beyond,
 }
 
 /// A walk that stopped (not [`Advance::Go`]), by the few fields needed to
@@ -241,6 +244,9 @@ impl Stopped {
         match adv {
             Advance::Cap => failed(Failure::StepCap),
             Advance::Lost => failed(Failure::Lost),
+            Advance::Beyond => Resolved::Done(TraceOutcome::Miss {
+                tets_visited: visited,
+            }),
             Advance::Go | Advance::Face => match Link(link).as_constrained() {
                 Some(c) => resolve_constrained(mesh, ray, c, ids, tet, visited),
                 None => Resolved::Done(TraceOutcome::Miss {
@@ -254,12 +260,14 @@ impl Stopped {
 impl Advance {
     /// The stop of a SIMD lane that did not move on in a round, checked in
     /// the order of [`advance`](super::step::advance): the step cap, then a new vertex out of
-    /// range, else a non-tet exit link.
-    pub(crate) fn stopped(capped: bool, lost: bool) -> Advance {
+    /// range, then an exit face past `t_max`, else a non-tet exit link.
+    pub(crate) fn stopped(capped: bool, lost: bool, beyond: bool) -> Advance {
         if capped {
             Advance::Cap
         } else if lost {
             Advance::Lost
+        } else if beyond {
+            Advance::Beyond
         } else {
             Advance::Face
         }

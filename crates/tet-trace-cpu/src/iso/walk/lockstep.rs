@@ -108,6 +108,7 @@ impl IsoWalk<'_> {
             starts: Starts::Each(&starts),
             cap: self.cap,
             out: &mut ends,
+            bounded: false,
         };
         if let Err(batch) = lockstep::trace::<Planar, _, _>(batch, Width::Auto, &mut gate) {
             // No SIMD lanes, or records they cannot gather: the portable

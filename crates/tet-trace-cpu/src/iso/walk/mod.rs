@@ -673,7 +673,9 @@ impl<'m> IsoWalk<'m> {
         };
         match adv {
             Advance::Go => prefetch_index(&self.ranges, lane.next),
-            Advance::Face => {}
+            // The iso walk's lanes are never bounded (no `Reach`): their
+            // faces are checked like any other.
+            Advance::Face | Advance::Beyond => {}
             Advance::Cap => return failed(Failure::StepCap),
             Advance::Lost => return failed(Failure::Lost),
         }
