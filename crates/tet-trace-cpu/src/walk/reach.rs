@@ -92,13 +92,8 @@ mod tests {
     /// without a finite `t_max`, or where the threshold is not normal.
     #[test]
     fn beyond_means_beyond_in_f64() {
-        let mut seed = 11u64;
-        let mut rand = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-        };
+        let mut rng = tet_core::synthetic::SplitMix64(11);
+        let mut rand = || rng.range_f32(-1.0, 1.0);
         let mut counted = 0;
         for scale in [1e-12f32, 1e-3, 1.0, 1e3, 1e12] {
             for _ in 0..20_000 {

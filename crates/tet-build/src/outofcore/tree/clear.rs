@@ -145,13 +145,8 @@ mod tests {
     /// on a fine grid lies nearer the wanted one.
     #[test]
     fn a_clear_value_is_clear_and_nearest() {
-        let mut seed = 7u64;
-        let mut rand = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = tet_core::synthetic::SplitMix64(7);
+        let mut rand = || rng.range_f32(0.0, 1.0);
         for round in 0..40 {
             let n = 5 + round * 3;
             let xs: Vec<f32> = (0..n).map(|_| rand()).collect();
