@@ -148,6 +148,8 @@
 //! * `start`: where a walk starts and its start-up;
 //! * `step`: one step of Algorithm 1 and the single-ray walk;
 //! * `until`: walks that end on entering given tets (shadow rays);
+//! * `reach`: walks that end once past their ray's `t_max`
+//!   (ambient-occlusion rays, [`trace_within`]);
 //! * `entry`: the boundary face a ray from outside enters through;
 //! * `lanes`: batches on one thread, the interleaved walk;
 //! * `after_stop`: the stopped-lane cold path of the SIMD walks.
