@@ -35,7 +35,7 @@ pub fn parse_methods(s: &str) -> Result<Vec<Method>> {
     s.split(',')
         .map(|m| {
             Method::from_str(m.trim(), true).map_err(|_| {
-                anyhow::anyhow!("unknown method `{m}` (expected sctp, tet80, tet80-consistent, tet32, tet20, tet16, obvhs, embree, embree8, brute, exact or all)")
+                anyhow::anyhow!("unknown method `{m}` (expected sctp, tet80, tet80-consistent, tet32, tet20, tet16, obvhs, embree, embree8, embree16, brute, exact or all)")
             })
         })
         .collect()

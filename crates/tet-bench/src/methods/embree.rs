@@ -12,7 +12,16 @@
 //! * `embree8`: `rtcIntersect8` on packets of eight consecutive rays of a
 //!   batch (the renderer's batches are 16×16 tiles, so packets are
 //!   coherent), secondary rays included: a tile's AO rays and its shadow
-//!   rays toward one light go in packets of eight too.
+//!   rays toward one light go in packets of eight too;
+//! * `embree16`: `rtcIntersect16`, likewise on packets of sixteen (Embree
+//!   runs those only with AVX-512: the method is refused on a CPU
+//!   without it).
+//!
+//! Every query is `rtcIntersect` (closest hit), AO and shadow rays
+//! included, as for every other method. `rtcOccluded` (any hit) would stop
+//! an occluded ray at its first hit, but on the AO rays of these scenes
+//! most find nothing within their length (82 % on Torus Knots), and an
+//! open ray traverses the same nodes either way.
 //!
 //! Hits are returned through the same record as every other method
 //! ([`super::bvh::input_hit`]: t from Embree, barycentrics and sides
@@ -25,9 +34,10 @@
 //! not set: on Torus Knots it changed nothing beyond noise, and setting it
 //! needs `unsafe` and would leak into the other methods' threads.
 
+use embree3::sys::{RTCRayHit8, RTCRayHit16};
 use embree3::{
-    BufferUsage, Device, Format, GeometryKind, IntersectContext, Ray as ERay, RayHit as ERayHit,
-    Scene, ValidMask, ValidMaskN,
+    BufferUsage, Device, Format, GeometryKind, Hit8, Hit16, IntersectContext, Ray as ERay, Ray8,
+    Ray16, RayHit as ERayHit, Scene, ValidMask, ValidMaskN,
 };
 use tet_core::{InputTriangles, TetMesh};
 use tet_trace_cpu::kernel::Tracer;
@@ -38,8 +48,6 @@ use super::bvh::input_hit;
 
 /// Embree's "no hit" geometry id.
 const INVALID_ID: u32 = u32::MAX;
-/// Rays per packet for `embree8`.
-const PACKET: usize = 8;
 /// Retraces allowed past the start face before giving up (reported as a miss).
 const SKIP_RETRIES: usize = 8;
 
@@ -52,8 +60,8 @@ pub struct EmbreeTracer<'m> {
     inputs: InputTriangles,
     /// Embree's committed scene (one triangle geometry).
     scene: Scene<'static>,
-    /// `rtcIntersect8` packets (`embree8`) rather than single rays.
-    packets: bool,
+    /// Rays per query: 1 (`embree`), 8 (`embree8`) or 16 (`embree16`).
+    width: usize,
     /// The device, which must outlive the scene (Scene holds its own handle).
     _device: Device,
 }
@@ -67,6 +75,12 @@ pub enum EmbreeError {
     /// Embree indexes triangles with 32-bit ids.
     #[error("Embree: {0} triangles exceed its 32-bit primitive ids")]
     TooLarge(usize),
+    /// Packets come in 1, 8 or 16 rays.
+    #[error("Embree: no packets of {0} rays (1, 8 or 16)")]
+    Width(usize),
+    /// `rtcIntersect16` needs AVX-512.
+    #[error("Embree: 16-wide packets need a CPU with AVX-512")]
+    NoAvx512,
 }
 
 /// An Embree failure, naming what was being created.
@@ -75,10 +89,17 @@ fn embree_err(what: &str, e: impl std::fmt::Debug) -> EmbreeError {
 }
 
 impl<'m> EmbreeTracer<'m> {
-    /// Builds the Embree scene; `packets` selects `rtcIntersect8` batches.
-    pub fn new(mesh: &'m TetMesh, packets: bool) -> Result<Self, EmbreeError> {
+    /// Builds the Embree scene; `width` (1, 8 or 16) selects single rays
+    /// or `rtcIntersect8` / `rtcIntersect16` packets.
+    pub fn new(mesh: &'m TetMesh, width: usize) -> Result<Self, EmbreeError> {
         if mesh.constrained.len() >= INVALID_ID as usize {
             return Err(EmbreeError::TooLarge(mesh.constrained.len()));
+        }
+        if !matches!(width, 1 | 8 | 16) {
+            return Err(EmbreeError::Width(width));
+        }
+        if width == 16 && !has_avx512() {
+            return Err(EmbreeError::NoAvx512);
         }
         let inputs = InputTriangles::of(mesh);
         let device = Device::new().map_err(|e| embree_err("device", e))?;
@@ -111,7 +132,7 @@ impl<'m> EmbreeTracer<'m> {
             mesh,
             inputs,
             scene,
-            packets,
+            width,
             _device: device,
         })
     }
@@ -172,10 +193,9 @@ impl<'m> EmbreeTracer<'m> {
 
 impl Tracer for EmbreeTracer<'_> {
     fn name(&self) -> String {
-        if self.packets {
-            "embree3-packet8/f32".into()
-        } else {
-            "embree3-single/f32".into()
+        match self.width {
+            1 => "embree3-single/f32".into(),
+            w => format!("embree3-packet{w}/f32"),
         }
     }
 
@@ -220,7 +240,7 @@ impl Tracer for EmbreeTracer<'_> {
 
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
         let from_face = matches!(start, Start::Face { .. });
-        if !self.packets || from_face {
+        if self.width == 1 || from_face {
             // A batch from one start that is not a face is a tile of camera
             // rays: coherent, which is how an application would tell Embree.
             let mut ctx = if from_face {
@@ -237,6 +257,67 @@ impl Tracer for EmbreeTracer<'_> {
     }
 }
 
+/// True where the CPU runs Embree's 16-wide packets (AVX-512F).
+fn has_avx512() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx512f")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// An Embree ray packet (`RTCRayHit8`, `RTCRayHit16`): filled lane by lane,
+/// traced by the matching `rtcIntersectN`, read back lane by lane.
+trait Packet {
+    /// Rays per packet.
+    const N: usize;
+    /// A packet of invalid lanes.
+    fn empty() -> Self;
+    /// Lane `i` traces `r` from `t_near`.
+    fn set(&mut self, i: usize, r: &Ray, t_near: f32);
+    /// `rtcIntersectN` on the lanes `valid` marks.
+    fn intersect(&mut self, scene: &Scene, ctx: &mut IntersectContext, valid: &[ValidMask]);
+    /// Lane `i`'s primitive and distance, `None` for no hit.
+    fn hit(&self, i: usize) -> Option<(u32, f32)>;
+}
+
+macro_rules! packet {
+    ($t:ty, $ray:ty, $hit:ty, $n:literal, $intersect:ident) => {
+        impl Packet for $t {
+            const N: usize = $n;
+            fn empty() -> Self {
+                Self {
+                    ray: <$ray>::empty(),
+                    hit: <$hit>::new(),
+                }
+            }
+            fn set(&mut self, i: usize, r: &Ray, t_near: f32) {
+                let p = &mut self.ray;
+                [p.org_x[i], p.org_y[i], p.org_z[i]] = r.origin.to_array();
+                [p.dir_x[i], p.dir_y[i], p.dir_z[i]] = r.direction.to_array();
+                p.tnear[i] = t_near;
+                p.tfar[i] = r.t_max;
+                p.mask[i] = u32::MAX;
+                p.id[i] = i as u32;
+            }
+            fn intersect(&mut self, scene: &Scene, ctx: &mut IntersectContext, valid: &[ValidMask]) {
+                let mut v = [ValidMask::Invalid; $n];
+                v.copy_from_slice(&valid[..$n]);
+                scene.$intersect(ctx, self, &ValidMaskN::from(v));
+            }
+            fn hit(&self, i: usize) -> Option<(u32, f32)> {
+                (self.hit.geomID[i] != INVALID_ID).then(|| (self.hit.primID[i], self.ray.tfar[i]))
+            }
+        }
+    };
+}
+
+packet!(RTCRayHit8, Ray8, Hit8, 8, intersect8);
+packet!(RTCRayHit16, Ray16, Hit16, 16, intersect16);
+
 impl EmbreeTracer<'_> {
     /// Rays with a start each (a tile's secondary rays), over the shortest
     /// of the three slices: single rays, or packets for `embree8`; a ray
@@ -250,7 +331,7 @@ impl EmbreeTracer<'_> {
                 .and_then(|f| self.inputs.of_face(f))
                 .unwrap_or(u32::MAX)
         };
-        if !self.packets {
+        if self.width == 1 {
             let mut ctx = IntersectContext::incoherent();
             for (i, (r, o)) in rays.iter().zip(out.iter_mut()).enumerate() {
                 *o = self.trace_in(&mut ctx, r, starts[i]);
@@ -260,53 +341,57 @@ impl EmbreeTracer<'_> {
         self.packets(IntersectContext::incoherent(), rays, skip, out);
     }
 
-    /// `rtcIntersect8` on packets of eight consecutive rays in `ctx`; ray
-    /// `i` must not report input triangle `skip(i)` (`u32::MAX`: none): a
-    /// lane that does is traced again alone, past it ([`Self::trace_one`]).
+    /// `rtcIntersect8` or `rtcIntersect16` (the tracer's width) on
+    /// packets of consecutive rays in `ctx`; ray `i` must not report input
+    /// triangle `skip(i)` (`u32::MAX`: none): a lane that does is traced
+    /// again alone, past it ([`Self::trace_one`]).
     fn packets(
+        &self,
+        ctx: IntersectContext,
+        rays: &[Ray],
+        skip: impl Fn(usize) -> u32,
+        out: &mut [TraceOutcome],
+    ) {
+        if self.width == 16 {
+            self.packets_of::<RTCRayHit16>(ctx, rays, skip, out)
+        } else {
+            self.packets_of::<RTCRayHit8>(ctx, rays, skip, out)
+        }
+    }
+
+    /// [`Self::packets`] with packets of type `P`.
+    fn packets_of<P: Packet>(
         &self,
         mut ctx: IntersectContext,
         rays: &[Ray],
         skip: impl Fn(usize) -> u32,
         out: &mut [TraceOutcome],
     ) {
-        for (c, (chunk, outs)) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)).enumerate() {
-            let mut packet = embree3::sys::RTCRayHit8 {
-                ray: embree3::Ray8::empty(),
-                hit: embree3::Hit8::new(),
-            };
-            let mut valid = [ValidMask::Invalid; PACKET];
+        let mut valid = vec![ValidMask::Invalid; P::N];
+        for (c, (chunk, outs)) in rays.chunks(P::N).zip(out.chunks_mut(P::N)).enumerate() {
+            let mut packet = P::empty();
+            valid.fill(ValidMask::Invalid);
             for (i, r) in chunk.iter().enumerate() {
-                if !r.is_valid() {
-                    continue;
+                if r.is_valid() {
+                    valid[i] = ValidMask::Valid;
+                    packet.set(i, r, r.t_min.max(0.0));
                 }
-                valid[i] = ValidMask::Valid;
-                let p = &mut packet.ray;
-                [p.org_x[i], p.org_y[i], p.org_z[i]] = r.origin.to_array();
-                [p.dir_x[i], p.dir_y[i], p.dir_z[i]] = r.direction.to_array();
-                p.tnear[i] = r.t_min.max(0.0);
-                p.tfar[i] = r.t_max;
-                p.mask[i] = u32::MAX;
-                p.id[i] = i as u32;
             }
-            self.scene
-                .intersect8(&mut ctx, &mut packet, &ValidMaskN::from(valid));
+            packet.intersect(&self.scene, &mut ctx, &valid);
             for (i, (r, o)) in chunk.iter().zip(outs.iter_mut()).enumerate() {
                 *o = if valid[i] != ValidMask::Valid {
                     TraceOutcome::Failed {
                         failure: Failure::InvalidRay,
                         tets_visited: 0,
                     }
-                } else if packet.hit.geomID[i] != INVALID_ID {
-                    let prim = packet.hit.primID[i];
-                    let s = skip(c * PACKET + i);
-                    if prim == s {
-                        self.trace_one(&mut ctx, r, s)
-                    } else {
-                        self.outcome(r, prim, packet.ray.tfar[i])
-                    }
                 } else {
-                    TraceOutcome::Miss { tets_visited: 0 }
+                    match packet.hit(i) {
+                        Some((prim, _)) if prim == skip(c * P::N + i) => {
+                            self.trace_one(&mut ctx, r, prim)
+                        }
+                        Some((prim, t)) => self.outcome(r, prim, t),
+                        None => TraceOutcome::Miss { tets_visited: 0 },
+                    }
                 };
             }
         }
@@ -332,8 +417,20 @@ mod tests {
             seed: 7,
             ..Default::default()
         });
-        let single = EmbreeTracer::new(&mesh, false).unwrap();
-        let packets = EmbreeTracer::new(&mesh, true).unwrap();
+        let single = EmbreeTracer::new(&mesh, 1).unwrap();
+        let mut widths = vec![EmbreeTracer::new(&mesh, 8).unwrap()];
+        // Sixteen-wide packets where the CPU has AVX-512 (refused elsewhere).
+        match EmbreeTracer::new(&mesh, 16) {
+            Ok(t) => widths.push(t),
+            Err(e) => assert!(!has_avx512() && matches!(e, EmbreeError::NoAvx512)),
+        }
+        for packets in &widths {
+            check_against_brute_force(&mesh, &single, packets);
+        }
+    }
+
+    /// `single` and `packets` on camera-like batches and secondary rays.
+    fn check_against_brute_force(mesh: &TetMesh, single: &EmbreeTracer, packets: &EmbreeTracer) {
         let mut rng = SplitMix64(3);
         let (mut checked, mut hits, mut secondary) = (0, 0, 0);
         let (mut conts, mut starts, mut singles) = (Vec::new(), Vec::new(), Vec::new());

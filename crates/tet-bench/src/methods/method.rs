@@ -32,6 +32,9 @@ pub enum Method {
     Embree,
     /// Embree 3, `rtcIntersect8` on packets of 8 rays (needs the `embree` feature).
     Embree8,
+    /// Embree 3, `rtcIntersect16` on packets of 16 rays (needs the `embree`
+    /// feature and a CPU with AVX-512).
+    Embree16,
     /// f64 brute force over all triangles (reference; slow).
     Brute,
     /// The exact reference walk: exact side products with a symbolic tie
@@ -62,6 +65,7 @@ impl Method {
             Method::StripsPackets => "strips-packets",
             Method::Embree => "embree",
             Method::Embree8 => "embree8",
+            Method::Embree16 => "embree16",
             Method::Brute => "brute",
             Method::Exact => "exact",
             Method::GpuTet20 => "gpu-tet20",
@@ -86,6 +90,7 @@ impl Method {
             | Method::StripsPackets
             | Method::Embree
             | Method::Embree8
+            | Method::Embree16
             | Method::Brute
             | Method::Exact => None,
         }

@@ -64,11 +64,13 @@ pub fn tracer_capped<'m>(
         (Method::Strips, false) => Box::new(StripsTracer::new(mesh, false)?),
         (Method::StripsPackets, false) => Box::new(StripsTracer::new(mesh, true)?),
         #[cfg(feature = "embree")]
-        (Method::Embree, false) => Box::new(embree::EmbreeTracer::new(mesh, false)?),
+        (Method::Embree, false) => Box::new(embree::EmbreeTracer::new(mesh, 1)?),
         #[cfg(feature = "embree")]
-        (Method::Embree8, false) => Box::new(embree::EmbreeTracer::new(mesh, true)?),
+        (Method::Embree8, false) => Box::new(embree::EmbreeTracer::new(mesh, 8)?),
+        #[cfg(feature = "embree")]
+        (Method::Embree16, false) => Box::new(embree::EmbreeTracer::new(mesh, 16)?),
         #[cfg(not(feature = "embree"))]
-        (Method::Embree | Method::Embree8, _) => bail!(
+        (Method::Embree | Method::Embree8 | Method::Embree16, _) => bail!(
             "method {} needs tet-bench built with `--features embree` (and the system Embree 3 \
              library: `apt-get install libembree-dev`)",
             method.name()
@@ -90,7 +92,8 @@ pub fn has_f64(method: Method) -> bool {
 
 /// The CPU methods every comparison runs (`tables`, `accuracy --methods
 /// all`): the tet walks, the obvhs BVH, Ray-Strips and, when built with
-/// the `embree` feature, Embree's single rays and packets.
+/// the `embree` feature, Embree's single rays and packets (of sixteen
+/// where the CPU has AVX-512).
 pub fn cpu_methods() -> Vec<Method> {
     let mut m = vec![
         Method::Tet20,
@@ -102,8 +105,21 @@ pub fn cpu_methods() -> Vec<Method> {
         Method::Obvhs,
         Method::Strips,
     ];
+    m.extend(embree_methods());
+    m
+}
+
+/// Embree's methods this build and CPU run: none without the `embree`
+/// feature; single rays and packets of eight, and of sixteen where the
+/// CPU has AVX-512.
+pub fn embree_methods() -> Vec<Method> {
+    let mut m = Vec::new();
     if cfg!(feature = "embree") {
         m.extend([Method::Embree, Method::Embree8]);
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            m.push(Method::Embree16);
+        }
     }
     m
 }

@@ -21,9 +21,7 @@ const ROUNDS: usize = 2;
 /// single rays and packets where built with it.
 fn methods() -> Vec<Method> {
     let mut m = vec![Method::Tet20, Method::Tet16, Method::Obvhs];
-    if cfg!(feature = "embree") {
-        m.extend([Method::Embree, Method::Embree8]);
-    }
+    m.extend(crate::methods::embree_methods());
     m
 }
 
