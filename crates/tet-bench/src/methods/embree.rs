@@ -303,7 +303,12 @@ macro_rules! packet {
                 p.mask[i] = u32::MAX;
                 p.id[i] = i as u32;
             }
-            fn intersect(&mut self, scene: &Scene, ctx: &mut IntersectContext, valid: &[ValidMask]) {
+            fn intersect(
+                &mut self,
+                scene: &Scene,
+                ctx: &mut IntersectContext,
+                valid: &[ValidMask],
+            ) {
                 let mut v = [ValidMask::Invalid; $n];
                 v.copy_from_slice(&valid[..$n]);
                 scene.$intersect(ctx, self, &ValidMaskN::from(v));

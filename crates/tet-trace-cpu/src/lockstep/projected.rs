@@ -66,7 +66,7 @@ impl Handover {
 }
 
 /// `L::WIDTH` walks in registers, and per lane its cold part.
-struct Pack<L: Lanes, G: Projected<L>> {
+struct Pack<L: Lanes, G: Projected<L>, const B: bool> {
     ray: G::Ray,
     /// The entry face: projected points and ids (counter-clockwise).
     face: [G::Vert; 3],
@@ -92,7 +92,7 @@ struct Pack<L: Lanes, G: Projected<L>> {
     beyond: [L::M; 3],
 }
 
-impl<L: Lanes, G: Projected<L>> Pack<L, G> {
+impl<L: Lanes, G: Projected<L>, const B: bool> Pack<L, G, B> {
     /// Every lane parked on tet 0 (exists whenever a walk started, so the
     /// loads of parked lanes stay in range).
     #[inline(always)]
@@ -127,6 +127,9 @@ impl<L: Lanes, G: Projected<L>> Pack<L, G> {
         self.visited = l.set_i(self.visited, k, lane.st.visited);
         self.live = l.or_m(self.live, l.mask_of_bits(1 << k));
         self.ray_index.as_mut()[k] = ray;
+        if !B {
+            return;
+        }
         let bit = l.mask_of_bits(1 << k);
         self.bounded = l.andnot_m(bit, self.bounded);
         if let Some(r) = &lane.reach {
@@ -203,9 +206,9 @@ struct Round<L: Lanes> {
 /// moves on to the exit neighbour; `Some` when some live lane needs the rare
 /// path (the step cap, an out-of-range vertex, a non-tet exit link).
 #[inline(always)]
-fn step<L: Lanes, G: Projected<L>, X: Records<L>>(
+fn step<L: Lanes, G: Projected<L>, X: Records<L>, const B: bool>(
     l: L,
-    pk: &mut Pack<L, G>,
+    pk: &mut Pack<L, G, B>,
     x: &X,
     points: &[Vec3],
     cap: u32,
@@ -262,7 +265,7 @@ fn step<L: Lanes, G: Projected<L>, X: Records<L>>(
     // Bounded walks: the new vertex's side of the plane past `t_max`
     // replaces the exiting one's; a face wholly past it ends the walk.
     let mut past = l.mask_of_bits(0);
-    if l.any(pk.bounded) {
+    if B && l.any(pk.bounded) {
         let b = l.and_m(go, pk.bounded);
         let far = beyond(l, &pk.reach, p);
         for (k, s) in [s0, s1, s2].into_iter().enumerate() {
@@ -274,7 +277,10 @@ fn step<L: Lanes, G: Projected<L>, X: Records<L>>(
             l.and_m(pk.beyond[0], l.and_m(pk.beyond[1], pk.beyond[2])),
         );
     }
-    let moving = l.andnot_m(past, l.and_m(go, l.lt_u(link, l.splat_i(Link::BOUNDARY.0))));
+    let mut moving = l.and_m(go, l.lt_u(link, l.splat_i(Link::BOUNDARY.0)));
+    if B {
+        moving = l.andnot_m(past, moving);
+    }
     pk.entry = l.select_i(moving, pk.next, pk.entry);
     pk.next = l.select_i(moving, link, pk.next);
     x.prefetch(l, link);
@@ -322,9 +328,9 @@ fn beyond<L: Lanes>(l: L, r: &[L::F; 10], p: [L::F; 3]) -> L::M {
 
 /// The scalar tie rule for the lanes of `tie` (their edge tests replaced).
 #[inline(always)]
-fn ties<L: Lanes, G: Projected<L>>(
+fn ties<L: Lanes, G: Projected<L>, const B: bool>(
     l: L,
-    pk: &Pack<L, G>,
+    pk: &Pack<L, G, B>,
     d: L::I,
     v: &G::Vert,
     tie: L::M,
@@ -354,10 +360,10 @@ fn ties<L: Lanes, G: Projected<L>>(
 /// and refill the lane (or park it). Only what ending or crossing needs is
 /// read from the registers. Returns the number of lanes parked.
 #[inline(always)]
-fn events<L: Lanes, G: Projected<L>>(
+fn events<L: Lanes, G: Projected<L>, const B: bool>(
     l: L,
     feed: &mut Feed<'_>,
-    pk: &mut Pack<L, G>,
+    pk: &mut Pack<L, G, B>,
     r: &Round<L>,
 ) -> usize {
     let mut parked = 0;
@@ -390,10 +396,10 @@ fn events<L: Lanes, G: Projected<L>>(
 /// refills them, handing over at once the new walks whose first tet is the
 /// gate's too. Returns the number of lanes parked.
 #[inline(always)]
-fn gate_lanes<L: Lanes, G: Projected<L>, GT: Gate<Handover>>(
+fn gate_lanes<L: Lanes, G: Projected<L>, GT: Gate<Handover>, const B: bool>(
     l: L,
     feed: &mut Feed<'_>,
-    pk: &mut Pack<L, G>,
+    pk: &mut Pack<L, G, B>,
     gate: &mut GT,
     stop: u32,
 ) -> usize {
@@ -420,45 +426,45 @@ fn gate_lanes<L: Lanes, G: Projected<L>, GT: Gate<Handover>>(
 
 /// The projected walk of geometry `G` over the record reads `X`, for the
 /// driver ([`run`]).
-struct Walk<'a, G, X> {
+struct Walk<'a, G, X, const B: bool> {
     records: X,
     points: &'a [Vec3],
     cap: u32,
     _geometry: PhantomData<fn() -> G>,
 }
 
-impl<G, X: Copy> Clone for Walk<'_, G, X> {
+impl<G, X: Copy, const B: bool> Clone for Walk<'_, G, X, B> {
     fn clone(&self) -> Self {
         *self
     }
 }
 
-impl<G, X: Copy> Copy for Walk<'_, G, X> {}
+impl<G, X: Copy, const B: bool> Copy for Walk<'_, G, X, B> {}
 
-impl<'a, L: Lanes, G: Projected<L>, X: Records<L>> Rounds<L> for Walk<'a, G, X> {
+impl<'a, L: Lanes, G: Projected<L>, X: Records<L>, const B: bool> Rounds<L> for Walk<'a, G, X, B> {
     type Feed = Feed<'a>;
-    type Pack = Pack<L, G>;
+    type Pack = Pack<L, G, B>;
     type Round = Round<L>;
     type Handover = Handover;
 
     #[inline(always)]
-    fn fill(&self, l: L, feed: &mut Feed<'a>) -> (Pack<L, G>, usize) {
+    fn fill(&self, l: L, feed: &mut Feed<'a>) -> (Pack<L, G, B>, usize) {
         Pack::fill(l, feed)
     }
     #[inline(always)]
-    fn step(&self, l: L, pk: &mut Pack<L, G>) -> Option<Round<L>> {
+    fn step(&self, l: L, pk: &mut Pack<L, G, B>) -> Option<Round<L>> {
         step(l, pk, &self.records, self.points, self.cap)
     }
     #[inline(always)]
-    fn events(&self, l: L, feed: &mut Feed<'a>, pk: &mut Pack<L, G>, r: &Round<L>) -> usize {
+    fn events(&self, l: L, feed: &mut Feed<'a>, pk: &mut Pack<L, G, B>, r: &Round<L>) -> usize {
         events(l, feed, pk, r)
     }
     #[inline(always)]
-    fn entering(&self, l: L, pk: &Pack<L, G>) -> (L::Arr<u32>, u32) {
+    fn entering(&self, l: L, pk: &Pack<L, G, B>) -> (L::Arr<u32>, u32) {
         (L::i_lanes(pk.next), l.bits(pk.live))
     }
     #[inline(always)]
-    fn entering_is(&self, l: L, pk: &Pack<L, G>, tet: u32) -> u32 {
+    fn entering_is(&self, l: L, pk: &Pack<L, G, B>, tet: u32) -> u32 {
         l.bits(l.and_m(l.eq_i(pk.next, l.splat_i(tet)), pk.live))
     }
     #[inline(always)]
@@ -466,7 +472,7 @@ impl<'a, L: Lanes, G: Projected<L>, X: Records<L>> Rounds<L> for Walk<'a, G, X> 
         &self,
         l: L,
         feed: &mut Feed<'a>,
-        pk: &mut Pack<L, G>,
+        pk: &mut Pack<L, G, B>,
         gate: &mut GT,
         stop: u32,
     ) -> usize {
@@ -582,6 +588,8 @@ where
         bounded,
         ..
     } = batch;
+    // A gate's handover does not carry a bound: gated walks are whole.
+    let bounded = bounded && !GT::ON;
     let mut feed = Feed::new(mesh, rays, starts, out, bounded);
     if mesh.points.is_empty() {
         // No walk starts without points (a start tet has vertices): the
@@ -591,26 +599,57 @@ where
     }
     let points = &mesh.points[..];
     match gathered {
-        Some(records) => {
-            let w = Walk::<G, _> {
-                records,
-                points,
-                cap,
-                _geometry: PhantomData,
-            };
-            run::<L, _, GT, PACKS>(l, w, &mut feed, gate);
-        }
-        None => {
-            let w = Walk::<G, _> {
-                records: PerLane(topo),
-                points,
-                cap,
-                _geometry: PhantomData,
-            };
-            run::<L, _, GT, PACKS>(l, w, &mut feed, gate);
-        }
+        Some(records) => run_bounded_or_not::<L, G, _, GT, PACKS>(
+            l, records, points, cap, bounded, &mut feed, gate,
+        ),
+        None => run_bounded_or_not::<L, G, _, GT, PACKS>(
+            l,
+            PerLane(topo),
+            points,
+            cap,
+            bounded,
+            &mut feed,
+            gate,
+        ),
     }
     Ok(())
+}
+
+/// [`run`] of the walk over `records`, compiled apart for bounded walks
+/// ([`crate::walk::reach`]) so that the plain walk carries none of their
+/// work (measured 3.7 % slower on Torus Knots' camera rays when it did).
+#[inline(always)]
+fn run_bounded_or_not<'a, L, G, X, GT, const PACKS: usize>(
+    l: L,
+    records: X,
+    points: &'a [Vec3],
+    cap: u32,
+    bounded: bool,
+    feed: &mut Feed<'a>,
+    gate: &mut GT,
+) where
+    L: Lanes,
+    G: Projected<L>,
+    X: Records<L> + Copy,
+    GT: Gate<Handover>,
+{
+    if bounded {
+        let w = Walk::<G, X, true> {
+            records,
+            points,
+            cap,
+            _geometry: PhantomData,
+        };
+        run::<L, _, GT, PACKS>(l, w, feed, gate);
+    } else {
+        let w = Walk::<G, X, false> {
+            records,
+            points,
+            cap,
+            _geometry: PhantomData,
+        };
+        run::<L, _, GT, PACKS>(l, w, feed, gate);
+    }
 }
 
 /// The projected walk with Duff's 2-D basis ([`crate::DuffF32`]): the

@@ -42,12 +42,26 @@ impl<'a> ClearPositions<'a> {
         self.reported.push(p);
     }
 
-    /// The value nearest `want` at which `plane`'s axis, inside the box
-    /// `lo..hi` of its node, passes every point in that box at least twice
-    /// the tolerance away (and stays that far inside the box); `None` when
-    /// no gap between the points is wide enough, or when the only clear
-    /// value is the plane's own.
-    pub(super) fn value(&self, plane: SplitPlane, lo: Vec3, hi: Vec3, want: f64) -> Option<f32> {
+    /// Where `plane`, inside the box `lo..hi` of its node, may go near
+    /// `want`: within `reach` of it, the value farthest from every point
+    /// in that box (the middle of the widest gap there, ties to the
+    /// nearer), provided that is at least twice the tolerance; else the
+    /// value nearest `want` anywhere in the box that is that far from
+    /// every point. Always at least that far inside the box, never the
+    /// plane's own value; `None` when no gap is wide enough.
+    ///
+    /// Clearance, not just tolerance: a wall barely clear of a vertex
+    /// leaves TetGen a feature as thin as the gap (measured: parts stuck
+    /// past their time limit next to walls moved to the nearest clear
+    /// value at 30 M triangles).
+    pub(super) fn value(
+        &self,
+        plane: SplitPlane,
+        lo: Vec3,
+        hi: Vec3,
+        want: f64,
+        reach: f64,
+    ) -> Option<f32> {
         let a = plane.axis;
         let margin = 2.0 * self.tolerance;
         let slack = Vec3::splat(self.tolerance as f32);
@@ -70,26 +84,54 @@ impl<'a> ClearPositions<'a> {
             let right = coords.get(i).map_or(f64::INFINITY, |&c| c - x);
             v != plane.value && left.min(right) >= margin
         };
+        // The widest clearance within reach of `want`.
+        let (wlo, whi) = (want - reach, want + reach);
+        let mut widest: Option<(f64, f64, f32)> = None;
+        for w in coords.windows(2) {
+            let (from, to) = (w[0].max(wlo), w[1].min(whi));
+            if from > to {
+                continue;
+            }
+            let v = round_within((0.5 * (w[0] + w[1])).clamp(from, to), from, to);
+            let x = v as f64;
+            let room = (x - w[0]).min(w[1] - x);
+            let d = (x - want).abs();
+            let better = widest.is_none_or(|(r, bd, _)| room > r || (room == r && d < bd));
+            if better && clear(v) {
+                widest = Some((room, d, v));
+            }
+        }
+        if let Some((_, _, v)) = widest {
+            return Some(v);
+        }
         let mut best: Option<(f64, f32)> = None;
         for w in coords.windows(2) {
             let (from, to) = (w[0] + margin, w[1] - margin);
             if from > to {
                 continue;
             }
-            // The f32 nearest `want` in the gap, stepped back into it where
-            // rounding took it out (the check is on the rounded value).
-            let mut v = want.clamp(from, to) as f32;
-            if (v as f64) < from {
-                v = v.next_up();
-            } else if (v as f64) > to {
-                v = v.next_down();
-            }
+            // The f32 nearest `want` in the gap (the check is on the
+            // rounded value).
+            let v = round_within(want.clamp(from, to), from, to);
             let d = (v as f64 - want).abs();
             if best.is_none_or(|(bd, _)| d < bd) && clear(v) {
                 best = Some((d, v));
             }
         }
         best.map(|(_, v)| v)
+    }
+}
+
+/// `x` (in `from..=to`) rounded to f32, stepped back into the interval
+/// where rounding took it out.
+fn round_within(x: f64, from: f64, to: f64) -> f32 {
+    let v = x as f32;
+    if (v as f64) < from {
+        v.next_up()
+    } else if (v as f64) > to {
+        v.next_down()
+    } else {
+        v
     }
 }
 
@@ -108,10 +150,11 @@ mod tests {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// Points every 0.01 along x but for one gap: the wanted value inside
-    /// the dense run moves to the gap's nearer clear edge; a wanted value
-    /// already clear is kept; points outside the box (on the other axes)
-    /// do not count; without a wide enough gap there is no value.
+    /// Points every 0.01 along x but for one gap: a wanted value in the
+    /// dense run with no wide gap within reach moves to the gap's nearer
+    /// clear edge; one with the gap within reach to the gap's middle;
+    /// points outside the box (on the other axes) do not count; without a
+    /// wide enough gap there is no value.
     #[test]
     fn a_moved_plane_lands_in_the_nearest_gap_wide_enough() {
         let tol = 0.01;
@@ -125,24 +168,31 @@ mod tests {
         vs.push(Vec3::new(0.65, 3.0, 0.5));
         let (lo, hi) = (Vec3::ZERO, Vec3::ONE);
         let clear = ClearPositions::new(&vs, tol);
-        let v = clear.value(plane(0.3), lo, hi, 0.3).unwrap();
+        let v = clear.value(plane(0.3), lo, hi, 0.3, 0.1).unwrap();
         assert!(nearest(&xs, v) >= 2.0 * tol - 1e-7, "{v}");
         assert!((v - 0.61).abs() < 1e-6, "the gap's lower clear edge: {v}");
-        // Wanted 0.66, inside the gap already: kept.
-        assert_eq!(clear.value(plane(0.3), lo, hi, 0.66), Some(0.66));
+        // Wanted 0.66, the gap within reach: its middle; wanted 0.52, the
+        // gap's part within reach: its clearest value, the reach's end.
+        for (want, at) in [(0.66, 0.645), (0.52, 0.62)] {
+            let v = clear.value(plane(0.3), lo, hi, want, 0.1).unwrap();
+            assert!((v - at).abs() < 1e-6, "{want}: {v}");
+        }
         // Reported points in the gap close it.
         let mut closed = ClearPositions::new(&vs, tol);
         for x in [0.62, 0.645, 0.67] {
             closed.avoid(Vec3::new(x, 0.5, 0.5));
         }
-        assert_eq!(closed.value(plane(0.3), lo, hi, 0.3), None);
+        assert_eq!(closed.value(plane(0.3), lo, hi, 0.3, 0.1), None);
         // The plane's own value is no move.
-        assert_ne!(clear.value(plane(0.66), lo, hi, 0.66), Some(0.66));
+        let middle = clear.value(plane(0.3), lo, hi, 0.66, 0.1).unwrap();
+        assert_ne!(clear.value(plane(middle), lo, hi, 0.66, 0.1), Some(middle));
     }
 
     /// Random clouds: whatever the value, it is clear of every point in the
-    /// box and inside the box by twice the tolerance, and no clear value
-    /// on a fine grid lies nearer the wanted one.
+    /// box and inside the box by twice the tolerance; where some value
+    /// within reach is clear, it lies within reach and no value on a fine
+    /// grid there is farther from the points; else no clear value on the
+    /// grid lies nearer the wanted one.
     #[test]
     fn a_clear_value_is_clear_and_nearest() {
         let mut rng = tet_core::synthetic::SplitMix64(7);
@@ -158,15 +208,22 @@ mod tests {
             let mut edges = xs.clone();
             edges.extend([0.0, 1.0]);
             let ok = |v: f32| nearest(&edges, v) >= 2.0 * tol && v != 2.0;
-            match clear.value(plane(2.0), lo, hi, want) {
+            let reach = 0.05;
+            let grid = || (0..=10_000).map(|k| k as f32 / 10_000.0);
+            let within = |g: f32| (g as f64 - want).abs() <= reach;
+            match clear.value(plane(2.0), lo, hi, want, reach) {
+                Some(v) if grid().any(|g| within(g) && ok(g)) => {
+                    assert!(ok(v) && within(v), "round {round}: {v}");
+                    let room = nearest(&edges, v);
+                    for g in grid().filter(|&g| within(g)) {
+                        assert!(nearest(&edges, g) <= room + 1e-6, "{g} clearer than {v}");
+                    }
+                }
                 Some(v) => {
                     assert!(ok(v), "round {round}: {v}");
                     let d = (v as f64 - want).abs();
-                    for k in 0..=10_000 {
-                        let g = k as f32 / 10_000.0;
-                        if ok(g) {
-                            assert!((g as f64 - want).abs() >= d - 1e-6, "{g} nearer than {v}");
-                        }
+                    for g in grid().filter(|&g| ok(g)) {
+                        assert!((g as f64 - want).abs() >= d - 1e-6, "{g} nearer than {v}");
                     }
                 }
                 None => {

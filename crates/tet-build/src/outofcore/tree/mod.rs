@@ -347,7 +347,7 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                 // Where no gap is wide enough in the whole box (only the
                 // pieces crossing the node are checked), the fixed step.
                 let mut to = |p: SplitPlane, lo, hi| {
-                    let v = clear.value(p, lo, hi, p.value as f64);
+                    let v = clear.value(p, lo, hi, p.value as f64, step / 2.0);
                     v.or(Some((p.value as f64 + step) as f32))
                 };
                 if moves >= MAX_PLANE_MOVES || !tree.move_plane(plane, b.min, b.max, &mut to) {
@@ -382,7 +382,9 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                 let mut moved = false;
                 let mut to = |p: SplitPlane, lo, hi| {
                     let want = p.value as f64 + step;
-                    clear.value(p, lo, hi, want).or(Some(want as f32))
+                    clear
+                        .value(p, lo, hi, want, step / 2.0)
+                        .or(Some(want as f32))
                 };
                 for plane in walls {
                     moved |= tree.move_plane(plane, b.min, b.max, &mut to);
