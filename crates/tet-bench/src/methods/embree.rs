@@ -284,6 +284,7 @@ trait Packet {
     fn hit(&self, i: usize) -> Option<(u32, f32)>;
 }
 
+/// [`Packet`] for one of Embree's packet types and its `rtcIntersectN`.
 macro_rules! packet {
     ($t:ty, $ray:ty, $hit:ty, $n:literal, $intersect:ident) => {
         impl Packet for $t {
@@ -441,18 +442,18 @@ mod tests {
         let (mut conts, mut starts, mut singles) = (Vec::new(), Vec::new(), Vec::new());
         for aim in [Aim::Random, Aim::Vertex, Aim::EdgeMidpoint] {
             // Rays of one batch share a start tet, as in a render tile.
-            let (r0, t0) = random_ray(&mesh, &mut rng, aim);
+            let (r0, t0) = random_ray(mesh, &mut rng, aim);
             let mut rays = vec![r0];
             while rays.len() < 203 {
-                let (r, _) = random_ray(&mesh, &mut rng, aim);
+                let (r, _) = random_ray(mesh, &mut rng, aim);
                 rays.push(Ray::new(r0.origin, r.direction));
             }
             let mut batch = vec![TraceOutcome::Miss { tets_visited: 0 }; rays.len()];
             packets.trace_batch(&rays, Start::Tet(t0), &mut batch);
             for (ray, b) in rays.iter().zip(&batch) {
                 let s = single.trace(ray, Start::Tet(t0));
-                let want = closest_hit(&mesh, ray);
-                if grazes_an_edge(&mesh, ray, 1e-4) {
+                let want = closest_hit(mesh, ray);
+                if grazes_an_edge(mesh, ray, 1e-4) {
                     continue;
                 }
                 checked += 1;
