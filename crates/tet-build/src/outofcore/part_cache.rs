@@ -23,8 +23,9 @@ use std::hash::{Hash, Hasher};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use glam::Vec3;
+
 use super::facet_faces::FacetKind;
-use super::parts::PartFacetList;
 
 /// What identifies a part's PLC (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -35,14 +36,14 @@ pub(super) struct PlcPrint {
 }
 
 impl PlcPrint {
-    /// The print of one part's PLC.
-    pub(super) fn of(list: &PartFacetList) -> PlcPrint {
+    /// The print of one part's PLC: its facets and box faces.
+    pub(super) fn of(facets: &[([Vec3; 3], FacetKind)], box_faces: &[[Vec3; 3]]) -> PlcPrint {
         let mut digests = [0u64; 2];
         for (salt, d) in digests.iter_mut().enumerate() {
             // Fixed keys (the same for every `new` in a run), salted.
             let mut h = std::hash::DefaultHasher::new();
             salt.hash(&mut h);
-            for (t, kind) in &list.facets {
+            for (t, kind) in facets {
                 for p in t {
                     p.to_array().map(f32::to_bits).hash(&mut h);
                 }
@@ -51,7 +52,7 @@ impl PlcPrint {
                     FacetKind::Seam => (1u8, 0u32).hash(&mut h),
                 }
             }
-            for t in &list.box_faces {
+            for t in box_faces {
                 for p in t {
                     p.to_array().map(f32::to_bits).hash(&mut h);
                 }
@@ -59,8 +60,8 @@ impl PlcPrint {
             *d = h.finish();
         }
         PlcPrint {
-            facets: list.facets.len(),
-            box_faces: list.box_faces.len(),
+            facets: facets.len(),
+            box_faces: box_faces.len(),
             digests,
         }
     }
@@ -111,13 +112,13 @@ impl<T> PartCache<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec3;
 
-    fn list(corner: f32, kind: FacetKind) -> PartFacetList {
-        PartFacetList {
-            facets: vec![([Vec3::ZERO, Vec3::X, Vec3::new(0.0, corner, 0.0)], kind)],
-            box_faces: vec![],
-        }
+    /// The print of a PLC of one facet.
+    fn print(corner: f32, kind: FacetKind) -> PlcPrint {
+        PlcPrint::of(
+            &[([Vec3::ZERO, Vec3::X, Vec3::new(0.0, corner, 0.0)], kind)],
+            &[],
+        )
     }
 
     /// The same PLC gives the same print; a corner one ulp away, another
@@ -125,21 +126,18 @@ mod tests {
     /// handed back once, and only for its own print.
     #[test]
     fn a_part_comes_back_only_for_the_same_plc() {
-        let a = PlcPrint::of(&list(1.0, FacetKind::Scene(3)));
-        assert_eq!(a, PlcPrint::of(&list(1.0, FacetKind::Scene(3))));
-        assert_ne!(
-            a,
-            PlcPrint::of(&list(1.0f32.next_up(), FacetKind::Scene(3)))
-        );
-        assert_ne!(a, PlcPrint::of(&list(1.0, FacetKind::Scene(4))));
-        assert_ne!(a, PlcPrint::of(&list(1.0, FacetKind::Seam)));
+        let a = print(1.0, FacetKind::Scene(3));
+        assert_eq!(a, print(1.0, FacetKind::Scene(3)));
+        assert_ne!(a, print(1.0f32.next_up(), FacetKind::Scene(3)));
+        assert_ne!(a, print(1.0, FacetKind::Scene(4)));
+        assert_ne!(a, print(1.0, FacetKind::Seam));
         let cache = PartCache::default();
         cache.keep(2, a, "part 2");
         assert_eq!(cache.take(1, a), None);
         assert_eq!(cache.take(2, a), Some("part 2"));
         assert_eq!(cache.take(2, a), None, "handed back once");
         cache.keep(2, a, "part 2");
-        let b = PlcPrint::of(&list(2.0, FacetKind::Scene(3)));
+        let b = print(2.0, FacetKind::Scene(3));
         assert_eq!(cache.take(2, b), None, "another PLC");
         assert_eq!(cache.take(2, a), None, "dropped by the miss");
         assert_eq!(cache.reused(), 1);

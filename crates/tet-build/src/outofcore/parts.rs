@@ -402,7 +402,7 @@ pub(super) fn run_parts<T: Send>(
             }
             let k = order[i];
             let r = parts.facets(k).and_then(|list| {
-                let print = cache.map(|_| PlcPrint::of(&list));
+                let print = cache.map(|_| PlcPrint::of(&list.facets, &list.box_faces));
                 if let (Some(c), Some(p)) = (cache, print)
                     && let Some(kept) = c.take(k, p)
                 {
