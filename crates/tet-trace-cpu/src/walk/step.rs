@@ -54,8 +54,10 @@ pub fn trace<P: Projection, T: Topology>(
     }
 }
 
-/// [`trace`] as a bounded walk ([`super::reach`]): it ends as a miss as
-/// soon as the face it leaves through lies wholly past `ray.t_max`. The
+/// [`trace`] as a bounded walk: it ends as a miss as soon as the face it
+/// leaves through lies wholly past `ray.t_max` (by a conservative f32
+/// test on each vertex, the same in the SIMD lockstep walk; the rule and
+/// its error bound are in the crate's `walk/reach.rs`). The
 /// same hit or miss as [`trace`] (a walk that would reach the step cap
 /// past `t_max` ends as a miss instead), in fewer tets.
 pub fn trace_within<P: Projection, T: Topology>(
