@@ -115,6 +115,27 @@ impl<'m, L: Topology, P: Projection> WalkTracer<'m, L, P> {
             bounded: false,
         }
     }
+
+    /// `walk` on the batch of `rays` from `starts` into `out` (over the
+    /// shortest of the three), bounded or not, then the exact walk where
+    /// a walk reached the step cap: what every batch entry of the
+    /// projected kernels does, whichever batch walk it takes.
+    fn walk_batch(
+        &self,
+        rays: &[Ray],
+        starts: Starts<'_>,
+        out: &mut [TraceOutcome],
+        bounded: bool,
+        walk: impl FnOnce(Batch<'_, L>),
+    ) {
+        let n = starts.batch_len(rays.len(), out.len());
+        let (rays, out) = (&rays[..n], &mut out[..n]);
+        walk(Batch {
+            bounded,
+            ..self.batch(rays, starts, out)
+        });
+        exact_where_lost(self.mesh, self.cap, rays, starts, out);
+    }
 }
 
 impl<L: Topology, P: BatchWalk> Tracer for WalkTracer<'_, L, P> {
@@ -135,10 +156,7 @@ impl<L: Topology, P: BatchWalk> Tracer for WalkTracer<'_, L, P> {
         self.trace_batch_from(rays, Starts::Same(start), out)
     }
     fn trace_batch_from(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
-        let n = starts.batch_len(rays.len(), out.len());
-        let (rays, out) = (&rays[..n], &mut out[..n]);
-        P::trace_batch(self.batch(rays, starts, out));
-        exact_where_lost(self.mesh, self.cap, rays, starts, out);
+        self.walk_batch(rays, starts, out, false, P::trace_batch);
     }
     /// The bounded walk ([`trace_within`]), the exact walk where it
     /// reaches the step cap.
@@ -149,13 +167,7 @@ impl<L: Topology, P: BatchWalk> Tracer for WalkTracer<'_, L, P> {
     /// In SIMD lockstep where the CPU has it, each walk bounded as
     /// [`Tracer::trace_within`] bounds it.
     fn trace_batch_within(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
-        let n = starts.batch_len(rays.len(), out.len());
-        let (rays, out) = (&rays[..n], &mut out[..n]);
-        P::trace_batch(Batch {
-            bounded: true,
-            ..self.batch(rays, starts, out)
-        });
-        exact_where_lost(self.mesh, self.cap, rays, starts, out);
+        self.walk_batch(rays, starts, out, true, P::trace_batch);
     }
     fn trace_until(&self, ray: &Ray, start: Start, stop: &[u32]) -> TraceOutcome {
         let cap = step_cap(self.mesh);
@@ -200,23 +212,16 @@ impl<L: Topology, P: BatchWalk> Tracer for Interleaved<'_, '_, L, P> {
         self.0.trace(ray, start)
     }
     fn trace_batch(&self, rays: &[Ray], start: Start, out: &mut [TraceOutcome]) {
-        let w = self.0;
-        let starts = Starts::Same(start);
-        trace_interleaved::<P, L, LANES>(w.batch(rays, starts, out));
-        exact_where_lost(w.mesh, w.cap, rays, starts, out);
+        let walk = trace_interleaved::<P, L, LANES>;
+        self.0
+            .walk_batch(rays, Starts::Same(start), out, false, walk);
     }
     fn trace_within(&self, ray: &Ray, start: Start) -> TraceOutcome {
         self.0.trace_within(ray, start)
     }
     fn trace_batch_within(&self, rays: &[Ray], starts: Starts<'_>, out: &mut [TraceOutcome]) {
-        let w = self.0;
-        let n = starts.batch_len(rays.len(), out.len());
-        let (rays, out) = (&rays[..n], &mut out[..n]);
-        trace_interleaved::<P, L, LANES>(Batch {
-            bounded: true,
-            ..w.batch(rays, starts, out)
-        });
-        exact_where_lost(w.mesh, w.cap, rays, starts, out);
+        let walk = trace_interleaved::<P, L, LANES>;
+        self.0.walk_batch(rays, starts, out, true, walk);
     }
 }
 
