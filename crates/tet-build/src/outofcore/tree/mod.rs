@@ -244,11 +244,12 @@ pub const MAX_PART_MOVES: usize = 2;
 /// `split.limit_bytes`, then builds it ([`build_tree`]). A plane that
 /// meets a degenerate configuration only the build can see (a point made
 /// by an earlier cut within tolerance of it, [`SeamError::PlaneNearPoint`]
-/// or [`SeamError::DegenerateCut`]) is moved to the nearest position
-/// clear of that point and of the scene's vertices in its box, and the
-/// build retried, at most [`MAX_PLANE_MOVES`] times; the walls of a part
-/// TetGen fails on or runs past its time limit on are moved by about
-/// 1/4096 of the box's extent (to the nearest clear position), at most
+/// or [`SeamError::DegenerateCut`]) is moved, within half a step (1/4096
+/// of the box's extent), to the value farthest from that point and the
+/// scene's vertices in its box ([`clear`]), and the build retried, at
+/// most [`MAX_PLANE_MOVES`] times; the walls of a part TetGen fails on or
+/// runs past its time limit on are moved by about a step (likewise to
+/// the clearest value within half a step of it), at most
 /// [`MAX_PART_MOVES`] times. A retry runs TetGen only on the parts whose
 /// input the moves changed: the others are kept from the attempt before
 /// (see `part_cache`).
@@ -323,7 +324,8 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
     let (mut moves, mut part_moves) = (0, 0);
     let tolerance = NEAR_PLANE * (b.max - b.min).max_element() as f64;
     let mut clear = ClearPositions::new(&scene.vertices, tolerance);
-    // A part's walls move by this much (to the nearest clear value).
+    // A part's walls move by about this much (to the clearest value within
+    // half of it; see `clear`).
     let step = (b.max - b.min).max_element() as f64 / 4096.0;
     loop {
         match build(&tree) {
@@ -337,8 +339,8 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                     },
                 ));
             }
-            // The plane moves to the nearest value clear of the point and
-            // of every scene vertex in its box.
+            // The plane moves to the value farthest from the point and
+            // every scene vertex in its box, within half a step.
             Err(
                 e @ (SeamError::PlaneNearPoint { plane, point, .. }
                 | SeamError::DegenerateCut { plane, point, .. }),
