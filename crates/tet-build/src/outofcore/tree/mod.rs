@@ -246,7 +246,7 @@ pub const MAX_PART_MOVES: usize = 2;
 /// by an earlier cut within tolerance of it, [`SeamError::PlaneNearPoint`]
 /// or [`SeamError::DegenerateCut`]) is moved, within half a step (1/4096
 /// of the box's extent), to the value farthest from that point and the
-/// scene's vertices in its box ([`clear`]), and the build retried, at
+/// scene's vertices in its box (module `clear`), and the build retried, at
 /// most [`MAX_PLANE_MOVES`] times; the walls of a part TetGen fails on or
 /// runs past its time limit on are moved by about a step (likewise to
 /// the clearest value within half a step of it), at most
