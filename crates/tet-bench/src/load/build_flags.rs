@@ -32,7 +32,11 @@ pub struct BuildFlags {
     /// a tet (`-o/`; TetGen's default 165).
     #[arg(long, value_name = "DEGREES")]
     pub max_dihedral: Option<f64>,
-    /// Time limit for TetGen in seconds (the build runs in a worker process).
+    /// Time limit for TetGen in seconds (the build runs in a worker
+    /// process). A part of a walled or out-of-core build has at most 10 s
+    /// plus 2 ms per point and triangle of its input, about twenty times
+    /// what such a part takes; one that runs longer is stuck, and has its
+    /// walls moved and is built again.
     #[arg(long, default_value_t = 600.0)]
     pub time_limit: f64,
     /// Do not add the enclosing box around the scene.

@@ -301,14 +301,6 @@ pub fn build_scene_in(
     Ok((mesh, summary))
 }
 
-/// `--walls auto`: the time limit of one part's TetGen run, seconds (or
-/// `--time-limit` where lower). Its parts are predicted at about 28 MiB
-/// and built in about a second; a run far past that is stuck (TetGen's
-/// boundary recovery under `-Y` can loop), and the build moves the part's
-/// walls and tries again rather than wait out the 600 s default.
-#[cfg(feature = "tetgen")]
-pub const WALLED_PART_TIME_LIMIT_S: f64 = 60.0;
-
 /// `--walls`: a scene built as parts with exact walls between them, in
 /// memory, even when it would fit one TetGen run. The out-of-core
 /// builder's recursive planes (Erkoç et al. 2021) cut the enclosing
@@ -338,16 +330,10 @@ fn build_walled(
     let spinner = spinner(quiet);
     let depth = walls.depth(scene.triangles.len());
     spinner.set_message(format!("building {} in parts with walls", scene.name));
-    let mut options = tet_build::outofcore::seam::SeamOptions {
+    let options = tet_build::outofcore::seam::SeamOptions {
         parallel_parts: std::thread::available_parallelism().map_or(1, |n| n.get()),
         ..seam_options(scene, flags, extra)?
     };
-    if walls == build_flags::Walls::Auto {
-        // Each part is small (a few thousand triangles); one that runs
-        // long has met a configuration TetGen is stuck on, which moving
-        // its walls or the next split or one piece resolves sooner.
-        options.isolation = worker_isolation(flags.time_limit.min(WALLED_PART_TIME_LIMIT_S))?;
-    }
     // `auto`: the parts as the memory planner cuts them for a small
     // target (dense regions split, light ones and empty margins left
     // whole), or, should that build fail, every part split to `depth`.

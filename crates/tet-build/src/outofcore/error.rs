@@ -177,12 +177,53 @@ pub enum SeamError {
         /// How many.
         count: usize,
     },
+    /// Several parts failed in one attempt of a build that retries, each
+    /// in a way that moving its walls may cure ([`SeamError::part_to_retry`]),
+    /// in part order (never fewer than two).
+    #[error("{} parts failed; the first: {}", .0.len(), .0.first().map_or(String::new(), |e| e.to_string()))]
+    PartsFailed(Vec<SeamError>),
     /// Assembly or validation of the merged mesh failed.
     #[error("merged mesh: {0}")]
     Mesh(#[from] MeshError),
     /// Writing a part file or streaming the parts into the mesh file failed.
     #[error("streaming merge: {0}")]
     Stream(#[from] StreamError),
+}
+
+impl SeamError {
+    /// The part whose walls a retry moves, where this is TetGen failing on
+    /// one part in a way a slightly different PLC may not meet: running
+    /// past its time limit (its boundary recovery under `-Y` looping), a
+    /// crash, its own internal or small-feature errors, or Steiner points
+    /// that flatten tets when rounded to f32.
+    pub fn part_to_retry(&self) -> Option<usize> {
+        match self {
+            SeamError::Tetgen {
+                part,
+                source:
+                    TetgenError::Timeout { .. }
+                    | TetgenError::Internal
+                    | TetgenError::SmallFeature
+                    | TetgenError::CloseFacets
+                    | TetgenError::Other(_)
+                    | TetgenError::WorkerDied { .. },
+            }
+            | SeamError::RoundingFlattens { part, .. } => Some(*part),
+            _ => None,
+        }
+    }
+
+    /// Every part whose walls a retry moves ([`SeamError::part_to_retry`],
+    /// also for each of [`SeamError::PartsFailed`]); empty when this
+    /// failure is not one a retry may cure.
+    pub fn parts_to_retry(&self) -> Vec<usize> {
+        match self {
+            SeamError::PartsFailed(all) => {
+                all.iter().filter_map(SeamError::part_to_retry).collect()
+            }
+            e => e.part_to_retry().into_iter().collect(),
+        }
+    }
 }
 
 /// A failure of the part files or of the streaming merge; each names the

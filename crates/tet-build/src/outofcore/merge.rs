@@ -18,7 +18,7 @@ pub(super) struct PartInputs<'a> {
     /// Each part's PLC facets, made when the part is taken up.
     pub(super) parts: Box<dyn PartFacets + 'a>,
     /// Input scene triangle of each cleaned one.
-    pub(super) triangle_source: Vec<u32>,
+    pub(super) triangle_source: std::borrow::Cow<'a, [u32]>,
     /// Input scene triangles.
     pub(super) triangle_count: u32,
 }

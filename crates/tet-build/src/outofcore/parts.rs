@@ -4,6 +4,7 @@
 //! [`SeamReport`] of a split build.
 
 use std::collections::HashMap;
+use std::time::Duration;
 
 use glam::{DVec3, Vec3};
 
@@ -231,6 +232,23 @@ pub(super) fn run_part(
     run_plc(part, facets, PartPlc::new(facets, box_faces), options)
 }
 
+/// The time limit of one part's TetGen run in a build that retries:
+/// [`PART_TIME_FLOOR`] plus [`PART_TIME_PER_ELEMENT`] for each point and
+/// triangle of its PLC, about twenty times what such a part takes. A run
+/// far past its size's time has met a configuration TetGen's boundary
+/// recovery loops on (at 30 M triangles, one part in tens); the build
+/// moves that part's walls and tries again sooner than a fixed limit
+/// sized for the largest part would let it.
+pub(super) fn part_time_limit(points: usize, triangles: usize) -> Duration {
+    PART_TIME_FLOOR + PART_TIME_PER_ELEMENT * (points + triangles).min(u32::MAX as usize) as u32
+}
+
+/// See [`part_time_limit`].
+pub(super) const PART_TIME_FLOOR: Duration = Duration::from_secs(10);
+
+/// See [`part_time_limit`].
+pub(super) const PART_TIME_PER_ELEMENT: Duration = Duration::from_millis(2);
+
 /// TetGen runs on one part before rounding gives up: the first, then
 /// re-runs with rounded Steiner points as input points.
 const MAX_PART_ROUNDS: usize = 4;
@@ -374,9 +392,14 @@ pub(super) fn self_intersection(
 /// start last), which keeps both threads busy when parts differ in size.
 /// Each part is handed to `finish` on its thread as soon as its TetGen
 /// run returns. Results are in part order; the first error (in part order)
-/// is returned. With a `cache`, a part whose PLC is one the cache kept is
-/// taken from it instead of run, and when a part fails, the parts
-/// finished are kept there for the next attempt ([`PartCache`]).
+/// is returned. With a `cache` (a build that retries), a part whose PLC is
+/// one the cache kept is taken from it instead of run; a part that fails
+/// in a way a retry may cure ([`SeamError::part_to_retry`]) does not stop
+/// the others, so that one attempt finds every such part (returned as
+/// [`SeamError::PartsFailed`] when there are several); each part's TetGen
+/// run has [`part_time_limit`] (under the isolation's own limit); and
+/// when any part fails, the parts finished are kept in the cache for the
+/// next attempt ([`PartCache`]).
 pub(super) fn run_parts<T: Send>(
     parts: &dyn PartFacets,
     options: &SeamOptions,
@@ -412,10 +435,28 @@ pub(super) fn run_parts<T: Send>(
                 // Held until the part is handed on: this process's share
                 // of the result counts as long as the worker's.
                 let _ticket = admission.enter(plc.predicted_peak_bytes());
-                let part = run_plc(k, &list.facets, plc, options).and_then(|m| finish(k, m))?;
+                let timed;
+                let part_options = match (cache, &options.isolation) {
+                    (Some(_), Isolation::Worker(w)) => {
+                        let limit =
+                            part_time_limit(plc.input.points.len(), plc.input.triangles.len());
+                        let mut w = w.clone();
+                        w.timeout = Some(w.timeout.map_or(limit, |t| t.min(limit)));
+                        timed = SeamOptions {
+                            isolation: Isolation::Worker(w),
+                            ..options.clone()
+                        };
+                        &timed
+                    }
+                    _ => options,
+                };
+                let part =
+                    run_plc(k, &list.facets, plc, part_options).and_then(|m| finish(k, m))?;
                 Ok((print, part))
             });
-            if r.is_err() {
+            if let Err(e) = &r
+                && (cache.is_none() || e.part_to_retry().is_none())
+            {
                 failed.store(true, Ordering::Relaxed);
             }
             *results[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
@@ -432,16 +473,23 @@ pub(super) fn run_parts<T: Send>(
         });
     }
     let mut out = Vec::with_capacity(count);
-    let mut first_error = None;
+    // A failure a retry cannot cure comes first: retrying would meet it again.
+    let (mut fatal, mut curable) = (None, Vec::new());
     for (k, r) in results.into_iter().enumerate() {
         match r.into_inner().unwrap_or_else(|e| e.into_inner()) {
             Some(Ok(m)) => out.push((k, m)),
+            Some(Err(e)) if e.part_to_retry().is_some() => curable.push(e),
             Some(Err(e)) => {
-                first_error.get_or_insert(e);
+                fatal.get_or_insert(e);
             }
             None => {}
         }
     }
+    let first_error = fatal.or_else(|| match curable.len() {
+        0 => None,
+        1 => curable.pop(),
+        _ => Some(SeamError::PartsFailed(curable)),
+    });
     match first_error {
         Some(e) => {
             if let Some(c) = cache {

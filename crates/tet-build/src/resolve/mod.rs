@@ -72,7 +72,10 @@
 //! cutting along such lines need not end.
 //!
 //! Input vertices are never moved or dropped; every piece records the input
-//! triangle it came from and its normal agrees with that triangle's. The
+//! triangle it came from and its normal agrees with that triangle's, but
+//! for a piece flat within rounding (three points collinear before
+//! rounding, e.g. a crossing point exactly on the triangle's edge rounded
+//! just off it), whose normal is rounding noise. The
 //! predicates run on `f64` with a forward error bound (`arith.rs`) and fall
 //! back to exact expansion arithmetic (`expansion.rs`) when the bound cannot
 //! decide. Exactly degenerate input triangles are an error (cleaning

@@ -23,7 +23,7 @@ use crate::outofcore::merge::PartInputs;
 use crate::outofcore::parts::{FacetKind, PartPlc, SeamOptions, SeamReport};
 use crate::outofcore::seam::slab_part_inputs;
 use crate::outofcore::split::{SlabPlan, SplitOptions, plan_slabs};
-use crate::outofcore::tree::{plan_tree_with_moves, tree_part_inputs};
+use crate::outofcore::tree::{plan_tree_with_moves, tree_part_inputs_once};
 use crate::scene::Scene;
 
 /// How to cut the scene.
@@ -153,10 +153,13 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
         ..SplitOptions::under_limit(limit, options.shaped_for_rays)
     };
     let seam = &options.seam;
+    let prepared = std::cell::OnceCell::new();
     let tree = match options.planner {
         Planner::Slabs => None,
         _ => {
-            match plan_tree_with_moves(scene, &split, seam, |t| tree_part_inputs(scene, t, seam)) {
+            match plan_tree_with_moves(scene, &split, seam, |t| {
+                tree_part_inputs_once(scene, &prepared, t, seam)
+            }) {
                 Ok(((inputs, report), plan)) => {
                     let mut next = 0;
                     let node = TreeNode::from_cut_tree(&plan.cuts, &mut next);

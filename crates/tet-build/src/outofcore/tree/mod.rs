@@ -62,7 +62,6 @@ use super::stream::{StreamOptions, StreamSummary, ToFile};
 use crate::bbox::EnclosingBox;
 use crate::clean::clean_scene;
 use crate::scene::Scene;
-use crate::tetgen::TetgenError;
 
 pub use cut_tree::CutTree;
 
@@ -122,11 +121,42 @@ pub(in crate::outofcore) fn tree_part_inputs<'a>(
     tree: &CutTree,
     options: &SeamOptions,
 ) -> Result<(PartInputs<'a>, SeamReport), SeamError> {
+    tree_part_inputs_of(scene, prepare(scene, options)?, tree, options)
+}
+
+/// [`tree_part_inputs`] prepared once: `prepared` is filled on the first
+/// call and read on the next, so that an attempt after a moved plane does
+/// not clean the scene and check it for self-intersections again (at 30 M
+/// triangles, minutes each time). Filled on the first call, not before,
+/// because a planner holds its own cleaned copy until its cut tree is made.
+pub(in crate::outofcore) fn tree_part_inputs_once<'a, 's: 'a>(
+    scene: &'s Scene,
+    prepared: &'a std::cell::OnceCell<Prepared<'s>>,
+    tree: &CutTree,
+    options: &SeamOptions,
+) -> Result<(PartInputs<'a>, SeamReport), SeamError> {
+    let p = match prepared.get() {
+        Some(p) => p,
+        None => {
+            let p = prepare(scene, options)?;
+            prepared.get_or_init(|| p)
+        }
+    };
+    tree_part_inputs_of(scene, p.again(), tree, options)
+}
+
+/// [`tree_part_inputs`] of `scene` prepared as `prepared`.
+fn tree_part_inputs_of<'a>(
+    scene: &Scene,
+    prepared: Prepared<'a>,
+    tree: &CutTree,
+    options: &SeamOptions,
+) -> Result<(PartInputs<'a>, SeamReport), SeamError> {
     let Prepared {
         scene: cleaned,
         triangle_source,
         resolve,
-    } = prepare(scene, options)?;
+    } = prepared;
     let b = EnclosingBox::new(cleaned.bounds(), options.enclosing_box)?;
     let mut cut = run_clipping(&cleaned.vertices, &cleaned.triangles, tree, b.min, b.max)?;
     prepare_walls(&mut cut, b.min, b.max);
@@ -233,10 +263,16 @@ pub struct TreePlan {
 /// a degenerate configuration before giving up.
 pub const MAX_PLANE_MOVES: usize = 8;
 
-/// How many times [`build_tree_with_memory_limit`] moves the walls of a
-/// part TetGen failed or crashed on or ran past its time limit on (each
-/// retry builds every part again) before giving up.
+/// How many times [`build_tree_with_memory_limit`] moves the walls of one
+/// part TetGen failed or crashed on or ran past its time limit on before
+/// giving up.
 pub const MAX_PART_MOVES: usize = 2;
+
+/// How many attempts after the first [`build_tree_with_memory_limit`]
+/// makes for parts TetGen failed on (each attempt moves the walls of
+/// every part that failed in the one before, and runs TetGen on the parts
+/// whose input changed) before giving up.
+pub const MAX_PART_RETRIES: usize = 6;
 
 /// The paper's `TETRA` under a memory limit: plans the recursive split of
 /// `scene` ([`super::split::plan_split`], planes avoiding vertices within
@@ -250,7 +286,13 @@ pub const MAX_PART_MOVES: usize = 2;
 /// most [`MAX_PLANE_MOVES`] times; the walls of a part TetGen fails on or
 /// runs past its time limit on are moved by about a step (likewise to
 /// the clearest value within half a step of it), at most
-/// [`MAX_PART_MOVES`] times. A retry runs TetGen only on the parts whose
+/// [`MAX_PART_MOVES`] times per part and in at most [`MAX_PART_RETRIES`]
+/// attempts. An attempt goes on past such a part, so that one retry
+/// moves the walls of every part that failed; it gives each part's TetGen
+/// run a time limit scaled to the part's size (10 s and 2 ms per point
+/// and triangle, under the worker's own limit), so that a stuck part
+/// costs about twenty times what a part of its size takes, not the
+/// limit of the largest. A retry runs TetGen only on the parts whose
 /// input the moves changed: the others are kept from the attempt before
 /// (see `part_cache`).
 pub fn build_tree_with_memory_limit(
@@ -280,8 +322,10 @@ fn build_tree_with_memory_limit_with<M: Merge>(
     merge: &M,
 ) -> Result<(M::Output, SeamReport, TreePlan), SeamError> {
     let cache = PartCache::default();
+    let prepared = std::cell::OnceCell::new();
     let ((output, report), plan) = plan_tree_with_moves(scene, split, options, |tree| {
-        build_tree_with(scene, tree, options, merge, Some(&cache))
+        let (inputs, report) = tree_part_inputs_once(scene, &prepared, tree, options)?;
+        finish_parts(inputs, report, options, merge, Some(&cache))
     })?;
     Ok((output, report, plan))
 }
@@ -321,7 +365,9 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
     let mut tree = CutTree::from_split_tree(&plan);
     plan.forget_triangles();
     drop(cleaned);
-    let (mut moves, mut part_moves) = (0, 0);
+    let (mut moves, mut retries) = (0, 0);
+    // Wall moves per part (by leaf index, which moves do not change).
+    let mut part_moves = std::collections::HashMap::<usize, usize>::new();
     let tolerance = NEAR_PLANE * (b.max - b.min).max_element() as f64;
     let mut clear = ClearPositions::new(&scene.vertices, tolerance);
     // A part's walls move by about this much (to the clearest value within
@@ -357,30 +403,31 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                 }
                 moves += 1;
             }
-            // TetGen stuck or failing on one part: its walls met the
+            // TetGen stuck or failing on parts: their walls met the
             // scene in a configuration TetGen's boundary recovery (`-Y`
             // adds no point on the walls) cannot take; seen on a city of
             // fan-triangulated streets, where a wall crossing a fan near
             // its apex leaves a row of crossings 0.002 apart and TetGen
-            // ran until killed. Move the part's walls and build again.
-            // Likewise where a part's Steiner points flatten tets when
-            // rounded to f32 (seen on Neptune), and where TetGen crashes
-            // on a part (seen once in 5,043 parts of 30 M triangles: a
-            // segmentation fault in its worker).
-            Err(
-                e @ (SeamError::Tetgen {
-                    part,
-                    source:
-                        TetgenError::Timeout { .. }
-                        | TetgenError::Internal
-                        | TetgenError::SmallFeature
-                        | TetgenError::CloseFacets
-                        | TetgenError::Other(_)
-                        | TetgenError::WorkerDied { .. },
+            // ran until killed. Move those parts' walls (each plane once)
+            // and build again. Likewise where a part's Steiner points
+            // flatten tets when rounded to f32 (seen on Neptune), and
+            // where TetGen crashes on a part (a segmentation fault in its
+            // worker, seen in the 5,043 parts of 30 M triangles).
+            Err(e) if !e.parts_to_retry().is_empty() => {
+                let failed = e.parts_to_retry();
+                let mut walls: Vec<SplitPlane> = Vec::new();
+                for &part in &failed {
+                    let n = part_moves.entry(part).or_default();
+                    *n += 1;
+                    if *n > MAX_PART_MOVES {
+                        return Err(e);
+                    }
+                    for plane in tree.leaf_walls(part).unwrap_or_default() {
+                        if !walls.contains(&plane) {
+                            walls.push(plane);
+                        }
+                    }
                 }
-                | SeamError::RoundingFlattens { part, .. }),
-            ) => {
-                let walls = tree.leaf_walls(part).unwrap_or_default();
                 let mut moved = false;
                 let mut to = |p: SplitPlane, lo, hi| {
                     let want = p.value as f64 + step;
@@ -391,11 +438,11 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                 for plane in walls {
                     moved |= tree.move_plane(plane, b.min, b.max, &mut to);
                 }
-                if part_moves >= MAX_PART_MOVES || !moved {
+                if retries >= MAX_PART_RETRIES || !moved {
                     return Err(e);
                 }
-                part_moves += 1;
-                moves += 1;
+                retries += 1;
+                moves += failed.len();
             }
             Err(e) => return Err(e),
         }
