@@ -1594,6 +1594,7 @@ fn first_run_fails_then_walls_move(first: &str, timeout_s: u64) {
         "the first run was the failing one"
     );
     assert_eq!(plan.plane_moves, 1);
+    assert_eq!(plan.part_failures.len(), 1, "{:?}", plan.part_failures);
     assert_eq!(report.part_tets.len(), 4);
     // The built planes are the planned ones but for the stuck part's walls.
     assert_ne!(plan.cuts, CutTree::from_split_tree(&plan.plan));
@@ -1716,6 +1717,14 @@ fn parts_that_fail_in_one_attempt_are_retried_together() {
     let (mesh, report, plan) = build_tree_with_memory_limit(&scene, &split, &options).unwrap();
     let runs = std::fs::read_to_string(&runs).unwrap().lines().count();
     assert_eq!(plan.plane_moves, 3, "three parts' walls moved");
+    assert_eq!(plan.part_failures.len(), 3, "{:?}", plan.part_failures);
+    assert!(
+        plan.part_failures
+            .iter()
+            .all(|f| f.contains("TetGen on part")),
+        "{:?}",
+        plan.part_failures
+    );
     assert_eq!(report.part_tets.len(), 8);
     // Two attempts: eight runs, then the parts not reused.
     assert_eq!(runs, 8 + 8 - report.parts_reused, "{runs} runs");

@@ -68,6 +68,8 @@ struct Shape {
     depth: usize,
     /// How many times planes were moved and the build retried.
     plane_moves: usize,
+    /// The failures of TetGen on parts that retries moved walls for.
+    part_failures: Vec<String>,
 }
 
 /// How the parts were merged, for the report.
@@ -220,6 +222,7 @@ impl Limited<'_> {
             max_part_peak_kib: build.worker_peak_kib,
             part_split_pieces: vec![0],
             plane_moves: 0,
+            part_failures: Vec::new(),
             parts_reused: 0,
             total_s: start.elapsed().as_secs_f64(),
             merge: "in-core".to_string(),
@@ -430,6 +433,7 @@ impl Limited<'_> {
                     planner: "tree",
                     depth: built.plan.depth(),
                     plane_moves: built.plane_moves,
+                    part_failures: built.part_failures,
                 };
                 Ok((out, report, shape))
             }
@@ -440,6 +444,7 @@ impl Limited<'_> {
                     planner: "slabs",
                     depth: (s.values.len() + 1).next_power_of_two().trailing_zeros() as usize,
                     plane_moves: 0,
+                    part_failures: Vec::new(),
                 };
                 Ok((out, report, shape))
             }
@@ -486,6 +491,7 @@ impl Limited<'_> {
             planner: shape.planner.to_string(),
             depth: shape.depth,
             plane_moves: shape.plane_moves,
+            part_failures: shape.part_failures.clone(),
             parts_reused: report.parts_reused,
             triangles_cut: report.triangles_cut,
             part_points: report.part_points,

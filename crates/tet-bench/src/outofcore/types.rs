@@ -116,6 +116,11 @@ pub struct MemoryReport {
     /// How many times the build moved planes and tried again (a cut too
     /// near a point, or TetGen failing on a part); 0 for slabs.
     pub plane_moves: usize,
+    /// Each failure of TetGen on a part (its message: the part and why)
+    /// that made the build move the part's walls and try again, in the
+    /// order met; empty for slabs and one-piece builds.
+    #[serde(default)]
+    pub part_failures: Vec<String>,
     /// Parts the retries took as the attempt before built them (their
     /// input unchanged by the moves), summed over retries.
     pub parts_reused: usize,

@@ -257,6 +257,9 @@ pub struct TreePlan {
     pub cuts: CutTree,
     /// How many plane moves the build needed.
     pub plane_moves: usize,
+    /// Each failure of TetGen on a part that a retry moved the part's
+    /// walls for, in the order met (its message: the part and why).
+    pub part_failures: Vec<String>,
 }
 
 /// How many times [`build_tree_with_memory_limit`] moves a plane that met
@@ -365,7 +368,10 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
     let mut tree = CutTree::from_split_tree(&plan);
     plan.forget_triangles();
     drop(cleaned);
-    let (mut moves, mut retries) = (0, 0);
+    // Moves in all (the report's), moves of planes too near a point (at
+    // most `MAX_PLANE_MOVES`), attempts after parts failed.
+    let (mut moves, mut plane_moves, mut retries) = (0, 0, 0);
+    let mut part_failures = Vec::new();
     // Wall moves per part (by leaf index, which moves do not change).
     let mut part_moves = std::collections::HashMap::<usize, usize>::new();
     let tolerance = NEAR_PLANE * (b.max - b.min).max_element() as f64;
@@ -382,6 +388,7 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                         plan,
                         cuts: tree,
                         plane_moves: moves,
+                        part_failures,
                     },
                 ));
             }
@@ -398,9 +405,11 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                     let v = clear.value(p, lo, hi, p.value as f64, step / 2.0);
                     v.or(Some((p.value as f64 + step) as f32))
                 };
-                if moves >= MAX_PLANE_MOVES || !tree.move_plane(plane, b.min, b.max, &mut to) {
+                if plane_moves >= MAX_PLANE_MOVES || !tree.move_plane(plane, b.min, b.max, &mut to)
+                {
                     return Err(e);
                 }
+                plane_moves += 1;
                 moves += 1;
             }
             // TetGen stuck or failing on parts: their walls met the
@@ -443,6 +452,12 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                 }
                 retries += 1;
                 moves += failed.len();
+                match e {
+                    SeamError::PartsFailed(all) => {
+                        part_failures.extend(all.iter().map(ToString::to_string));
+                    }
+                    e => part_failures.push(e.to_string()),
+                }
             }
             Err(e) => return Err(e),
         }
