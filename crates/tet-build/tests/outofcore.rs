@@ -1601,6 +1601,51 @@ fn first_run_fails_then_walls_move(first: &str, timeout_s: u64) {
     check_against_in_core(&scene, &mesh);
 }
 
+/// A worker script in `dir` that counts its runs in the file it returns
+/// second (one line per run) and, with that count as `$n`, runs the shell
+/// `crash_when` (a `case` pattern: runs that crash) before the real
+/// worker; and the options that build one part at a time through it.
+#[cfg(unix)]
+fn crashing_worker(dir: &std::path::Path, crash_when: &str) -> (SeamOptions, std::path::PathBuf) {
+    use std::os::unix::fs::PermissionsExt;
+    let (script, runs) = (dir.join("crashes.sh"), dir.join("runs"));
+    std::fs::write(
+        &script,
+        format!(
+            "#!/bin/sh\necho run >> '{runs}'\nn=$(wc -l < '{runs}')\n\
+             case $n in {crash_when}) cat >/dev/null; kill -SEGV $$;; esac\n\
+             exec '{worker}' \"$@\"\n",
+            runs = runs.display(),
+            worker = env!("CARGO_BIN_EXE_tet-build-worker"),
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    (one_part_at_a_time(script), runs)
+}
+
+/// One part at a time through the worker `program`, 30 s per run.
+fn one_part_at_a_time(program: std::path::PathBuf) -> SeamOptions {
+    SeamOptions {
+        isolation: Isolation::Worker(WorkerCommand {
+            program,
+            args: vec![],
+            timeout: Some(Duration::from_secs(30)),
+        }),
+        parallel_parts: 1,
+        ..SeamOptions::default()
+    }
+}
+
+/// One knot split into eight parts.
+fn eight_parts() -> SplitOptions {
+    SplitOptions {
+        limit_bytes: u64::MAX,
+        min_depth: 3,
+        ..SplitOptions::default()
+    }
+}
+
 /// A retry runs TetGen only on the parts whose input the moved walls
 /// changed, and merges the very mesh a fresh build of the final planes
 /// gives. The worker crashes on its sixth run (the attempt goes on: seven
@@ -1609,40 +1654,13 @@ fn first_run_fails_then_walls_move(first: &str, timeout_s: u64) {
 #[cfg(unix)]
 #[test]
 fn a_retry_rebuilds_only_the_parts_whose_input_changed() {
-    use std::os::unix::fs::PermissionsExt;
     use tet_build::outofcore::tree::build_tree_with_memory_limit;
 
     let dir = tempfile::tempdir().unwrap();
-    let (script, runs) = (dir.path().join("crashes-once.sh"), dir.path().join("runs"));
-    std::fs::write(
-        &script,
-        format!(
-            "#!/bin/sh\necho run >> '{runs}'\n\
-             if [ \"$(wc -l < '{runs}')\" -eq 6 ]; then cat >/dev/null; kill -SEGV $$; fi\n\
-             exec '{worker}' \"$@\"\n",
-            runs = runs.display(),
-            worker = env!("CARGO_BIN_EXE_tet-build-worker"),
-        ),
-    )
-    .unwrap();
-    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
-    let worker = |program: std::path::PathBuf| SeamOptions {
-        isolation: Isolation::Worker(WorkerCommand {
-            program,
-            args: vec![],
-            timeout: Some(Duration::from_secs(30)),
-        }),
-        parallel_parts: 1,
-        ..SeamOptions::default()
-    };
+    let (options, runs) = crashing_worker(dir.path(), "6");
     let scene = knot_grid(1, 120, 12);
-    let split = SplitOptions {
-        limit_bytes: u64::MAX,
-        min_depth: 3,
-        ..SplitOptions::default()
-    };
     let (mesh, report, plan) =
-        build_tree_with_memory_limit(&scene, &split, &worker(script)).unwrap();
+        build_tree_with_memory_limit(&scene, &eight_parts(), &options).unwrap();
     let runs = std::fs::read_to_string(&runs).unwrap().lines().count();
     assert_eq!(plan.plane_moves, 1, "one crash, one move");
     assert_eq!(report.part_tets.len(), 8);
@@ -1656,7 +1674,7 @@ fn a_retry_rebuilds_only_the_parts_whose_input_changed() {
     // unless reused.
     assert_eq!(runs, 8 + 8 - report.parts_reused, "{runs} runs");
     let real = std::path::PathBuf::from(env!("CARGO_BIN_EXE_tet-build-worker"));
-    let (fresh, fresh_report) = build_tree(&scene, &plan.cuts, &worker(real)).unwrap();
+    let (fresh, fresh_report) = build_tree(&scene, &plan.cuts, &one_part_at_a_time(real)).unwrap();
     assert_eq!(fresh_report.parts_reused, 0);
     assert!(mesh == fresh, "the retry's mesh is not the fresh build's");
     check_against_in_core(&scene, &mesh);
@@ -1671,41 +1689,12 @@ fn a_retry_rebuilds_only_the_parts_whose_input_changed() {
 #[cfg(unix)]
 #[test]
 fn parts_that_fail_in_one_attempt_are_retried_together() {
-    use std::os::unix::fs::PermissionsExt;
     use tet_build::outofcore::tree::{MAX_PART_MOVES, build_tree_with_memory_limit};
 
     let dir = tempfile::tempdir().unwrap();
-    let (script, runs) = (
-        dir.path().join("crashes-thrice.sh"),
-        dir.path().join("runs"),
-    );
-    std::fs::write(
-        &script,
-        format!(
-            "#!/bin/sh\necho run >> '{runs}'\n\
-             case \"$(wc -l < '{runs}')\" in 2|4|6) cat >/dev/null; kill -SEGV $$;; esac\n\
-             exec '{worker}' \"$@\"\n",
-            runs = runs.display(),
-            worker = env!("CARGO_BIN_EXE_tet-build-worker"),
-        ),
-    )
-    .unwrap();
-    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
-    let options = SeamOptions {
-        isolation: Isolation::Worker(WorkerCommand {
-            program: script,
-            args: vec![],
-            timeout: Some(Duration::from_secs(30)),
-        }),
-        parallel_parts: 1,
-        ..SeamOptions::default()
-    };
+    let (options, runs) = crashing_worker(dir.path(), "2|4|6");
     let scene = knot_grid(1, 120, 12);
-    let split = SplitOptions {
-        limit_bytes: u64::MAX,
-        min_depth: 3,
-        ..SplitOptions::default()
-    };
+    let split = eight_parts();
     // Three moves of one part each: more than a build that moved one
     // part's walls per attempt (and at most this many in all) could make.
     const {
