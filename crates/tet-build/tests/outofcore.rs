@@ -1720,3 +1720,26 @@ fn parts_that_fail_in_one_attempt_are_retried_together() {
     assert_ne!(plan.cuts, CutTree::from_split_tree(&plan.plan));
     check_against_in_core(&scene, &mesh);
 }
+
+/// A build whose worker crashes on every part gives up, saying why: each
+/// part is retried after its walls moved, at most `MAX_PART_MOVES` times,
+/// all parts of an attempt together.
+#[cfg(unix)]
+#[test]
+fn a_build_whose_parts_always_fail_gives_up_saying_why() {
+    use tet_build::outofcore::seam::SeamError;
+    use tet_build::outofcore::tree::{MAX_PART_MOVES, build_tree_with_memory_limit};
+
+    let dir = tempfile::tempdir().unwrap();
+    let (options, runs) = crashing_worker(dir.path(), "*");
+    let scene = knot_grid(1, 120, 12);
+    match build_tree_with_memory_limit(&scene, &eight_parts(), &options) {
+        Err(SeamError::GaveUp { why, last }) => {
+            assert!(why.contains("failed after"), "{why}");
+            assert!(matches!(*last, SeamError::PartsFailed(ref all) if all.len() == 8));
+        }
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+    let runs = std::fs::read_to_string(&runs).unwrap().lines().count();
+    assert_eq!(runs, 8 * (MAX_PART_MOVES + 1), "{runs} runs");
+}

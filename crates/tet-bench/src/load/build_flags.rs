@@ -34,7 +34,7 @@ pub struct BuildFlags {
     pub max_dihedral: Option<f64>,
     /// Time limit for TetGen in seconds (the build runs in a worker
     /// process). A part of a walled or out-of-core build has at most 10 s
-    /// plus 2 ms per point and triangle of its input, about twenty times
+    /// plus 2 ms per point and triangle of its input, ten to thirty times
     /// what such a part takes; one that runs longer is stuck, and has its
     /// walls moved and is built again.
     #[arg(long, default_value_t = 600.0)]

@@ -182,6 +182,16 @@ pub enum SeamError {
     /// in part order (never fewer than two).
     #[error("{} parts failed; the first: {}", .0.len(), .0.first().map_or(String::new(), |e| e.to_string()))]
     PartsFailed(Vec<SeamError>),
+    /// A build that retries parts TetGen failed on stopped retrying: `why`
+    /// (a part failed after its moves, the retries ran out, or no wall of
+    /// a part could move), and the failure that ended it.
+    #[error("gave up retrying failed parts ({why}); the last failure: {last}")]
+    GaveUp {
+        /// Why it stopped.
+        why: String,
+        /// The failure of the last attempt.
+        last: Box<SeamError>,
+    },
     /// Assembly or validation of the merged mesh failed.
     #[error("merged mesh: {0}")]
     Mesh(#[from] MeshError),

@@ -234,9 +234,9 @@ pub(super) fn run_part(
 
 /// The time limit of one part's TetGen run in a build that retries:
 /// [`PART_TIME_FLOOR`] plus [`PART_TIME_PER_ELEMENT`] for each point and
-/// triangle of its PLC, about twenty times what such a part takes. A run
+/// triangle of its PLC, ten to thirty times what such a part takes. A run
 /// far past its size's time has met a configuration TetGen's boundary
-/// recovery loops on (at 30 M triangles, one part in tens); the build
+/// recovery loops on (at 30 M triangles, a few parts of thousands); the build
 /// moves that part's walls and tries again sooner than a fixed limit
 /// sized for the largest part would let it.
 pub(super) fn part_time_limit(points: usize, triangles: usize) -> Duration {

@@ -294,7 +294,7 @@ pub const MAX_PART_RETRIES: usize = 6;
 /// moves the walls of every part that failed; it gives each part's TetGen
 /// run a time limit scaled to the part's size (10 s and 2 ms per point
 /// and triangle, under the worker's own limit), so that a stuck part
-/// costs about twenty times what a part of its size takes, not the
+/// costs ten to thirty times what a part of its size takes, not the
 /// limit of the largest. A retry runs TetGen only on the parts whose
 /// input the moves changed: the others are kept from the attempt before
 /// (see `part_cache`).
@@ -423,32 +423,58 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
             // where TetGen crashes on a part (a segmentation fault in its
             // worker, seen in the 5,043 parts of 30 M triangles).
             Err(e) if !e.parts_to_retry().is_empty() => {
+                let gave_up = |why: String, last: SeamError| SeamError::GaveUp {
+                    why,
+                    last: Box::new(last),
+                };
                 let failed = e.parts_to_retry();
-                let mut walls: Vec<SplitPlane> = Vec::new();
+                if retries >= MAX_PART_RETRIES {
+                    return Err(gave_up(format!("{MAX_PART_RETRIES} retries"), e));
+                }
+                // Every failed part's walls, taken before any moves.
+                let mut walls = Vec::with_capacity(failed.len());
                 for &part in &failed {
                     let n = part_moves.entry(part).or_default();
                     *n += 1;
                     if *n > MAX_PART_MOVES {
-                        return Err(e);
+                        let why = format!("part {part} failed after {MAX_PART_MOVES} moves");
+                        return Err(gave_up(why, e));
                     }
-                    for plane in tree.leaf_walls(part).unwrap_or_default() {
-                        if !walls.contains(&plane) {
-                            walls.push(plane);
+                    walls.push(tree.leaf_walls(part).unwrap_or_default());
+                }
+                // Each plane once: up by a step, else down (a thin
+                // neighbour's planes may stand within a step), else a
+                // quarter step either way.
+                let mut moved: Vec<SplitPlane> = Vec::new();
+                let mut stuck = Vec::new();
+                for (&part, planes) in failed.iter().zip(&walls) {
+                    let mut any = false;
+                    for &plane in planes {
+                        if moved.contains(&plane) {
+                            any = true;
+                            continue;
+                        }
+                        for offset in [step, -step, step / 4.0, -step / 4.0] {
+                            let mut to = |p: SplitPlane, lo, hi| {
+                                let want = p.value as f64 + offset;
+                                clear
+                                    .value(p, lo, hi, want, offset.abs() / 2.0)
+                                    .or(Some(want as f32))
+                            };
+                            if tree.move_plane(plane, b.min, b.max, &mut to) {
+                                moved.push(plane);
+                                any = true;
+                                break;
+                            }
                         }
                     }
+                    if !any {
+                        stuck.push(part);
+                    }
                 }
-                let mut moved = false;
-                let mut to = |p: SplitPlane, lo, hi| {
-                    let want = p.value as f64 + step;
-                    clear
-                        .value(p, lo, hi, want, step / 2.0)
-                        .or(Some(want as f32))
-                };
-                for plane in walls {
-                    moved |= tree.move_plane(plane, b.min, b.max, &mut to);
-                }
-                if retries >= MAX_PART_RETRIES || !moved {
-                    return Err(e);
+                if !stuck.is_empty() {
+                    let why = format!("no wall of part(s) {stuck:?} can move");
+                    return Err(gave_up(why, e));
                 }
                 retries += 1;
                 moves += failed.len();
