@@ -239,15 +239,15 @@ pub(super) fn run_part(
 /// recovery loops on (at 30 M triangles, a few parts of thousands); the build
 /// moves that part's walls and tries again sooner than a fixed limit
 /// sized for the largest part would let it.
-pub(super) fn part_time_limit(points: usize, triangles: usize) -> Duration {
+fn part_time_limit(points: usize, triangles: usize) -> Duration {
     PART_TIME_FLOOR + PART_TIME_PER_ELEMENT * (points + triangles).min(u32::MAX as usize) as u32
 }
 
 /// See [`part_time_limit`].
-pub(super) const PART_TIME_FLOOR: Duration = Duration::from_secs(10);
+const PART_TIME_FLOOR: Duration = Duration::from_secs(10);
 
 /// See [`part_time_limit`].
-pub(super) const PART_TIME_PER_ELEMENT: Duration = Duration::from_millis(2);
+const PART_TIME_PER_ELEMENT: Duration = Duration::from_millis(2);
 
 /// TetGen runs on one part before rounding gives up: the first, then
 /// re-runs with rounded Steiner points as input points.

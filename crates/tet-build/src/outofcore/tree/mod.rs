@@ -84,7 +84,7 @@ pub fn build_tree(
     tree: &CutTree,
     options: &SeamOptions,
 ) -> Result<(TetMesh, SeamReport), SeamError> {
-    build_tree_with(scene, tree, options, &InMemory, None)
+    build_tree_with(scene, tree, options, &InMemory)
 }
 
 /// [`build_tree`] with the parts written to part files as they finish and
@@ -98,20 +98,18 @@ pub fn build_tree_to_file(
     options: &SeamOptions,
     stream: &StreamOptions,
 ) -> Result<(StreamSummary, SeamReport), SeamError> {
-    build_tree_with(scene, tree, options, &ToFile::new(stream)?, None)
+    build_tree_with(scene, tree, options, &ToFile::new(stream)?)
 }
 
-/// [`build_tree`] with the parts finished and merged by `merge`, and
-/// taken from `cache` where an earlier attempt built the same PLC.
+/// [`build_tree`] with the parts finished and merged by `merge`.
 fn build_tree_with<M: Merge>(
     scene: &Scene,
     tree: &CutTree,
     options: &SeamOptions,
     merge: &M,
-    cache: Option<&PartCache<M::Part>>,
 ) -> Result<(M::Output, SeamReport), SeamError> {
     let (inputs, report) = tree_part_inputs(scene, tree, options)?;
-    finish_parts(inputs, report, options, merge, cache)
+    finish_parts(inputs, report, options, merge, None)
 }
 
 /// Every leaf's PLC of `scene` split by `tree` (see the module docs), in
@@ -368,9 +366,9 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
     let mut tree = CutTree::from_split_tree(&plan);
     plan.forget_triangles();
     drop(cleaned);
-    // Moves in all (the report's), moves of planes too near a point (at
-    // most `MAX_PLANE_MOVES`), attempts after parts failed.
-    let (mut moves, mut plane_moves, mut retries) = (0, 0, 0);
+    // Moves of planes too near a point (at most `MAX_PLANE_MOVES`),
+    // attempts after parts failed.
+    let (mut plane_moves, mut retries) = (0, 0);
     let mut part_failures = Vec::new();
     // Wall moves per part (by leaf index, which moves do not change).
     let mut part_moves = std::collections::HashMap::<usize, usize>::new();
@@ -387,7 +385,8 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                     TreePlan {
                         plan,
                         cuts: tree,
-                        plane_moves: moves,
+                        // One move per part failure besides.
+                        plane_moves: plane_moves + part_moves.values().sum::<usize>(),
                         part_failures,
                     },
                 ));
@@ -410,7 +409,6 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                     return Err(e);
                 }
                 plane_moves += 1;
-                moves += 1;
             }
             // TetGen stuck or failing on parts: their walls met the
             // scene in a configuration TetGen's boundary recovery (`-Y`
@@ -477,7 +475,6 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                     return Err(gave_up(why, e));
                 }
                 retries += 1;
-                moves += failed.len();
                 match e {
                     SeamError::PartsFailed(all) => {
                         part_failures.extend(all.iter().map(ToString::to_string));
