@@ -41,6 +41,15 @@ fn json(args: &[&str]) -> Value {
     json_env(args, &[])
 }
 
+/// Part `k`'s input digest in the plan of `jobdir`.
+fn plan_digest(jobdir: &Path, k: usize) -> String {
+    let job: Value = serde_json::from_str(&read(&jobdir.join("job.json"))).unwrap();
+    job["parts"][k]["input_digest"]
+        .as_str()
+        .unwrap()
+        .to_string()
+}
+
 fn read(p: &Path) -> String {
     std::fs::read_to_string(p).unwrap()
 }
@@ -166,6 +175,34 @@ fn a_planned_job_runs_part_by_part_and_merges_into_the_local_build() {
         "{reason}"
     );
     std::fs::remove_file(&running).unwrap();
+    // TetGen stuck on it: to be planned again, not merely run again; an
+    // error on another input is an earlier plan's and does not count.
+    let digest = plan_digest(&jobdir, last);
+    let error = jobdir.join(format!("part-{last}.error.json"));
+    let record = |input_digest: &str| {
+        serde_json::json!({
+            "part": last, "kind": "build", "message": "part stuck", "input_digest": input_digest,
+            "host": "another-node", "retry": true,
+        })
+        .to_string()
+    };
+    std::fs::write(&error, record(&digest)).unwrap();
+    let status = json(&["job", "status", j]);
+    assert_eq!(status["failed"], 1);
+    assert_eq!(status["replan"], serde_json::json!([last]));
+    let text = String::from_utf8_lossy(&bench(&["job", "status", j], &[]).stdout).to_string();
+    assert!(
+        text.contains(&format!("plan again (build SCENE --plan {j})")),
+        "{text}"
+    );
+    std::fs::write(&error, record("xxh64:0000000000000000")).unwrap();
+    let status = json(&["job", "status", j]);
+    assert_eq!(
+        (status["failed"].clone(), status["missing"].clone()),
+        (0.into(), 1.into())
+    );
+    assert_eq!(status["replan"], serde_json::json!([]));
+    std::fs::remove_file(&error).unwrap();
 
     let s = json(&[
         "submit",

@@ -2,7 +2,7 @@
 //! (as separate processes would), merge, against the single-process
 //! streamed build of the same plan; failed, stale, half-written and
 //! killed parts are named, rebuilt alone, and the merge comes out byte for
-//! byte the same.
+//! byte the same; a part stuck in TetGen is cured by planning again.
 
 #![cfg(feature = "tetgen")]
 
@@ -281,4 +281,107 @@ fn the_plan_records_every_tetgen_option() {
             tetgen.max_dihedral
         )
     );
+}
+
+/// A part TetGen is stuck on in a job (its worker hangs) fails after a
+/// time scaled to its size, not the worker's ten minutes, and its error
+/// record says moving its walls may cure it. Planning the job again into
+/// its directory moves that part's walls, and a third plan keeps them (it
+/// never goes back to the input that failed); every part is rebuilt
+/// exactly when its input changed, and the merge is the single-process
+/// build of the moved planes, byte for byte.
+#[cfg(unix)]
+#[test]
+fn a_part_stuck_in_a_job_is_cured_by_planning_again() {
+    use std::os::unix::fs::PermissionsExt;
+    let scene = knot_grid(1, 120, 12);
+    let dir = tempfile::tempdir().unwrap();
+    let jobdir = dir.path().join("job");
+    let options = PlanOptions {
+        parts: 4,
+        ..PlanOptions::default()
+    };
+    let job = plan_job(&scene, &options, &jobdir).unwrap();
+    assert!(job.failed_inputs.is_empty());
+    let n = job.parts.len();
+    let stuck = 1;
+
+    let script = dir.path().join("hangs.sh");
+    std::fs::write(&script, "#!/bin/sh\nexec sleep 120\n").unwrap();
+    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let hangs = Isolation::Worker(WorkerCommand {
+        program: script,
+        args: vec![],
+        timeout: Some(Duration::from_secs(600)),
+    });
+    let start = std::time::Instant::now();
+    let e = build_part(&jobdir, &job, stuck, &hangs).unwrap_err();
+    let took = start.elapsed().as_secs_f64();
+    assert!(took < 100.0, "{took} s: the stuck part ran to its end");
+    assert!(e.walls_may_cure(), "{e}");
+    for k in (0..n).filter(|&k| k != stuck) {
+        build_part(&jobdir, &job, k, &worker()).unwrap();
+    }
+    let out = dir.path().join("job.tmesh");
+    let (_, failed, _) = not_ready(merge_job(&jobdir, &job, &out).unwrap_err());
+    assert_eq!(failed, vec![stuck]);
+    match &job_status(&jobdir, &job, false).unwrap()[stuck] {
+        PartState::Failed(e) => assert!(e.retry && e.kind == "build", "{e:?}"),
+        other => panic!("{other:?}"),
+    }
+
+    // Planned again: the stuck part's input is gone, its walls moved.
+    let again = plan_job(&scene, &options, &jobdir).unwrap();
+    assert_eq!(again.parts.len(), n);
+    assert_eq!(again.failed_inputs.len(), 1, "{:?}", again.failed_inputs);
+    let failed_digest = &job.parts[stuck].input_digest;
+    assert_eq!(&again.failed_inputs[0].input_digest, failed_digest);
+    assert!(again.parts.iter().all(|p| &p.input_digest != failed_digest));
+    assert_ne!(again.partition, job.partition);
+    assert_eq!(JobManifest::load(&jobdir).unwrap(), again);
+    // The old error record is an earlier plan's.
+    assert!(matches!(
+        job_status(&jobdir, &again, false).unwrap()[stuck],
+        PartState::Missing
+    ));
+    for k in 0..n {
+        let changed = again.parts[k].input_digest != job.parts[k].input_digest;
+        let outcome = build_part(&jobdir, &again, k, &worker()).unwrap();
+        assert_eq!(
+            matches!(outcome, PartOutcome::Built(_)),
+            changed,
+            "part {k}: {outcome:?}"
+        );
+    }
+    merge_job(&jobdir, &again, &out).unwrap();
+    let tree = match &again.partition {
+        tet_build::outofcore::job::manifest::Partition::Tree { tree, .. } => tree.cut_tree(),
+        other => panic!("{other:?}"),
+    };
+    let local_out = dir.path().join("local.tmesh");
+    let local_options = SeamOptions {
+        isolation: worker(),
+        ..SeamOptions::default()
+    };
+    build_tree_to_file(
+        &scene,
+        &tree,
+        &local_options,
+        &StreamOptions::new(&local_out),
+    )
+    .unwrap();
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        std::fs::read(&local_out).unwrap()
+    );
+
+    // Planned a third time: the same plan, nothing to build.
+    let third = plan_job(&scene, &options, &jobdir).unwrap();
+    assert_eq!(third, again);
+    for k in 0..n {
+        assert!(matches!(
+            build_part(&jobdir, &third, k, &worker()).unwrap(),
+            PartOutcome::Skipped(_)
+        ));
+    }
 }

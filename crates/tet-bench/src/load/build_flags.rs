@@ -36,7 +36,8 @@ pub struct BuildFlags {
     /// process). A part of a walled or out-of-core build has at most 10 s
     /// plus 2 ms per point and triangle of its input, ten to thirty times
     /// what such a part takes; one that runs longer is stuck, and has its
-    /// walls moved and is built again.
+    /// walls moved and is built again (in a job: by `build --plan` again,
+    /// see `job status`).
     #[arg(long, default_value_t = 600.0)]
     pub time_limit: f64,
     /// Do not add the enclosing box around the scene.

@@ -182,6 +182,21 @@ pub enum SeamError {
     /// in part order (never fewer than two).
     #[error("{} parts failed; the first: {}", .0.len(), .0.first().map_or(String::new(), |e| e.to_string()))]
     PartsFailed(Vec<SeamError>),
+    /// Part `part` of a job planned again has an input that failed before
+    /// (its digest `input_digest`; `message`: how it failed then), in a way
+    /// moving its walls may cure: the planner moves them as it does for a
+    /// part that fails in a local build.
+    #[error(
+        "part {part}: its input {input_digest} failed in an earlier run of the job ({message})"
+    )]
+    FailedBefore {
+        /// Part index in the plan being made.
+        part: usize,
+        /// The input's digest.
+        input_digest: String,
+        /// The earlier failure, in words.
+        message: String,
+    },
     /// A build that retries parts TetGen failed on stopped retrying: `why`
     /// (a part failed after its moves, the retries ran out, or no wall of
     /// a part could move), and the failure that ended it.
@@ -205,7 +220,8 @@ impl SeamError {
     /// one part in a way a slightly different PLC may not meet: running
     /// past its time limit (its boundary recovery under `-Y` looping), a
     /// crash, its own internal or small-feature errors, or Steiner points
-    /// that flatten tets when rounded to f32.
+    /// that flatten tets when rounded to f32; or a job's part whose input
+    /// failed so before ([`SeamError::FailedBefore`]).
     pub fn part_to_retry(&self) -> Option<usize> {
         match self {
             SeamError::Tetgen {
@@ -218,7 +234,8 @@ impl SeamError {
                     | TetgenError::Other(_)
                     | TetgenError::WorkerDied { .. },
             }
-            | SeamError::RoundingFlattens { part, .. } => Some(*part),
+            | SeamError::RoundingFlattens { part, .. }
+            | SeamError::FailedBefore { part, .. } => Some(*part),
             _ => None,
         }
     }

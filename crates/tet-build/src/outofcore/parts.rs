@@ -232,7 +232,8 @@ pub(super) fn run_part(
     run_plc(part, facets, PartPlc::new(facets, box_faces), options)
 }
 
-/// The time limit of one part's TetGen run in a build that retries:
+/// The time limit of one part's TetGen run in a build that retries (a
+/// local build, or a job planned again over its failed parts):
 /// [`PART_TIME_FLOOR`] plus [`PART_TIME_PER_ELEMENT`] for each point and
 /// triangle of its PLC, ten to thirty times what such a part takes. A run
 /// far past its size's time has met a configuration TetGen's boundary
@@ -241,6 +242,21 @@ pub(super) fn run_part(
 /// sized for the largest part would let it.
 fn part_time_limit(points: usize, triangles: usize) -> Duration {
     PART_TIME_FLOOR + PART_TIME_PER_ELEMENT * (points + triangles).min(u32::MAX as usize) as u32
+}
+
+/// `isolation` with a worker's time limit cut to [`part_time_limit`] of a
+/// part of `points` and `triangles` (in process: unchanged, TetGen cannot
+/// be stopped there).
+pub(super) fn timed_for_part(isolation: &Isolation, points: usize, triangles: usize) -> Isolation {
+    match isolation {
+        Isolation::Worker(w) => {
+            let limit = part_time_limit(points, triangles);
+            let mut w = w.clone();
+            w.timeout = Some(w.timeout.map_or(limit, |t| t.min(limit)));
+            Isolation::Worker(w)
+        }
+        other => other.clone(),
+    }
 }
 
 /// See [`part_time_limit`].
@@ -436,19 +452,19 @@ pub(super) fn run_parts<T: Send>(
                 // of the result counts as long as the worker's.
                 let _ticket = admission.enter(plc.predicted_peak_bytes());
                 let timed;
-                let part_options = match (cache, &options.isolation) {
-                    (Some(_), Isolation::Worker(w)) => {
-                        let limit =
-                            part_time_limit(plc.input.points.len(), plc.input.triangles.len());
-                        let mut w = w.clone();
-                        w.timeout = Some(w.timeout.map_or(limit, |t| t.min(limit)));
+                let part_options = match cache {
+                    Some(_) => {
                         timed = SeamOptions {
-                            isolation: Isolation::Worker(w),
+                            isolation: timed_for_part(
+                                &options.isolation,
+                                plc.input.points.len(),
+                                plc.input.triangles.len(),
+                            ),
                             ..options.clone()
                         };
                         &timed
                     }
-                    _ => options,
+                    None => options,
                 };
                 let part =
                     run_plc(k, &list.facets, plc, part_options).and_then(|m| finish(k, m))?;

@@ -34,6 +34,10 @@ pub struct PlanDoc {
     pub part_predicted_bytes: Vec<u64>,
     /// Bytes of each part's input file.
     pub part_input_bytes: Vec<u64>,
+    /// Part inputs known to fail from earlier runs of the job in this
+    /// directory (`job.json`'s `failed_inputs`): the plan moved the walls
+    /// of the parts that had them.
+    pub failed_inputs: usize,
 }
 
 /// `tet-bench build SCENE --plan JOB_DIR`.
@@ -89,6 +93,7 @@ pub fn plan(args: &BuildArgs, dir: &Path, json: bool) -> Result<()> {
         limit_bytes: job.build.limit_bytes,
         part_predicted_bytes: job.parts.iter().map(|p| p.predicted_peak_bytes).collect(),
         part_input_bytes: job.parts.iter().map(|p| p.input_bytes).collect(),
+        failed_inputs: job.failed_inputs.len(),
     };
     if json {
         return print_json(&doc);
@@ -102,6 +107,12 @@ pub fn plan(args: &BuildArgs, dir: &Path, json: bool) -> Result<()> {
         mib(job.max_predicted_bytes()),
         doc.job_dir
     )?;
+    if doc.failed_inputs > 0 {
+        outln!(
+            "  walls moved around {} part input(s) that failed in earlier runs; parts whose input is unchanged keep their results",
+            doc.failed_inputs
+        )?;
+    }
     let n = doc.parts;
     outln!(
         "  build each part: tet-bench build-part {} --index K   (K = 0..{}; or a Slurm array / Kubernetes Indexed Job)",

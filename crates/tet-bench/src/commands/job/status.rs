@@ -50,6 +50,11 @@ pub struct StatusDoc {
     pub missing: usize,
     /// Every part not done and not running: what to run again.
     pub rerun: Vec<usize>,
+    /// The failed parts whose failure moving their walls may cure
+    /// (TetGen failed, crashed or ran past the part's time limit): run
+    /// `build SCENE --plan JOB_DIR` again, which moves their walls, then
+    /// the parts not done.
+    pub replan: Vec<usize>,
 }
 
 /// `tet-bench job …`.
@@ -94,6 +99,12 @@ pub fn job(args: &JobArgs, json: bool) -> Result<()> {
             .iter()
             .filter(|p| p.state != "done" && p.state != "running")
             .map(|p| p.index)
+            .collect(),
+        replan: states
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| matches!(s, PartState::Failed(e) if e.retry))
+            .map(|(k, _)| k)
             .collect(),
         parts,
     };
@@ -149,6 +160,13 @@ fn print_status(doc: &StatusDoc) -> Result<()> {
             p.reason
                 .as_ref()
                 .map_or(String::new(), |r| format!("  ({r})"))
+        )?;
+    }
+    if !doc.replan.is_empty() {
+        outln!(
+            "  plan again (build SCENE --plan {}): walls to move around {}",
+            doc.job_dir,
+            super::slurm::array_ranges(&doc.replan)
         )?;
     }
     if !doc.rerun.is_empty() {

@@ -196,6 +196,13 @@ impl JobError {
         }
     }
 
+    /// Moving the part's walls may cure this failure of a part's build
+    /// ([`SeamError::part_to_retry`]): the job is to be planned again
+    /// rather than the part run again on the same input.
+    pub fn walls_may_cure(&self) -> bool {
+        matches!(self, JobError::Build { source, .. } if source.part_to_retry().is_some())
+    }
+
     /// Every part to run again before the merge can succeed (sorted).
     pub fn rerun(&self) -> Vec<usize> {
         match self {

@@ -355,6 +355,25 @@ pub struct JobManifest {
     pub parts: Vec<PartRecord>,
     /// How the results are merged.
     pub merge: MergePlan,
+    /// Part inputs that failed in earlier runs of the job in a way moving
+    /// their walls may cure: the plan moved the walls of every part whose
+    /// input was one of them, and keeps them so that planning again does
+    /// not go back to an input known to fail. Empty (and absent from the
+    /// file) when none failed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub failed_inputs: Vec<FailedInput>,
+}
+
+/// A part input that failed ([`JobManifest::failed_inputs`]).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FailedInput {
+    /// The input's digest.
+    pub input_digest: String,
+    /// The part it was in the plan it failed in.
+    pub part: usize,
+    /// How it failed, in words.
+    pub message: String,
 }
 
 impl JobManifest {

@@ -20,13 +20,17 @@
 //! | `part-K.input` | [`plan_job`] | part K's facets ([`part_input`]: binary, magic, version, sizes, checksum) |
 //! | `part-K.tmesh` | [`build_part`] | part K's mesh (mesh file format), Hilbert-sorted on its own |
 //! | `part-K.done.json` | [`build_part`] (after the result) | [`DoneRecord`]: input and result digests, measured peaks (`VmHWM`) |
-//! | `part-K.error.json` | [`build_part`] on failure | [`ErrorRecord`]: the part, the kind of error, the message |
+//! | `part-K.error.json` | [`build_part`] on failure | [`ErrorRecord`]: the part, the kind of error, the message, whether moving its walls may cure it |
 //!
 //! Every file is written atomically (temporary file, rename): a killed
 //! run leaves a previous file or none, never half of one. A part is *done*
 //! when its done record names the plan's input digest and its result has
 //! the recorded digest; [`build_part`] skips a done part and rebuilds any
-//! other, so running a part twice, or after a crash, is safe.
+//! other, so running a part twice, or after a crash, is safe. A part
+//! TetGen fails on, crashes on or is stuck on (each part's run has a time
+//! limit scaled to its size) is cured by planning the job again into its
+//! directory: [`plan_job`] moves that part's walls ([`replan`]) and keeps
+//! every other part's input, and so its result.
 //!
 //! Modules, bottom up:
 //!
@@ -36,6 +40,7 @@
 //! * [`manifest`]: the job description, `job.json`.
 //! * [`records`]: done and error records, atomic writes.
 //! * [`plan`]: planning, [`plan_job`].
+//! * [`replan`]: planning again over parts that failed.
 //! * [`run`]: [`build_part`], the part index from Slurm or Kubernetes.
 //! * [`status`]: each part's state from the directory.
 //! * [`merge`]: the merge, [`merge_job`].
@@ -47,11 +52,12 @@ pub mod merge;
 pub mod part_input;
 pub mod plan;
 pub mod records;
+pub mod replan;
 pub mod run;
 pub mod status;
 
 pub use error::{InputFault, JobError};
-pub use manifest::{JOB_FILE, JobManifest, PartPaths};
+pub use manifest::{FailedInput, JOB_FILE, JobManifest, PartPaths};
 pub use merge::merge_job;
 pub use plan::{PlanOptions, Planner, plan_job, scene_digest};
 pub use records::{DoneRecord, ErrorRecord, RunningRecord};

@@ -28,7 +28,8 @@ use glam::Vec3;
 
 use super::digest::xxh64;
 use super::error::InputFault;
-use crate::outofcore::parts::FacetKind;
+use crate::outofcore::merge::PartInputs;
+use crate::outofcore::parts::{FacetKind, PartFacetList};
 
 /// The first 8 bytes of a part input file.
 pub const MAGIC: [u8; 8] = *b"TETPART\0";
@@ -58,6 +59,28 @@ pub struct PartInput {
 }
 
 impl PartInput {
+    /// Part `k` of `inputs` as its input file holds it, made from its PLC
+    /// `list`. Facets carry the *input* scene triangle, so that a part
+    /// needs no map back from the cleaned scene.
+    pub(super) fn of_part(inputs: &PartInputs, k: usize, list: &PartFacetList) -> PartInput {
+        PartInput {
+            part: k as u32,
+            triangle_count: inputs.triangle_count,
+            facets: list
+                .facets
+                .iter()
+                .map(|(t, kind)| {
+                    let id = match kind {
+                        FacetKind::Scene(s) => inputs.triangle_source[*s as usize],
+                        FacetKind::Seam => SEAM_FACET,
+                    };
+                    (*t, id)
+                })
+                .collect(),
+            box_faces: list.box_faces.clone(),
+        }
+    }
+
     /// The facets as the part builder takes them.
     pub(in crate::outofcore) fn facet_kinds(&self) -> Vec<([Vec3; 3], FacetKind)> {
         self.facets

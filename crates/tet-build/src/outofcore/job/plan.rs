@@ -14,13 +14,14 @@ use super::manifest::{
     BuildRecord, ExactF32, JOB_FILE, JOB_SCHEMA, JOB_VERSION, JobManifest, MergePlan, PartRecord,
     Partition, SceneRecord, SeamRecord, TreeNode,
 };
-use super::part_input::{PartInput, SEAM_FACET, encode};
+use super::part_input::{PartInput, encode};
 use super::records::write_atomic;
+use super::replan::{fail_known_inputs, known_failures};
 use crate::bbox::EnclosingBox;
 use crate::clean::clean_scene;
 use crate::outofcore::error::SeamError;
 use crate::outofcore::merge::PartInputs;
-use crate::outofcore::parts::{FacetKind, PartPlc, SeamOptions, SeamReport};
+use crate::outofcore::parts::{PartPlc, SeamOptions, SeamReport};
 use crate::outofcore::seam::slab_part_inputs;
 use crate::outofcore::split::{SlabPlan, SplitOptions, plan_slabs};
 use crate::outofcore::tree::{plan_tree_with_moves, tree_part_inputs_once};
@@ -132,8 +133,13 @@ fn slabs_for(
 /// Cuts `scene` into parts (see [`PlanOptions`]), writes every part's
 /// input file and `job.json` into `dir` (made if missing) and returns the
 /// plan. Results of an earlier plan in `dir` stay; a part whose input is
-/// unchanged keeps its result (its digest still matches).
+/// unchanged keeps its result (its digest still matches). Where parts of
+/// an earlier plan of the same scene in `dir` failed in a way moving their
+/// walls may cure, the tree planner moves the walls of every part whose
+/// input failed ([`super::replan`]).
 pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobManifest, JobError> {
+    let digest = scene_digest(scene);
+    let failed_inputs = known_failures(dir, &digest)?;
     let (cleaned, _) = clean_scene(scene).map_err(|e| JobError::Plan(SeamError::from(e)))?;
     if cleaned.triangles.is_empty() {
         return Err(JobError::Plan(SeamError::EmptyScene));
@@ -158,7 +164,9 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
         Planner::Slabs => None,
         _ => {
             match plan_tree_with_moves(scene, &split, seam, |t| {
-                tree_part_inputs_once(scene, &prepared, t, seam)
+                let (inputs, report) = tree_part_inputs_once(scene, &prepared, t, seam)?;
+                fail_known_inputs(&inputs, &failed_inputs)?;
+                Ok((inputs, report))
             }) {
                 Ok(((inputs, report), plan)) => {
                     let mut next = 0;
@@ -208,7 +216,7 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
         version: JOB_VERSION,
         scene: SceneRecord {
             name: scene.name.clone(),
-            digest: scene_digest(scene),
+            digest,
             vertices: scene.vertices.len(),
             triangles: inputs.triangle_count,
         },
@@ -228,6 +236,7 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
         partition,
         merge: merge_plan(&report, parts.len(), camera, lights),
         parts,
+        failed_inputs,
     };
     write_atomic(&dir.join(JOB_FILE), manifest.to_json().as_bytes())?;
     Ok(manifest)
@@ -254,25 +263,8 @@ fn write_inputs(inputs: &PartInputs, dir: &Path) -> Result<Vec<PartRecord>, JobE
     for k in 0..inputs.parts.len() {
         let list = inputs.parts.facets(k).map_err(JobError::Plan)?;
         let plc = PartPlc::new(&list.facets, &list.box_faces);
-        // Facets carry the *input* scene triangle, so that a part needs no
-        // map back from the cleaned scene.
-        let input = PartInput {
-            part: k as u32,
-            triangle_count: inputs.triangle_count,
-            facets: list
-                .facets
-                .iter()
-                .map(|(t, kind)| {
-                    let id = match kind {
-                        FacetKind::Scene(s) => inputs.triangle_source[*s as usize],
-                        FacetKind::Seam => SEAM_FACET,
-                    };
-                    (*t, id)
-                })
-                .collect(),
-            box_faces: list.box_faces,
-        };
-        drop(list.facets);
+        let input = PartInput::of_part(inputs, k, &list);
+        drop(list);
         let (bytes, sum) = encode(&input);
         let name = format!("part-{k}.input");
         write_atomic(&dir.join(&name), &bytes)?;

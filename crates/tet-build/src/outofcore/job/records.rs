@@ -57,6 +57,13 @@ pub struct ErrorRecord {
     pub input_digest: String,
     /// Host that ran it.
     pub host: String,
+    /// Moving the part's walls may cure the failure (TetGen failed,
+    /// crashed or ran past the part's time limit on this input): planning
+    /// the job again into its directory moves them ([`super::plan_job`]);
+    /// building the part again would meet the same input. Absent (false)
+    /// in records written before it existed.
+    #[serde(default)]
+    pub retry: bool,
 }
 
 /// `part-K.running.json`: a run of a part in progress, written when it

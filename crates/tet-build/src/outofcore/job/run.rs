@@ -15,7 +15,7 @@ use super::records::{
     DoneRecord, ErrorRecord, RunningRecord, host_name, read_json, write_atomic, write_json,
 };
 use crate::outofcore::error::{SeamError, StreamError};
-use crate::outofcore::parts::{SeamOptions, run_part};
+use crate::outofcore::parts::{SeamOptions, run_part, timed_for_part};
 use crate::tetgen::{Isolation, TetgenOptions};
 
 /// The environment variables that carry a part index, in the order read:
@@ -124,6 +124,7 @@ pub fn build_part(
                 message: e.to_string(),
                 input_digest: job.parts[k].input_digest.clone(),
                 host: host_name(),
+                retry: e.walls_may_cure(),
             };
             // The error itself is what the caller must see; a record that
             // cannot be written is secondary.
@@ -202,7 +203,9 @@ fn build(
                 .or(TetgenOptions::default().max_dihedral),
             ..TetgenOptions::default()
         },
-        isolation: isolation.clone(),
+        // A stuck part fails after a time scaled to its size, as in a
+        // local build, so that planning again can move its walls soon.
+        isolation: timed_for_part(isolation, record.points, record.triangles),
         ..SeamOptions::default()
     };
     let built = |source: SeamError| JobError::Build { part: k, source };

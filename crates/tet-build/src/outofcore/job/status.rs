@@ -13,7 +13,7 @@ use super::records::{DoneRecord, ErrorRecord, RunningRecord, read_json};
 pub enum PartState {
     /// Finished: a result of this plan, as recorded.
     Done(DoneRecord),
-    /// The last run failed (and left no valid result).
+    /// The last run on the plan's input failed (and left no valid result).
     Failed(ErrorRecord),
     /// A result is there but not this plan's, or damaged: why.
     Stale(String),
@@ -63,7 +63,11 @@ pub fn part_state(
     {
         return Ok(PartState::Running(running));
     }
-    if let Ok(Some(error)) = read_json::<ErrorRecord>(&paths.error) {
+    // An error on another input is an earlier plan's: planning again
+    // changed this part's input (see `replan`).
+    if let Ok(Some(error)) = read_json::<ErrorRecord>(&paths.error)
+        && error.input_digest == job.parts[k].input_digest
+    {
         return Ok(PartState::Failed(error));
     }
     Ok(match stale {
