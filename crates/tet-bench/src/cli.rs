@@ -70,6 +70,12 @@ pub enum Command {
     /// Submit a planned job to a batch system: an array of part tasks and
     /// a merge that waits for them.
     Submit(SubmitArgs),
+    /// The GPU benchmark in one command (needs `--features gpu`): kernel
+    /// times of the GPU walks (Aman et al. 2022, Table 3), a GPU BVH on
+    /// the same rays and secondary rays, every hit checked against the CPU
+    /// walk; writes `OUT_DIR/gpu.json` and `OUT_DIR/gpu.md`.
+    #[command(after_help = procedural_scenes_help())]
+    GpuBench(GpuBenchArgs),
     /// Internal: serve one TetGen request on stdin/stdout (isolated builds).
     #[command(hide = true)]
     TetgenWorker,
@@ -435,6 +441,69 @@ impl TablesArgs {
     pub fn min_time_s(&self) -> f64 {
         self.min_time.unwrap_or(if self.quick { 0.2 } else { 0.5 })
     }
+}
+
+/// `gpu-bench` arguments.
+#[derive(Debug, Args)]
+pub struct GpuBenchArgs {
+    /// Where `gpu.json` and `gpu.md` go (`meshes.json` with
+    /// `--prepare-meshes`); created when missing.
+    pub out_dir: PathBuf,
+    /// Small images (160×120), 3 timed dispatches, one secondary pass: a
+    /// test of the command (CI, lavapipe), not of speed.
+    #[arg(long)]
+    pub quick: bool,
+    /// Directory of prebuilt meshes, one `NAME.tmesh` per scene (NAME: the
+    /// scene spec after its `#`, an OBJ's file stem or the procedural
+    /// name, lower case, other characters as `-`: `torus-knots`,
+    /// `torus-knots-box`, `armadillo`, `neptune`, `mix`). A scene without
+    /// its file is built when TetGen is compiled in, else skipped.
+    #[arg(long, value_name = "DIR")]
+    pub meshes: Option<PathBuf>,
+    /// Build every scene's mesh into `--meshes DIR` (no GPU needed), report
+    /// each file's size and the total against `--budget-mb`, and stop.
+    #[arg(long, requires = "meshes", conflicts_with = "adapter_only")]
+    pub prepare_meshes: bool,
+    /// With `--prepare-meshes`: megabytes the meshes may take on the way
+    /// to a GPU machine (the whole carried set, binary and loader
+    /// packages with it, stays under 60 MB: give what is left for them).
+    #[arg(
+        long,
+        value_name = "MB",
+        default_value_t = 60.0,
+        requires = "prepare_meshes"
+    )]
+    pub budget_mb: f64,
+    /// Print the adapter wgpu finds (name, backend, device type, driver)
+    /// and stop; fails on a software adapter (lavapipe, llvmpipe) unless
+    /// `--allow-software`.
+    #[arg(long)]
+    pub adapter_only: bool,
+    /// With `--adapter-only`: accept a software adapter.
+    #[arg(long, requires = "adapter_only")]
+    pub allow_software: bool,
+    /// The scenes.json of the real scenes (Armadillo, Neptune, Mix).
+    #[arg(long, value_name = "FILE", default_value = "scenes/scenes.json")]
+    pub scenes: PathBuf,
+    /// Measure this scene instead of the five of Table 3 (repeatable; any
+    /// SCENE as for `render`, or a `.tmesh` file).
+    #[arg(long = "scene", value_name = "SCENE")]
+    pub scene: Vec<String>,
+    /// Image width (default: 1920, or 160 with `--quick`).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height (default: 1440, or 120 with `--quick`).
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Timed dispatches of each method, after one warm-up; the best is
+    /// reported (default: 20, or 3 with `--quick`).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// Build missing meshes in the default tight box (cameras outside the
+    /// mesh, rays entering through its boundary) instead of the papers'
+    /// wide box that holds the camera and lights.
+    #[arg(long)]
+    pub tight_box: bool,
 }
 
 /// `iso` arguments.

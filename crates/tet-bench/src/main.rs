@@ -6,9 +6,10 @@
 //!
 //! 1. commands — [`commands`] (`build`, `info`, `render`, `accuracy`,
 //!    `iso`, `convert`, and the job commands `build --plan`, `build-part`,
-//!    `merge`, `job status`, `submit`) and [`tables`] (one module per paper
-//!    table, the driver, and the report writers: Markdown, CSV, JSON, SVG
-//!    figures);
+//!    `merge`, `job status`, `submit`, `gpu-bench`) and [`tables`] (one
+//!    module per paper table, the driver, and the report writers: Markdown,
+//!    CSV, JSON, SVG figures); `gpu-bench` alone reads from [`tables`]:
+//!    the published figures it prints beside its own;
 //! 2. the command line — [`cli`] (the subcommands and their arguments; the
 //!    values they name are defined below);
 //! 3. measurement, returning plain serialisable data — [`timing`] (speed,
@@ -58,6 +59,7 @@ fn main() -> ExitCode {
         Command::Merge(a) => commands::job::merge(a, cli.json),
         Command::Job(a) => commands::job::job(a, cli.json),
         Command::Submit(a) => commands::job::submit(a, cli.json),
+        Command::GpuBench(a) => commands::gpu_bench::run(a, cli.json),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,7 +1,7 @@
 // Declarations shared by the GPU kernels (`walk.wgsl`, `tet80.wgsl`):
 // outcome codes, the records exchanged with the host (layouts mirrored by
-// `tracer.rs`), the bindings, the ray of the current invocation, the
-// camera-ray generator and the hit computation.
+// `records.rs`), the bindings, the ray of the current invocation and the
+// hit computation. Follows `camera.wgsl` (the camera-ray generator).
 
 const BOUNDARY: u32 = 0x7FFFFFFFu;
 const NO_TET: u32 = 0xFFFFFFFFu;
@@ -29,12 +29,7 @@ struct Params {
     cam_tet: u32,
     cam_ids: vec4<u32>,
     cam_links: vec4<u32>,
-    eye: vec4<f32>,
-    forward: vec4<f32>,
-    right: vec4<f32>,
-    up: vec4<f32>,
-    // half_h, aspect, pixel offset (0 or 0.5), unused
-    lens: vec4<f32>,
+    camera: Camera,
 };
 
 struct RayRec {
@@ -151,17 +146,9 @@ fn duff_basis(n: vec3<f32>) {
 // read from the batch (basis made on the host in f64, like the CPU).
 fn load_ray(idx: u32) {
     if (params.camera_mode != 0u) {
-        let pix = params.first_ray + idx;
-        let i = pix % params.width;
-        let j = pix / params.width;
-        let x = 2.0 * (f32(i) + params.lens.z) / f32(params.width) - 1.0;
-        let y = 1.0 - 2.0 * (f32(j) + params.lens.z) / f32(params.height);
-        let half_h = params.lens.x;
-        let dd = params.forward.xyz + params.right.xyz * (half_h * params.lens.y * x)
-            + params.up.xyz * (half_h * y);
-        let len = sqrt(dd.x * dd.x + dd.y * dd.y + dd.z * dd.z);
-        r_d = dd * (1.0 / len);
-        r_o = params.eye.xyz;
+        r_d = camera_direction(params.camera, params.first_ray + idx, params.width,
+                               params.height);
+        r_o = params.camera.eye.xyz;
         r_tmin = 0.0;
         r_tmax = 3.4028235e38;
         let dl = sqrt(r_d.x * r_d.x + r_d.y * r_d.y + r_d.z * r_d.z);

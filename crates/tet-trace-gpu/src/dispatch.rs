@@ -1,6 +1,7 @@
 //! The GPU side of a tracer: the uploaded mesh and compiled kernel
-//! ([`Kernel`]), one dispatch of the walk with its read-back and timing, and
-//! how many rays fit one dispatch.
+//! ([`Kernel`]), one compute pass with its read-back and timing
+//! ([`run_pass`], shared with the BVH kernel), and how many rays fit one
+//! dispatch.
 
 use std::sync::mpsc;
 
@@ -86,16 +87,7 @@ impl Kernel {
         let device = &ctx.device;
         let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let val = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let storage = |label: &str, data: &[u8]| {
-            // Zero-sized bindings are invalid: pad empty arrays.
-            let pad = [0u8; 32];
-            let contents = if data.is_empty() { &pad[..] } else { data };
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
+        let storage = |label: &str, data: &[u8]| storage_buffer(device, label, data);
         let points_buf = storage("points", bytemuck::cast_slice(&points));
         let tets_bufs: Vec<wgpu::Buffer> = (0..split.count)
             .map(|j| {
@@ -140,105 +132,138 @@ impl Kernel {
         rays: &wgpu::Buffer,
         starts: &wgpu::Buffer,
     ) -> Result<(Vec<HitRec>, Option<f64>), GpuError> {
-        let n = params.ray_count;
-        if n == 0 {
-            return Ok((Vec::new(), None));
+        let mut inputs = vec![(0, &self.points), (2, &self.faces), (4, rays), (5, starts)];
+        for (j, b) in self.tets.iter().enumerate() {
+            inputs.push((Split::binding(j as u32), b));
         }
-        let device = &ctx.device;
-        let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let val = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let out_bytes = n as u64 * size_of::<HitRec>() as u64;
-        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("params"),
-            contents: bytemuck::bytes_of(params),
-            usage: wgpu::BufferUsages::UNIFORM,
+        run_pass(
+            ctx,
+            "walk",
+            &self.pipeline,
+            &inputs,
+            (3, bytemuck::bytes_of(params)),
+            6,
+            params.ray_count,
+        )
+    }
+}
+
+/// One compute pass of `n` invocations (workgroups of [`WORKGROUP`], the
+/// `@workgroup_size` of every kernel, spread over a 2-D grid when they
+/// exceed the per-dimension limit) of `pipeline`, with the storage buffers
+/// `inputs` (binding, buffer), the uniform `params` (binding, bytes) and a
+/// fresh output array of `n` records `T` at `out_binding`. Returns the
+/// records and, when timestamps are enabled, the pass's GPU time (ms).
+pub(crate) fn run_pass<T: Pod>(
+    ctx: &GpuContext,
+    label: &'static str,
+    pipeline: &wgpu::ComputePipeline,
+    inputs: &[(u32, &wgpu::Buffer)],
+    params: (u32, &[u8]),
+    out_binding: u32,
+    n: u32,
+) -> Result<(Vec<T>, Option<f64>), GpuError> {
+    if n == 0 {
+        return Ok((Vec::new(), None));
+    }
+    let device = &ctx.device;
+    let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let val = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let out_bytes = n as u64 * size_of::<T>() as u64;
+    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("params"),
+        contents: params.1,
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let out = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("results"),
+        size: out_bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("results readback"),
+        size: out_bytes,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut entries: Vec<wgpu::BindGroupEntry<'_>> =
+        inputs.iter().map(|&(b, buf)| entry(b, buf)).collect();
+    entries.push(entry(params.0, &uniform));
+    entries.push(entry(out_binding, &out));
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    });
+    let timing = ctx.timestamps.then(|| {
+        let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("timestamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count: 2,
         });
-        let out = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("hits"),
-            size: out_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps"),
+            size: 16,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("hits readback"),
-            size: out_bytes,
+        let read = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps readback"),
+            size: 16,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut entries = vec![
-            entry(0, &self.points),
-            entry(2, &self.faces),
-            entry(3, &uniform),
-            entry(4, rays),
-            entry(5, starts),
-            entry(6, &out),
-        ];
-        for (j, b) in self.tets.iter().enumerate() {
-            entries.push(entry(Split::binding(j as u32), b));
-        }
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("walk"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &entries,
-        });
-        let timing = ctx.timestamps.then(|| {
-            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("walk timestamps"),
-                ty: wgpu::QueryType::Timestamp,
-                count: 2,
-            });
-            let resolve = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamps"),
-                size: 16,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            let read = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamps readback"),
-                size: 16,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            (set, resolve, read)
-        });
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("walk"),
-        });
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("walk"),
-                timestamp_writes: timing.as_ref().map(|(set, _, _)| {
-                    wgpu::ComputePassTimestampWrites {
-                        query_set: set,
-                        beginning_of_pass_write_index: Some(0),
-                        end_of_pass_write_index: Some(1),
-                    }
+        (set, resolve, read)
+    });
+    let mut enc =
+        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(label),
+            timestamp_writes: timing
+                .as_ref()
+                .map(|(set, _, _)| wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
                 }),
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            let groups = n.div_ceil(WORKGROUP);
-            let x = groups.min(ctx.max_workgroups);
-            pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
-        }
-        enc.copy_buffer_to_buffer(&out, 0, &readback, 0, out_bytes);
-        if let Some((set, resolve, read)) = &timing {
-            enc.resolve_query_set(set, 0..2, resolve, 0);
-            enc.copy_buffer_to_buffer(resolve, 0, read, 0, 16);
-        }
-        ctx.queue.submit([enc.finish()]);
-        let hits: Vec<HitRec> = read_buffer(device, &readback)?;
-        let gpu_ms = match &timing {
-            Some((_, _, read)) => {
-                let ts: Vec<u64> = read_buffer(device, read)?;
-                let ticks = ts[1].saturating_sub(ts[0]);
-                Some(ticks as f64 * ctx.queue.get_timestamp_period() as f64 / 1e6)
-            }
-            None => None,
-        };
-        scope_result("dispatch", val, oom)?;
-        Ok((hits, gpu_ms))
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        let groups = n.div_ceil(WORKGROUP);
+        let x = groups.min(ctx.max_workgroups);
+        pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
     }
+    enc.copy_buffer_to_buffer(&out, 0, &readback, 0, out_bytes);
+    if let Some((set, resolve, read)) = &timing {
+        enc.resolve_query_set(set, 0..2, resolve, 0);
+        enc.copy_buffer_to_buffer(resolve, 0, read, 0, 16);
+    }
+    ctx.queue.submit([enc.finish()]);
+    let records: Vec<T> = read_buffer(device, &readback)?;
+    let gpu_ms = match &timing {
+        Some((_, _, read)) => {
+            let ts: Vec<u64> = read_buffer(device, read)?;
+            let ticks = ts[1].saturating_sub(ts[0]);
+            Some(ticks as f64 * ctx.queue.get_timestamp_period() as f64 / 1e6)
+        }
+        None => None,
+    };
+    scope_result("dispatch", val, oom)?;
+    Ok((records, gpu_ms))
+}
+
+/// A read-only storage buffer holding `data` (an empty array gets 32 zero
+/// bytes: zero-sized bindings are invalid).
+pub(crate) fn storage_buffer(device: &wgpu::Device, label: &str, data: &[u8]) -> wgpu::Buffer {
+    let pad = [0u8; 32];
+    let contents = if data.is_empty() { &pad[..] } else { data };
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE,
+    })
 }
 
 /// Rays per dispatch so that every per-ray buffer fits the limits.

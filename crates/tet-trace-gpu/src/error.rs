@@ -62,6 +62,10 @@ pub enum GpuError {
         /// What is wrong.
         detail: String,
     },
+    /// The mesh has no constrained faces: a BVH over its scene triangles
+    /// would be empty.
+    #[error("the mesh has no constrained faces (no scene triangles to build a BVH over)")]
+    EmptyScene,
     /// wgpu reported a validation or out-of-memory error.
     #[error("wgpu error during {during}: {message}")]
     Wgpu {

@@ -1,5 +1,6 @@
 //! The layouts with a GPU kernel and the assembly of their WGSL sources:
-//! `common.wgsl` (records, bindings, camera rays, hit point) + `walk.wgsl`
+//! `camera.wgsl` (camera rays) + `common.wgsl` (records, bindings, hit
+//! point) + `walk.wgsl`
 //! (projected walk) + the layout's `layout_vx` / `layout_exit`, or
 //! `common.wgsl` + `tet80.wgsl` (Plücker walk). Decision tables are packed
 //! from the CPU crate's constants, so the two cannot drift apart.
@@ -13,8 +14,10 @@ use crate::error::GpuError;
 
 /// WGSL source of the layout-independent walk.
 const WALK: &str = include_str!("walk.wgsl");
-/// WGSL shared by the kernels (records, bindings, camera rays, hit point).
+/// WGSL shared by the kernels (records, bindings, hit point).
 const COMMON: &str = include_str!("common.wgsl");
+/// WGSL of the camera-ray generator, shared with the BVH kernel.
+pub(crate) const CAMERA: &str = include_str!("camera.wgsl");
 /// WGSL of the Tet80 Plücker walk.
 const TET80: &str = include_str!("tet80.wgsl");
 
@@ -75,7 +78,7 @@ impl GpuLayout {
 
     /// The complete WGSL source of the layout's kernel.
     pub(crate) fn source(self, split: Split) -> String {
-        let common = format!("{COMMON}\n{}", split.wgsl());
+        let common = format!("{CAMERA}\n{COMMON}\n{}", split.wgsl());
         if self == GpuLayout::Tet80 {
             let [exit, second, first] = tet80_tables();
             format!(

@@ -17,7 +17,9 @@
 //!   meaning field by field) plus [`DispatchStats`];
 //! * walks that lost their way on the GPU are walked again on the host by
 //!   the exact walk, as the CPU tracers do (see "Walks that lost their
-//!   way" below).
+//!   way" below);
+//! * [`GpuBvh`]: the same-run GPU BVH baseline over the same triangles (see
+//!   "The GPU BVH baseline" below).
 //!
 //! ## The kernels: a port of the CPU walk (Aman et al. 2022, Algorithms 1–7)
 //!
@@ -154,6 +156,24 @@
 //! fallback: a kernel that needs the exact outcome on the device (no host
 //! round trip) would need an exact walk in WGSL.
 //!
+//! ## The GPU BVH baseline
+//!
+//! [`GpuBvh`] is the peer the GPU tet walks are measured against: a binary
+//! BVH over the mesh's constrained faces (the scene triangles), built on the
+//! CPU by obvhs (SAH, spatial pre-splits, reinsertion: the preset of the CPU
+//! BVH baseline) and traversed by a WGSL kernel (`src/bvh.wgsl`: a stack of
+//! postponed subtrees, the nearer child first, subtrees behind the closest
+//! hit skipped, Möller–Trumbore triangles in f32). It runs on the same
+//! [`GpuContext`], takes the same [`tet_trace_cpu::Ray`]s, generates camera
+//! rays with the walks' own WGSL camera code ([`GpuBvh::render`], rays
+//! bit-identical to [`GpuTracer::render`]'s) and reports the same
+//! [`DispatchStats`], so a benchmark compares walk and BVH on the same rays,
+//! in the same run, on the same device. Its hits report the scene triangle id
+//! the walks report; the BVH's triangle test is not watertight, so the two may
+//! differ on rays that graze an edge. Nodes of 32 bytes, leaf triangles of 48
+//! bytes (`src/bvh.rs` has the layout); [`DispatchStats::tets_visited`] counts
+//! the BVH boxes tested.
+//!
 //! ## Limits
 //!
 //! Every storage buffer must fit the device's `max_storage_buffer_binding_size`
@@ -163,7 +183,8 @@
 //! words when they do not fit one (the shader then picks the binding with a
 //! shift and a mask; a mesh that fits one binding gets the plain accessor and
 //! pays nothing): 512 MiB of records on lavapipe, i.e. ≈ 26 M Tet20 tets or
-//! 6.7 M Tet80 tets. Points and the constrained-face table are not split. A
+//! 6.7 M Tet80 tets. Points and the constrained-face table are not split,
+//! nor are the BVH's nodes and triangles ([`GpuBvh`]). A
 //! mesh that still does not fit gives [`GpuError::TooLarge`] naming the buffer
 //! and the limit. Ray batches and camera frames are split into as many
 //! dispatches as the limits (and the 65 535-workgroup dispatch limit)
@@ -201,6 +222,7 @@
 
 #![deny(missing_docs)]
 
+mod bvh;
 mod context;
 mod dispatch;
 mod error;
@@ -211,6 +233,7 @@ mod starts;
 mod stats;
 mod tracer;
 
+pub use bvh::{BvhHit, GpuBvh};
 pub use context::{GpuContext, GpuOptions, REQUIRE_ADAPTER_ENV};
 pub use error::GpuError;
 pub use layout::GpuLayout;

@@ -3,7 +3,11 @@
 //! record to the CPU's [`TraceOutcome`].
 
 use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use tet_core::scene::Camera;
 use tet_trace_cpu::{Failure, Hit, TraceOutcome};
+
+use crate::error::GpuError;
 
 // Outcome codes and start modes shared with the shader.
 pub(crate) const ST_HIT: u32 = 0;
@@ -29,13 +33,62 @@ pub(crate) struct Params {
     pub(crate) cam_tet: u32,
     pub(crate) cam_ids: [u32; 4],
     pub(crate) cam_links: [u32; 4],
+    pub(crate) camera: CameraRec,
+}
+const _: () = assert!(size_of::<Params>() == 144);
+
+/// The camera of a frame whose rays the GPU makes (`Camera` in
+/// `camera.wgsl`, shared by the tet walks and the BVH kernel): the eye, the
+/// view frame and the lens, in f32.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub(crate) struct CameraRec {
     pub(crate) eye: [f32; 4],
     pub(crate) forward: [f32; 4],
     pub(crate) right: [f32; 4],
     pub(crate) up: [f32; 4],
+    /// `half_h`, aspect, pixel offset (0 or 0.5), unused.
     pub(crate) lens: [f32; 4],
 }
-const _: () = assert!(size_of::<Params>() == 144);
+const _: () = assert!(size_of::<CameraRec>() == 80);
+
+impl CameraRec {
+    /// The record of `camera` for a `width × height` image; fails with
+    /// [`GpuError::Camera`] on an empty or too large image (more than
+    /// `u32::MAX` pixels) or a degenerate camera.
+    pub(crate) fn new(
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        pixel_centers: bool,
+    ) -> Result<CameraRec, GpuError> {
+        let pixels = width as u64 * height as u64;
+        if width == 0 || height == 0 || pixels > u32::MAX as u64 {
+            return Err(GpuError::Camera {
+                detail: format!("image size {width}x{height} is empty or too large"),
+            });
+        }
+        let forward = (camera.target - camera.position).normalize();
+        let right = -camera.up.cross(forward).normalize();
+        let up = -forward.cross(right);
+        if !(camera.position.is_finite() && forward.is_finite() && right.is_finite()) {
+            return Err(GpuError::Camera {
+                detail: format!("degenerate camera {camera:?}"),
+            });
+        }
+        let half_h = (camera.vfov_deg.to_radians() * 0.5).tan();
+        let aspect = width as f32 / height as f32;
+        let offset = if pixel_centers { 0.5 } else { 0.0 };
+        let v4 = |v: Vec3| v.extend(0.0).to_array();
+        Ok(CameraRec {
+            eye: v4(camera.position),
+            forward: v4(forward),
+            right: v4(right),
+            up: v4(up),
+            lens: [half_h, aspect, offset, 0.0],
+        })
+    }
+}
 
 /// One batch ray: origin + `t_min`, direction + `t_max`, projection basis.
 #[repr(C)]

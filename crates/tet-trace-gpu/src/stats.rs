@@ -29,7 +29,7 @@ impl GpuMemory {
 /// `FrameStats` (so `tet-bench` can report GPU methods the same way).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct DispatchStats {
-    /// Method name (`"gpu-tet20"`, ...).
+    /// Method name (`"gpu-tet20"`, ..., `"gpu-bvh"`).
     pub method: String,
     /// Adapter, from [`GpuContext::device_name`](crate::GpuContext::device_name).
     pub device: String,
@@ -49,7 +49,9 @@ pub struct DispatchStats {
     pub hits: u64,
     /// Rays that failed (step cap, lost, invalid).
     pub failures: u64,
-    /// Tets visited by all rays (for a re-walked ray, both walks' tets).
+    /// Tets visited by all rays (for a re-walked ray, both walks' tets);
+    /// for the BVH ([`GpuBvh`](crate::GpuBvh), method `"gpu-bvh"`), the
+    /// BVH boxes tested, the root's included.
     pub tets_visited: u64,
     /// Rays whose GPU walk lost its way (reached the default step cap, or
     /// found no start: `Failure::StepCap`, `Failure::Lost`) and that the

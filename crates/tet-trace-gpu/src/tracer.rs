@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use bytemuck::Zeroable;
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use tet_core::TetMesh;
 use tet_core::scene::Camera;
 use tet_trace_cpu::render::PinholeCamera;
@@ -19,7 +19,7 @@ use crate::dispatch::{Kernel, add_gpu_ms, rays_per_dispatch};
 use crate::error::GpuError;
 use crate::layout::GpuLayout;
 use crate::lost::exact_where_lost;
-use crate::records::{HitRec, Params, RayRec, StartRec};
+use crate::records::{CameraRec, HitRec, Params, RayRec, StartRec};
 use crate::starts::start_record;
 use crate::stats::{DispatchStats, GpuFrame, GpuMemory};
 
@@ -183,12 +183,8 @@ impl<'a> GpuTracer<'a> {
         start_tet: u32,
     ) -> Result<GpuFrame, GpuError> {
         let mesh = self.mesh;
+        let camera_rec = CameraRec::new(camera, width, height, pixel_centers)?;
         let pixels = width as u64 * height as u64;
-        if width == 0 || height == 0 || pixels > u32::MAX as u64 {
-            return Err(GpuError::Camera {
-                detail: format!("image size {width}x{height} is empty or too large"),
-            });
-        }
         if start_tet as usize >= mesh.tets.len() {
             return Err(GpuError::Camera {
                 detail: format!(
@@ -197,18 +193,6 @@ impl<'a> GpuTracer<'a> {
                 ),
             });
         }
-        let forward = (camera.target - camera.position).normalize();
-        let right = -camera.up.cross(forward).normalize();
-        let up = -forward.cross(right);
-        if !(camera.position.is_finite() && forward.is_finite() && right.is_finite()) {
-            return Err(GpuError::Camera {
-                detail: format!("degenerate camera {camera:?}"),
-            });
-        }
-        let half_h = (camera.vfov_deg.to_radians() * 0.5).tan();
-        let aspect = width as f32 / height as f32;
-        let offset = if pixel_centers { 0.5 } else { 0.0 };
-        let v4 = |v: Vec3| v.extend(0.0).to_array();
         let base = Params {
             camera_mode: 1,
             width,
@@ -216,11 +200,7 @@ impl<'a> GpuTracer<'a> {
             cam_tet: start_tet,
             cam_ids: mesh.tets[start_tet as usize],
             cam_links: mesh.neighbors[start_tet as usize].map(|l| l.0),
-            eye: v4(camera.position),
-            forward: v4(forward),
-            right: v4(right),
-            up: v4(up),
-            lens: [half_h, aspect, offset, 0.0],
+            camera: camera_rec,
             ..self.base_params()
         };
         let mut stats = self.new_stats();

@@ -5,6 +5,7 @@
 pub mod accuracy;
 pub mod build;
 pub mod convert;
+pub mod gpu_bench;
 pub mod info;
 pub mod iso;
 pub mod job;

@@ -53,7 +53,7 @@ mod large_models;
 mod memory;
 mod out_of_core;
 mod out_of_core_large;
-mod paper;
+pub mod paper;
 mod plan;
 mod plots;
 mod quality;
