@@ -21,46 +21,13 @@ use glam::Vec3;
 use tet_core::TetMesh;
 use tet_core::scene::Camera;
 use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
-use tet_trace_cpu::reference::{Aim, closest_hit, grazes_an_edge, random_ray, ray_triangle};
+use tet_trace_cpu::reference::{closest_hit, grazes_an_edge, ray_triangle};
 use tet_trace_cpu::render::PinholeCamera;
-use tet_trace_cpu::{Ray, Start, locate};
-use tet_trace_gpu::{
-    BvhHit, GpuBvh, GpuContext, GpuError, GpuLayout, GpuOptions, GpuTracer, REQUIRE_ADAPTER_ENV,
-};
+use tet_trace_cpu::{Ray, locate};
+use tet_trace_gpu::{BvhHit, GpuBvh, GpuContext, GpuError, GpuLayout, GpuOptions, GpuTracer};
 
-/// Distance to a constrained-face edge below which a ray counts as grazing
-/// (meshes have unit cells; scaled with the mesh).
-const GRAZE: f64 = 1e-4;
-
-fn required() -> bool {
-    std::env::var(REQUIRE_ADAPTER_ENV).is_ok_and(|v| !v.is_empty() && v != "0")
-}
-
-/// The adapter, or `None` (with a printed skip message) when there is none.
-fn gpu_with(opts: &GpuOptions) -> Option<GpuContext> {
-    match GpuContext::with_options(opts) {
-        Ok(c) => {
-            eprintln!("adapter: {}", c.device_name());
-            Some(c)
-        }
-        Err(e) => {
-            assert!(
-                !required(),
-                "{REQUIRE_ADAPTER_ENV} is set but no GPU adapter is available: {e}"
-            );
-            eprintln!(
-                "SKIPPED: no wgpu adapter ({e}). Install a Vulkan driver (lavapipe: \
-                 apt-get install -y mesa-vulkan-drivers) or set {REQUIRE_ADAPTER_ENV}=1 \
-                 to make this a failure."
-            );
-            None
-        }
-    }
-}
-
-fn gpu() -> Option<GpuContext> {
-    gpu_with(&GpuOptions::default())
-}
+mod common;
+use common::{GRAZE, gpu, gpu_with, random_rays};
 
 /// The mesh of the walk tests' random rays: 5³ jittered cells, 15 % of the
 /// faces constrained.
@@ -73,25 +40,6 @@ fn scattered_faces(scale: f32) -> TetMesh {
         seed: 11,
         ..Default::default()
     })
-}
-
-/// `n` rays from random points inside the mesh, aimed in turn at random
-/// directions, vertices, edge midpoints and face centroids, with the tet
-/// holding each origin.
-fn random_rays(mesh: &TetMesh, n: usize, seed: u64) -> (Vec<Ray>, Vec<Start>) {
-    let mut rng = SplitMix64(seed);
-    let aims = [
-        Aim::Random,
-        Aim::Vertex,
-        Aim::EdgeMidpoint,
-        Aim::FaceCentroid,
-    ];
-    (0..n)
-        .map(|i| {
-            let (r, t) = random_ray(mesh, &mut rng, aims[i % 4]);
-            (r, Start::Tet(t))
-        })
-        .unzip()
 }
 
 /// True when some face's crossing lies within rounding of the ray's

@@ -24,50 +24,17 @@ use glam::Vec3;
 use tet_core::TetMesh;
 use tet_core::scene::Camera;
 use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
-use tet_trace_cpu::reference::{Aim, axis_ray, closest_hit, grazes_an_edge, random_ray};
+use tet_trace_cpu::reference::{axis_ray, closest_hit, grazes_an_edge};
 use tet_trace_cpu::render::PinholeCamera;
 use tet_trace_cpu::tet16::Tet16Tracer;
 use tet_trace_cpu::tet20::Tet20Tracer;
 use tet_trace_cpu::tet32::Tet32Tracer;
 use tet_trace_cpu::tet80::Tet80Tracer;
 use tet_trace_cpu::{Failure, Ray, Start, TraceOutcome, Tracer, Viewpoint, locate};
-use tet_trace_gpu::{
-    GpuContext, GpuError, GpuFrame, GpuLayout, GpuOptions, GpuTracer, REQUIRE_ADAPTER_ENV,
-};
+use tet_trace_gpu::{GpuContext, GpuError, GpuFrame, GpuLayout, GpuOptions, GpuTracer};
 
-/// Distance to a constrained-face edge below which a ray counts as grazing
-/// (meshes have unit cells).
-const GRAZE: f64 = 1e-4;
-
-fn required() -> bool {
-    std::env::var(REQUIRE_ADAPTER_ENV).is_ok_and(|v| !v.is_empty() && v != "0")
-}
-
-/// The adapter, or `None` (with a printed skip message) when there is none.
-fn gpu_with(opts: &GpuOptions) -> Option<GpuContext> {
-    match GpuContext::with_options(opts) {
-        Ok(c) => {
-            eprintln!("adapter: {}", c.device_name());
-            Some(c)
-        }
-        Err(e) => {
-            assert!(
-                !required(),
-                "{REQUIRE_ADAPTER_ENV} is set but no GPU adapter is available: {e}"
-            );
-            eprintln!(
-                "SKIPPED: no wgpu adapter ({e}). Install a Vulkan driver (lavapipe: \
-                 apt-get install -y mesa-vulkan-drivers) or set {REQUIRE_ADAPTER_ENV}=1 \
-                 to make this a failure."
-            );
-            None
-        }
-    }
-}
-
-fn gpu() -> Option<GpuContext> {
-    gpu_with(&GpuOptions::default())
-}
+mod common;
+use common::{GRAZE, gpu, gpu_with, random_rays};
 
 /// Same walk: same outcome kind, face and tets visited (t and barycentrics
 /// may differ in the last bits: f32 on the GPU, f64 on the CPU).
@@ -233,22 +200,6 @@ fn check(
         rays.len()
     );
     differ
-}
-
-fn random_rays(mesh: &TetMesh, n: usize, seed: u64) -> (Vec<Ray>, Vec<Start>) {
-    let mut rng = SplitMix64(seed);
-    let aims = [
-        Aim::Random,
-        Aim::Vertex,
-        Aim::EdgeMidpoint,
-        Aim::FaceCentroid,
-    ];
-    (0..n)
-        .map(|i| {
-            let (r, t) = random_ray(mesh, &mut rng, aims[i % 4]);
-            (r, Start::Tet(t))
-        })
-        .unzip()
 }
 
 /// The CPU kernel of the same layout (f32 Duff projection).

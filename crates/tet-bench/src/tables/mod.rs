@@ -67,6 +67,8 @@ mod strips_vs_bvh;
 mod variant;
 mod zoom;
 
+pub use doc::TABLE_FLAGS;
+
 use std::time::Instant;
 
 use anyhow::{Context, Result};
@@ -77,7 +79,7 @@ use crate::methods::cpu_methods;
 use crate::methods::method::Method;
 use crate::output::{error_chain, outln, print_json};
 use crate::timing::{pool, target_features};
-use doc::{QualityTrade, SceneResult, Setup, TABLE_FLAGS, TablesDoc};
+use doc::{QualityTrade, SceneResult, Setup, TablesDoc};
 use plan::{MeshCache, Planned, plan, scene_specs};
 use report::{markdown, write_atomic, write_outputs};
 

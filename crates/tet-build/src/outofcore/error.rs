@@ -83,6 +83,12 @@ pub enum SeamError {
         /// What went wrong.
         what: &'static str,
     },
+    /// Several planes of one clipping pass met a point within tolerance or
+    /// a degenerate cut (each a [`SeamError::PlaneNearPoint`] or
+    /// [`SeamError::DegenerateCut`], in the order met; never fewer than
+    /// two): the planner moves all of them at once.
+    #[error("{} planes to move off points; the first: {}", .0.len(), .0.first().map_or(String::new(), |e| e.to_string()))]
+    PlanesNearPoints(Vec<SeamError>),
     /// A clipped piece of a scene triangle could not be triangulated
     /// (rounding made its outline self-intersect).
     #[error("piece of scene triangle {triangle} with {vertices} vertices cannot be triangulated")]
@@ -216,6 +222,32 @@ pub enum SeamError {
 }
 
 impl SeamError {
+    /// `found` as one error: none, the one, or
+    /// [`SeamError::PlanesNearPoints`].
+    pub(crate) fn planes_to_move(mut found: Vec<SeamError>) -> Option<SeamError> {
+        match found.len() {
+            0 => None,
+            1 => found.pop(),
+            _ => Some(SeamError::PlanesNearPoints(found)),
+        }
+    }
+
+    /// Each plane a retry moves off a point, with the point, where this
+    /// is a cut meeting a point within tolerance or a degenerate
+    /// configuration ([`SeamError::PlaneNearPoint`],
+    /// [`SeamError::DegenerateCut`], each of
+    /// [`SeamError::PlanesNearPoints`]); empty otherwise.
+    pub fn planes_near_points(&self) -> Vec<(SplitPlane, Vec3)> {
+        match self {
+            SeamError::PlaneNearPoint { plane, point, .. }
+            | SeamError::DegenerateCut { plane, point, .. } => vec![(*plane, *point)],
+            SeamError::PlanesNearPoints(all) => {
+                all.iter().flat_map(SeamError::planes_near_points).collect()
+            }
+            _ => Vec::new(),
+        }
+    }
+
     /// The part whose walls a retry moves, where this is TetGen failing on
     /// one part in a way a slightly different PLC may not meet: running
     /// past its time limit (its boundary recovery under `-Y` looping), a

@@ -66,17 +66,8 @@ pub fn mesh_file_name(spec: &str) -> Option<String> {
 /// rays start in the camera's tet, on the GPU) unless `tight`.
 pub fn build_flags(tight: bool) -> BuildFlags {
     BuildFlags {
-        quality: None,
-        min_dihedral: None,
-        max_steiner: None,
-        optimize: None,
-        max_dihedral: None,
-        time_limit: 600.0,
-        no_box: false,
         wide_box: !tight,
-        no_sort: false,
-        no_resolve: false,
-        walls: None,
+        ..crate::tables::TABLE_FLAGS
     }
 }
 

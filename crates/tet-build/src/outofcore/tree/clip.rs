@@ -230,6 +230,10 @@ pub(super) fn run_clipping(
     // (node, polygons, ghosts). Every point of a polygon is a scene vertex
     // (in `lines` already) or a registered crossing (added below).
     let mut stack = vec![(0usize, root_polys, Vec::<Poly>::new())];
+    // Planes that met a point within tolerance or a degenerate cut: the
+    // pass goes on past them (not below them), so that one retry of the
+    // planner moves every such plane found, not one per pass.
+    let mut to_move: Vec<SeamError> = Vec::new();
     while let Some((id, polys, ghosts)) = stack.pop() {
         let Some((plane, w, below, above)) = nodes[id].split else {
             pieces[id] = polys;
@@ -242,16 +246,19 @@ pub(super) fn run_clipping(
             .into_iter()
             .map(|p| (p, false))
             .chain(ghosts.into_iter().map(|p| (p, true)));
+        let mut broken = false;
         for (poly, ghost) in all {
             if let Some(&x) = poly.v.iter().find(|x| {
                 let d = (x[c] as f64 - plane.value as f64).abs();
                 d > 0.0 && d < tolerance
             }) {
-                return Err(SeamError::PlaneNearPoint {
+                to_move.push(SeamError::PlaneNearPoint {
                     plane,
                     point: x,
                     distance: (x[c] as f64 - plane.value as f64).abs(),
                 });
+                broken = true;
+                continue;
             }
             let below_any = poly.v.iter().any(|x| x[c] < plane.value);
             let above_any = poly.v.iter().any(|x| x[c] > plane.value);
@@ -265,7 +272,15 @@ pub(super) fn run_clipping(
                     hi_g.push(poly);
                 }
                 (true, true) => {
-                    let (l, h, seg) = clip(&poly, plane, &mut reg, tolerance)?;
+                    let (l, h, seg) = match clip(&poly, plane, &mut reg, tolerance) {
+                        Ok(cut) => cut,
+                        Err(e @ SeamError::DegenerateCut { .. }) => {
+                            to_move.push(e);
+                            broken = true;
+                            continue;
+                        }
+                        Err(e) => return Err(e),
+                    };
                     if !ghost {
                         triangles_cut.insert(poly.source);
                         walls[w].segments.push((
@@ -302,8 +317,15 @@ pub(super) fn run_clipping(
                 }
             }
         }
+        if broken {
+            // The halves are not whole: nothing below is checked this pass.
+            continue;
+        }
         stack.push((below, lo_p, lo_g));
         stack.push((above, hi_p, hi_g));
+    }
+    if let Some(e) = SeamError::planes_to_move(to_move) {
+        return Err(e);
     }
     reg.freeze();
     lines.add_crossings(reg.points());
@@ -343,6 +365,48 @@ mod tests {
                 split(0, 6.0, CutTree::Leaf, CutTree::Leaf),
             ),
         )
+    }
+
+    /// Every plane of one pass that meets a point within tolerance is
+    /// reported, not only the first (here two planes in two subtrees, each
+    /// with a vertex two or one f32 steps off it): the planner moves them
+    /// all in one retry.
+    #[test]
+    fn a_pass_reports_every_plane_near_a_point() {
+        let up = |v: f32, steps: u32| f32::from_bits(v.to_bits() + steps);
+        let vertices = [
+            Vec3::new(1.0, 1.0, 1.0),
+            Vec3::new(2.0, up(2.0, 2), 1.0),
+            Vec3::new(1.5, 3.0, 3.0),
+            Vec3::new(5.0, 1.0, 4.0),
+            Vec3::new(7.0, 1.0, up(5.0, 1)),
+            Vec3::new(5.5, 3.0, 6.0),
+        ];
+        let triangles = [[0, 1, 2], [3, 4, 5]];
+        let e = match run_clipping(&vertices, &triangles, &tree(), Vec3::ZERO, Vec3::splat(8.0)) {
+            Err(e) => e,
+            Ok(_) => panic!("both planes pass within tolerance of a vertex"),
+        };
+        assert!(
+            matches!(&e, SeamError::PlanesNearPoints(all) if all.len() == 2),
+            "{e}"
+        );
+        let mut planes: Vec<(usize, f32)> = e
+            .planes_near_points()
+            .into_iter()
+            .map(|(p, _)| (p.axis, p.value))
+            .collect();
+        planes.sort_by_key(|p| p.0);
+        assert_eq!(planes, vec![(1, 2.0), (2, 5.0)]);
+        // One such vertex alone: the single error, as before.
+        let one = run_clipping(
+            &vertices,
+            &triangles[..1],
+            &tree(),
+            Vec3::ZERO,
+            Vec3::splat(8.0),
+        );
+        assert!(matches!(one, Err(SeamError::PlaneNearPoint { .. })));
     }
 
     /// The leaf whose box holds `t` at least `tolerance` away from every

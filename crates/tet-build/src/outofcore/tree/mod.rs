@@ -260,8 +260,10 @@ pub struct TreePlan {
     pub part_failures: Vec<String>,
 }
 
-/// How many times [`build_tree_with_memory_limit`] moves a plane that met
-/// a degenerate configuration before giving up.
+/// How many times [`build_tree_with_memory_limit`] moves planes that met
+/// a degenerate configuration before giving up: each time, every plane
+/// one clipping pass found near a point (at 100 M triangles, more than one
+/// per pass).
 pub const MAX_PLANE_MOVES: usize = 8;
 
 /// How many times [`build_tree_with_memory_limit`] moves the walls of one
@@ -284,7 +286,8 @@ pub const MAX_PART_RETRIES: usize = 6;
 /// or [`SeamError::DegenerateCut`]) is moved, within half a step (1/4096
 /// of the box's extent), to the value farthest from that point and the
 /// scene's vertices in its box (module `clear`), and the build retried, at
-/// most [`MAX_PLANE_MOVES`] times; the walls of a part TetGen fails on or
+/// most [`MAX_PLANE_MOVES`] times (each retry moves every plane the
+/// clipping found near a point: [`SeamError::PlanesNearPoints`]); the walls of a part TetGen fails on or
 /// runs past its time limit on are moved by about a step (likewise to
 /// the clearest value within half a step of it), at most
 /// [`MAX_PART_MOVES`] times per part and in at most [`MAX_PART_RETRIES`]
@@ -366,9 +369,9 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
     let mut tree = CutTree::from_split_tree(&plan);
     plan.forget_triangles();
     drop(cleaned);
-    // Moves of planes too near a point (at most `MAX_PLANE_MOVES`),
-    // attempts after parts failed.
-    let (mut plane_moves, mut retries) = (0, 0);
+    // Planes moved off points, the attempts that moved them (at most
+    // `MAX_PLANE_MOVES`), attempts after parts failed.
+    let (mut plane_moves, mut plane_retries, mut retries) = (0, 0, 0);
     let mut part_failures = Vec::new();
     // Wall moves per part (by leaf index, which moves do not change).
     let mut part_moves = std::collections::HashMap::<usize, usize>::new();
@@ -391,24 +394,34 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                     },
                 ));
             }
-            // The plane moves to the value farthest from the point and
-            // every scene vertex in its box, within half a step.
-            Err(
-                e @ (SeamError::PlaneNearPoint { plane, point, .. }
-                | SeamError::DegenerateCut { plane, point, .. }),
-            ) => {
-                clear.avoid(point);
+            // Every plane the clipping found near a point moves to the
+            // value farthest from the points and every scene vertex in its
+            // box, within half a step (each plane once).
+            Err(e) if !e.planes_near_points().is_empty() => {
+                let found = e.planes_near_points();
+                if plane_retries >= MAX_PLANE_MOVES {
+                    return Err(e);
+                }
+                for &(_, point) in &found {
+                    clear.avoid(point);
+                }
                 // Where no gap is wide enough in the whole box (only the
                 // pieces crossing the node are checked), the fixed step.
                 let mut to = |p: SplitPlane, lo, hi| {
                     let v = clear.value(p, lo, hi, p.value as f64, step / 2.0);
                     v.or(Some((p.value as f64 + step) as f32))
                 };
-                if plane_moves >= MAX_PLANE_MOVES || !tree.move_plane(plane, b.min, b.max, &mut to)
-                {
+                let mut moved: Vec<SplitPlane> = Vec::new();
+                for &(plane, _) in &found {
+                    if !moved.contains(&plane) && tree.move_plane(plane, b.min, b.max, &mut to) {
+                        moved.push(plane);
+                    }
+                }
+                if moved.is_empty() {
                     return Err(e);
                 }
-                plane_moves += 1;
+                plane_retries += 1;
+                plane_moves += moved.len();
             }
             // TetGen stuck or failing on parts: their walls met the
             // scene in a configuration TetGen's boundary recovery (`-Y`
@@ -490,7 +503,53 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
 #[cfg(test)]
 mod tests {
     use super::geometry::triangulate_outline;
+    use super::*;
     use glam::Vec3;
+
+    /// One retry moves every plane a clipping pass found near a point (the
+    /// build here reports every wall of the part with the most at once),
+    /// and counts each.
+    #[test]
+    fn one_retry_moves_every_plane_found_near_a_point() {
+        let scene = crate::outofcore::memory_model::knot_grid(1, 60, 8);
+        let split = super::super::split::SplitOptions {
+            limit_bytes: u64::MAX,
+            min_depth: 3,
+            ..Default::default()
+        };
+        let mut calls: Vec<CutTree> = Vec::new();
+        let mut part = 0;
+        let (_, plan) = plan_tree_with_moves(&scene, &split, &SeamOptions::default(), |tree| {
+            calls.push(tree.clone());
+            if calls.len() > 1 {
+                return Ok(());
+            }
+            part = (0..tree.parts())
+                .max_by_key(|&k| tree.leaf_walls(k).unwrap().len())
+                .unwrap();
+            let near = tree
+                .leaf_walls(part)
+                .unwrap()
+                .into_iter()
+                .map(|plane| SeamError::PlaneNearPoint {
+                    plane,
+                    point: Vec3::splat(plane.value),
+                    distance: 1e-9,
+                })
+                .collect();
+            Err(SeamError::PlanesNearPoints(near))
+        })
+        .unwrap();
+        assert_eq!(calls.len(), 2, "one retry");
+        let before = calls[0].leaf_walls(part).unwrap();
+        let after = calls[1].leaf_walls(part).unwrap();
+        assert!(before.len() >= 2, "{before:?}");
+        assert_eq!(plan.plane_moves, before.len());
+        for (b, a) in before.iter().zip(&after) {
+            assert_eq!(b.axis, a.axis);
+            assert_ne!(b.value, a.value, "{b:?} did not move");
+        }
+    }
 
     /// A piece nearly parallel to a wall (z = 0) whose chain A–D–C on the
     /// wall is not exactly straight: the ear at B would leave the sliver
