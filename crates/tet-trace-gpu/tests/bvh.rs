@@ -27,7 +27,7 @@ use tet_trace_cpu::{Ray, locate};
 use tet_trace_gpu::{BvhHit, GpuBvh, GpuContext, GpuError, GpuLayout, GpuOptions, GpuTracer};
 
 mod common;
-use common::{GRAZE, gpu, gpu_with, random_rays};
+use common::{GRAZE, gpu, gpu_with, random_rays, shell_in_view};
 
 /// The mesh of the walk tests' random rays: 5³ jittered cells, 15 % of the
 /// faces constrained.
@@ -234,20 +234,7 @@ fn camera_case(ctx: &GpuContext, mesh: &TetMesh, camera: &Camera, w: u32, h: u32
 #[test]
 fn camera_rays_match_the_host_rays_and_the_walk() {
     let Some(ctx) = gpu() else { return };
-    let mesh = kuhn_grid(&GridSpec {
-        cells: [6, 6, 6],
-        jitter: 0.1,
-        constrained_fraction: 0.02,
-        shell: Some(([2, 2, 2], [4, 4, 4])),
-        seed: 17,
-        ..Default::default()
-    });
-    let camera = Camera {
-        position: Vec3::new(0.55, 4.3, 0.8),
-        target: Vec3::new(3.0, 3.0, 3.0),
-        up: Vec3::Y,
-        vfov_deg: 45.0,
-    };
+    let (mesh, camera) = shell_in_view();
     camera_case(&ctx, &mesh, &camera, 40, 30, false);
     // An odd size (a partial workgroup) through pixel centres.
     camera_case(&ctx, &mesh, &camera, 37, 23, true);

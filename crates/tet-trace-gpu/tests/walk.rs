@@ -34,7 +34,7 @@ use tet_trace_cpu::{Failure, Ray, Start, TraceOutcome, Tracer, Viewpoint, locate
 use tet_trace_gpu::{GpuContext, GpuError, GpuFrame, GpuLayout, GpuOptions, GpuTracer};
 
 mod common;
-use common::{GRAZE, gpu, gpu_with, random_rays};
+use common::{GRAZE, gpu, gpu_with, random_rays, shell_in_view};
 
 /// Same walk: same outcome kind, face and tets visited (t and barycentrics
 /// may differ in the last bits: f32 on the GPU, f64 on the CPU).
@@ -547,20 +547,7 @@ fn camera_case(
 #[test]
 fn camera_rays_generated_on_the_gpu_match_the_cpu_camera() {
     let Some(ctx) = gpu() else { return };
-    let mesh = kuhn_grid(&GridSpec {
-        cells: [6, 6, 6],
-        jitter: 0.1,
-        constrained_fraction: 0.02,
-        shell: Some(([2, 2, 2], [4, 4, 4])),
-        seed: 17,
-        ..Default::default()
-    });
-    let camera = Camera {
-        position: Vec3::new(0.55, 4.3, 0.8),
-        target: Vec3::new(3.0, 3.0, 3.0),
-        up: Vec3::Y,
-        vfov_deg: 45.0,
-    };
+    let (mesh, camera) = shell_in_view();
     for layout in GpuLayout::ALL {
         let frame = camera_case(&ctx, layout, &mesh, &camera, 40, 30);
         let hits = frame.outcomes.iter().filter(|o| o.hit().is_some()).count();

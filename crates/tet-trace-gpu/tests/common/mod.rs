@@ -4,8 +4,10 @@
 
 #![allow(dead_code)]
 
+use glam::Vec3;
 use tet_core::TetMesh;
-use tet_core::synthetic::SplitMix64;
+use tet_core::scene::Camera;
+use tet_core::synthetic::{GridSpec, SplitMix64, kuhn_grid};
 use tet_trace_cpu::reference::{Aim, random_ray};
 use tet_trace_cpu::{Ray, Start};
 use tet_trace_gpu::{GpuContext, GpuOptions, REQUIRE_ADAPTER_ENV};
@@ -62,4 +64,25 @@ pub fn random_rays(mesh: &TetMesh, n: usize, seed: u64) -> (Vec<Ray>, Vec<Start>
             (r, Start::Tet(t))
         })
         .unzip()
+}
+
+/// The camera tests' scene: a jittered 6³ grid with a closed shell around
+/// cells 2..4 and 2 % of the other faces constrained, and a camera inside
+/// the grid looking at the shell.
+pub fn shell_in_view() -> (TetMesh, Camera) {
+    let mesh = kuhn_grid(&GridSpec {
+        cells: [6, 6, 6],
+        jitter: 0.1,
+        constrained_fraction: 0.02,
+        shell: Some(([2, 2, 2], [4, 4, 4])),
+        seed: 17,
+        ..Default::default()
+    });
+    let camera = Camera {
+        position: Vec3::new(0.55, 4.3, 0.8),
+        target: Vec3::new(3.0, 3.0, 3.0),
+        up: Vec3::Y,
+        vfov_deg: 45.0,
+    };
+    (mesh, camera)
 }
