@@ -98,6 +98,16 @@ pub enum SeamError {
         /// Vertices of the piece's outline.
         vertices: usize,
     },
+    /// A clipped piece of part `part` could not be triangulated
+    /// ([`SeamError::PieceTriangulation`]): moving the part's walls cuts
+    /// the triangle elsewhere.
+    #[error("part {part}: {source}")]
+    PartPiece {
+        /// Part index.
+        part: usize,
+        /// The failure.
+        source: Box<SeamError>,
+    },
     /// No slab plan fits the memory limit.
     #[error("no slab plan keeps every part under {limit_bytes} bytes")]
     LimitTooSmall {
@@ -253,7 +263,9 @@ impl SeamError {
     /// past its time limit (its boundary recovery under `-Y` looping), a
     /// crash, its own internal or small-feature errors, or Steiner points
     /// that flatten tets when rounded to f32; or a job's part whose input
-    /// failed so before ([`SeamError::FailedBefore`]).
+    /// failed so before ([`SeamError::FailedBefore`]); or a piece of the
+    /// part's clipped triangles that rounding left untriangulable
+    /// ([`SeamError::PartPiece`]).
     pub fn part_to_retry(&self) -> Option<usize> {
         match self {
             SeamError::Tetgen {
@@ -267,7 +279,8 @@ impl SeamError {
                     | TetgenError::WorkerDied { .. },
             }
             | SeamError::RoundingFlattens { part, .. }
-            | SeamError::FailedBefore { part, .. } => Some(*part),
+            | SeamError::FailedBefore { part, .. }
+            | SeamError::PartPiece { part, .. } => Some(*part),
             _ => None,
         }
     }

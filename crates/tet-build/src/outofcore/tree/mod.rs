@@ -197,17 +197,35 @@ fn tree_part_inputs_of<'a>(
     }
     let mut clipped = Vec::with_capacity(leaves.len());
     let mut walls = Vec::with_capacity(leaves.len());
-    for &id in &leaves {
+    // Parts with a piece rounding left untriangulable (seen at 100 M
+    // triangles): their walls move, as for a part TetGen fails on, so that
+    // the planes cut the triangle elsewhere; all of them in one retry.
+    let mut untriangulable = Vec::new();
+    for (k, &id) in leaves.iter().enumerate() {
         // Each leaf's pieces are dropped as their facets are made, so the
         // two are not held whole at once.
         let polys = std::mem::take(&mut cut.pieces[id]);
         let mut pieces = Vec::with_capacity(polys.len());
         for poly in &polys {
-            let facets = piece_facets(poly, &cleaned, &cut.registry, &cut.lines)?;
-            pieces.push((poly.source, facets));
+            match piece_facets(poly, &cleaned, &cut.registry, &cut.lines) {
+                Ok(facets) => pieces.push((poly.source, facets)),
+                Err(e @ SeamError::PieceTriangulation { .. }) => {
+                    untriangulable.push(SeamError::PartPiece {
+                        part: k,
+                        source: Box::new(e),
+                    });
+                    break;
+                }
+                Err(e) => return Err(e),
+            }
         }
         clipped.push(pieces);
         walls.push(leaf_faces(&cut, id));
+    }
+    match untriangulable.len() {
+        0 => {}
+        1 => return Err(untriangulable.remove(0)),
+        _ => return Err(SeamError::PartsFailed(untriangulable)),
     }
     let mut part_of_node = vec![None; cut.nodes.len()];
     for (k, &id) in leaves.iter().enumerate() {
@@ -505,6 +523,38 @@ mod tests {
     use super::geometry::triangulate_outline;
     use super::*;
     use glam::Vec3;
+
+    /// A part with a clipped piece rounding left untriangulable has its
+    /// walls moved and the build tried again, like a part TetGen fails on.
+    #[test]
+    fn an_untriangulable_piece_moves_its_parts_walls() {
+        let scene = crate::outofcore::memory_model::knot_grid(1, 60, 8);
+        let split = super::super::split::SplitOptions {
+            limit_bytes: u64::MAX,
+            min_depth: 2,
+            ..Default::default()
+        };
+        let mut calls: Vec<CutTree> = Vec::new();
+        let (_, plan) = plan_tree_with_moves(&scene, &split, &SeamOptions::default(), |tree| {
+            calls.push(tree.clone());
+            if calls.len() > 1 {
+                return Ok(());
+            }
+            Err(SeamError::PartPiece {
+                part: 1,
+                source: Box::new(SeamError::PieceTriangulation {
+                    triangle: 7,
+                    vertices: 4,
+                }),
+            })
+        })
+        .unwrap();
+        assert_eq!(calls.len(), 2, "one retry");
+        assert_eq!(plan.part_failures.len(), 1, "{:?}", plan.part_failures);
+        let before = calls[0].leaf_walls(1).unwrap();
+        let after = calls[1].leaf_walls(1).unwrap();
+        assert!(before.iter().zip(&after).any(|(b, a)| b.value != a.value));
+    }
 
     /// One retry moves every plane a clipping pass found near a point (the
     /// build here reports every wall of the part with the most at once),
