@@ -20,7 +20,9 @@
 #       (name, backend, device type, driver); fail on a software adapter.
 #   scripts/gpu/headless-nvidia.sh bench OUT_DIR [gpu-bench flags]
 #       check, then `tet-bench gpu-bench OUT_DIR [flags]`: gpu.json and
-#       gpu.md in OUT_DIR (docs/cli.md, docs/json.md).
+#       gpu.md in OUT_DIR (docs/cli.md, docs/json.md), and, where
+#       nvidia-smi is there, the clocks before and after in
+#       OUT_DIR/nvidia-smi.csv.
 #
 # Environment: TET_BENCH, the binary (default target/release/tet-bench,
 # built with `cargo build --release -p tet-bench --features gpu`); DEB_DIR
@@ -112,6 +114,17 @@ setup() {
     fi
 }
 
+# The GPU's clocks, power and temperature as nvidia-smi reads them (when
+# the machine has it), one line per call, into OUT_DIR/nvidia-smi.csv:
+# wgpu does not report clocks.
+clocks() {
+    command -v nvidia-smi >/dev/null || return 0
+    local f="$out/nvidia-smi.csv"
+    local q=name,driver_version,clocks.sm,clocks.max.sm,clocks.mem,power.draw,temperature.gpu
+    [ -f "$f" ] || echo "when,$q" >"$f"
+    nvidia-smi --query-gpu="$q" --format=csv,noheader | sed "s/^/$1,/" >>"$f" || true
+}
+
 check() {
     [ -x "$TET_BENCH" ] || die "no $TET_BENCH (set TET_BENCH, or build it: cargo build --release -p tet-bench --features gpu)"
     local allow=()
@@ -139,10 +152,13 @@ bench)
     shift
     setup
     check
+    mkdir -p "$out"
+    clocks before
     "$TET_BENCH" gpu-bench "$out" "$@"
+    clocks after
     ;;
 *)
-    sed -n '2,34p' "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,37p' "$0" | sed 's/^# \{0,1\}//'
     exit 2
     ;;
 esac
