@@ -232,14 +232,28 @@ pub enum SeamError {
 }
 
 impl SeamError {
-    /// `found` as one error: none, the one, or
-    /// [`SeamError::PlanesNearPoints`].
-    pub(crate) fn planes_to_move(mut found: Vec<SeamError>) -> Option<SeamError> {
+    /// `found` as one error: none, the one, or `many` holding them all.
+    fn one_or_many(
+        mut found: Vec<SeamError>,
+        many: fn(Vec<SeamError>) -> SeamError,
+    ) -> Option<SeamError> {
         match found.len() {
             0 => None,
             1 => found.pop(),
-            _ => Some(SeamError::PlanesNearPoints(found)),
+            _ => Some(many(found)),
         }
+    }
+
+    /// `found` as one error: none, the one, or
+    /// [`SeamError::PlanesNearPoints`].
+    pub(crate) fn planes_to_move(found: Vec<SeamError>) -> Option<SeamError> {
+        SeamError::one_or_many(found, SeamError::PlanesNearPoints)
+    }
+
+    /// `found` (part failures a retry may cure) as one error: none, the
+    /// one, or [`SeamError::PartsFailed`].
+    pub(crate) fn parts_failed(found: Vec<SeamError>) -> Option<SeamError> {
+        SeamError::one_or_many(found, SeamError::PartsFailed)
     }
 
     /// Each plane a retry moves off a point, with the point, where this

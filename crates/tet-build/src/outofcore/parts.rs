@@ -501,11 +501,7 @@ pub(super) fn run_parts<T: Send>(
             None => {}
         }
     }
-    let first_error = fatal.or_else(|| match curable.len() {
-        0 => None,
-        1 => curable.pop(),
-        _ => Some(SeamError::PartsFailed(curable)),
-    });
+    let first_error = fatal.or_else(|| SeamError::parts_failed(curable));
     match first_error {
         Some(e) => {
             if let Some(c) = cache {

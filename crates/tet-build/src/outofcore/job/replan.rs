@@ -84,9 +84,5 @@ pub(super) fn fail_known_inputs(
             });
         }
     }
-    match again.len() {
-        0 => Ok(()),
-        1 => Err(again.remove(0)),
-        _ => Err(SeamError::PartsFailed(again)),
-    }
+    SeamError::parts_failed(again).map_or(Ok(()), Err)
 }

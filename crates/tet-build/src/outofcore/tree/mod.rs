@@ -222,10 +222,8 @@ fn tree_part_inputs_of<'a>(
         clipped.push(pieces);
         walls.push(leaf_faces(&cut, id));
     }
-    match untriangulable.len() {
-        0 => {}
-        1 => return Err(untriangulable.remove(0)),
-        _ => return Err(SeamError::PartsFailed(untriangulable)),
+    if let Some(e) = SeamError::parts_failed(untriangulable) {
+        return Err(e);
     }
     let mut part_of_node = vec![None; cut.nodes.len()];
     for (k, &id) in leaves.iter().enumerate() {
