@@ -291,6 +291,11 @@ fn memory_limit_builds_in_parts_that_trace_like_the_in_core_mesh() {
     // No retry on this scene: nothing moved, nothing reused.
     assert_eq!(m["plane_moves"].as_u64(), Some(0), "{m}");
     assert_eq!(m["parts_reused"].as_u64(), Some(0), "{m}");
+    assert_eq!(
+        m["surface_relaxed"].as_array().map(Vec::len),
+        Some(0),
+        "{m}"
+    );
     let part_tets: u64 = m["part_tets"]
         .as_array()
         .unwrap()

@@ -23,6 +23,13 @@ pub struct TetgenOptions {
     pub coplanar_tolerance: Option<f64>,
     /// `-Y`: keep the input surface mesh (no Steiner points on facets). On by default.
     pub preserve_surface: bool,
+    /// `-Y/2` (with [`Self::preserve_surface`]): where recovering a
+    /// boundary segment needs a Steiner point, TetGen puts it in the
+    /// volume, halfway between the segment and the one crossing it, and
+    /// recovers the segment again, instead of splitting the segment and
+    /// moving the point off it later (its default). Off by default; the
+    /// out-of-core builder's first relaxation for a part `-Y` fails on.
+    pub steiner_off_surface: bool,
     /// `-c`: keep the convex hull (otherwise TetGen removes tets outside the
     /// closed boundary it can find, which empties open scenes).
     pub keep_convex_hull: bool,
@@ -65,6 +72,7 @@ impl Default for TetgenOptions {
             max_steiner: None,
             coplanar_tolerance: None,
             preserve_surface: true,
+            steiner_off_surface: false,
             keep_convex_hull: true,
             neighbors: false,
             face_tets: false,
@@ -80,6 +88,9 @@ impl TetgenOptions {
         let mut s = String::from("p");
         if self.preserve_surface {
             s.push('Y');
+            if self.steiner_off_surface {
+                s.push_str("/2");
+            }
         }
         if self.keep_convex_hull {
             s.push('c');

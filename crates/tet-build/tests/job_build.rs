@@ -385,3 +385,90 @@ fn a_part_stuck_in_a_job_is_cured_by_planning_again() {
         ));
     }
 }
+
+/// A part a job's TetGen fails on wherever its walls stand is planned,
+/// after its walls moved twice, with its surface relaxed: its input file
+/// says so (another input, so another digest), `build-part` builds it
+/// with `-Y/2`, and the job merges. The worker here crashes on every
+/// request with plain `-Y` (read from the request's first bytes) and is
+/// the real worker otherwise; only `stuck` goes through it.
+#[cfg(unix)]
+#[test]
+fn a_part_failing_wherever_its_walls_stand_is_planned_with_its_surface_relaxed() {
+    use std::os::unix::fs::PermissionsExt;
+    use tet_build::outofcore::tree::MAX_PART_MOVES;
+    let scene = knot_grid(1, 120, 12);
+    let dir = tempfile::tempdir().unwrap();
+    let jobdir = dir.path().join("job");
+    let options = PlanOptions {
+        parts: 4,
+        ..PlanOptions::default()
+    };
+    let script = dir.path().join("no-y.sh");
+    std::fs::write(
+        &script,
+        format!(
+            "#!/bin/sh\nreq=$(mktemp)\ncat > \"$req\"\n\
+             if head -c 64 \"$req\" | grep -q -a pYc; then rm -f \"$req\"; kill -SEGV $$; fi\n\
+             '{worker}' \"$@\" < \"$req\"; rc=$?; rm -f \"$req\"; exit $rc\n",
+            worker = env!("CARGO_BIN_EXE_tet-build-worker"),
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let no_y = Isolation::Worker(WorkerCommand {
+        program: script,
+        args: vec![],
+        timeout: Some(Duration::from_secs(60)),
+    });
+    let stuck = 1;
+    let mut job = plan_job(&scene, &options, &jobdir).unwrap();
+    let n = job.parts.len();
+    for k in (0..n).filter(|&k| k != stuck) {
+        build_part(&jobdir, &job, k, &worker()).unwrap();
+    }
+    let mut digests = Vec::new();
+    // As planned, then moved MAX_PART_MOVES times: each fails.
+    for round in 0..=MAX_PART_MOVES {
+        let record = &job.parts[stuck];
+        assert!(!record.surface_relaxed, "round {round}");
+        assert!(!digests.contains(&record.input_digest), "round {round}");
+        digests.push(record.input_digest.clone());
+        let e = build_part(&jobdir, &job, stuck, &no_y).unwrap_err();
+        assert!(e.walls_may_cure(), "{e}");
+        job = plan_job(&scene, &options, &jobdir).unwrap();
+        assert_eq!(job.failed_inputs.len(), round + 1);
+    }
+    // Relaxed where its walls last stood: the input differs from the
+    // last failed one by its flag alone.
+    let record = &job.parts[stuck];
+    assert!(record.surface_relaxed);
+    assert!(!digests.contains(&record.input_digest));
+    assert!(job.parts.iter().filter(|p| p.surface_relaxed).count() == 1);
+    let last = std::fs::read(jobdir.join(&record.input)).unwrap();
+    let (input, _) = tet_build::outofcore::job::part_input::decode(&last).unwrap();
+    assert!(input.surface_relaxed);
+    let (unflagged, sum) = tet_build::outofcore::job::part_input::encode(
+        &tet_build::outofcore::job::part_input::PartInput {
+            surface_relaxed: false,
+            ..input
+        },
+    );
+    assert_eq!(
+        tet_build::outofcore::job::digest::format_digest(sum),
+        *digests.last().unwrap()
+    );
+    assert_eq!(unflagged.len(), last.len());
+    for k in 0..n {
+        let isolation = if k == stuck { &no_y } else { &worker() };
+        build_part(&jobdir, &job, k, isolation).unwrap();
+    }
+    let out = dir.path().join("job.tmesh");
+    merge_job(&jobdir, &job, &out).unwrap();
+    let mesh = tet_core::format::load(&out).unwrap();
+    mesh.validate().unwrap();
+    assert_eq!(
+        tet_core::InputTriangles::of(&mesh).len(),
+        scene.triangles.len()
+    );
+}

@@ -31,13 +31,14 @@ fn sample() -> PartInput {
             Vec3::splat(3.0),
             Vec3::new(3.0, -3.0, 0.5),
         ]],
+        surface_relaxed: true,
     }
 }
 
 /// The layout of the module docs, written out field by field.
 fn by_hand(p: &PartInput) -> Vec<u8> {
     let mut b = b"TETPART\0".to_vec();
-    for w in [1u32, p.part, p.triangle_count, 0] {
+    for w in [1u32, p.part, p.triangle_count, u32::from(p.surface_relaxed)] {
         b.extend(w.to_le_bytes());
     }
     b.extend((p.facets.len() as u64).to_le_bytes());
@@ -113,8 +114,8 @@ fn corrupt_part_inputs_give_typed_errors() {
         })
     ));
     let mut b = good.clone();
-    b[20] = 1;
-    assert!(matches!(decode(&b), Err(InputFault::Reserved(1))));
+    b[20] = 2;
+    assert!(matches!(decode(&b), Err(InputFault::Flags(2))));
     // A facet count that would ask for 2^64 bytes: refused by length,
     // nothing allocated.
     let mut b = good.clone();

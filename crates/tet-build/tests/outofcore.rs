@@ -1601,6 +1601,57 @@ fn first_run_fails_then_walls_move(first: &str, timeout_s: u64) {
     check_against_in_core(&scene, &mesh);
 }
 
+/// A part TetGen fails on wherever its walls stand is built with its
+/// surface relaxed (TetGen without `-Y`) after `MAX_PART_MOVES` moves.
+/// The worker here crashes on every request with `-Y` (found in the
+/// request's bytes) and is the real worker otherwise, so every part fails
+/// three times (as placed, then moved twice) and is then built relaxed;
+/// the merged mesh must trace like the in-core one.
+#[cfg(unix)]
+#[test]
+fn parts_failing_wherever_their_walls_stand_are_built_with_the_surface_relaxed() {
+    use std::os::unix::fs::PermissionsExt;
+    use tet_build::outofcore::seam::SurfaceMode;
+    use tet_build::outofcore::tree::{MAX_PART_MOVES, build_tree_with_memory_limit};
+
+    let dir = tempfile::tempdir().unwrap();
+    let (script, runs) = (dir.path().join("no-y.sh"), dir.path().join("runs"));
+    std::fs::write(
+        &script,
+        format!(
+            "#!/bin/sh
+req=$(mktemp)
+cat > \"$req\"
+             if head -c 64 \"$req\" | grep -q -a pYc; then echo Y >> '{runs}'; rm -f \"$req\"; kill -SEGV $$; fi
+             echo relaxed >> '{runs}'
+             '{worker}' \"$@\" < \"$req\"; rc=$?; rm -f \"$req\"; exit $rc
+",
+            runs = runs.display(),
+            worker = env!("CARGO_BIN_EXE_tet-build-worker"),
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let scene = knot_grid(1, 120, 12);
+    let split = SplitOptions {
+        limit_bytes: u64::MAX,
+        min_depth: 2,
+        ..SplitOptions::default()
+    };
+    let (mesh, report, plan) =
+        build_tree_with_memory_limit(&scene, &split, &one_part_at_a_time(script)).unwrap();
+    let n = report.part_tets.len();
+    assert_eq!(n, 4);
+    assert_eq!(plan.surface_relaxed_parts, (0..n).collect::<Vec<_>>());
+    assert_eq!(report.part_surface, vec![SurfaceMode::SteinerOffSurface; n]);
+    assert_eq!(plan.part_failures.len(), (MAX_PART_MOVES + 1) * n);
+    let runs = std::fs::read_to_string(&runs).unwrap();
+    let count = |what: &str| runs.lines().filter(|l| *l == what).count();
+    assert_eq!(count("Y"), (MAX_PART_MOVES + 1) * n, "{runs}");
+    assert!(count("relaxed") >= n, "{runs}");
+    check_against_in_core(&scene, &mesh);
+}
+
 /// A worker script in `dir` that counts its runs in the file it returns
 /// second (one line per run) and, with that count as `$n`, runs the shell
 /// `crash_when` (a `case` pattern: runs that crash) before the real
@@ -1723,7 +1774,8 @@ fn parts_that_fail_in_one_attempt_are_retried_together() {
 
 /// A build whose worker crashes on every part gives up, saying why: each
 /// part is retried after its walls moved, at most `MAX_PART_MOVES` times,
-/// all parts of an attempt together.
+/// all parts of an attempt together, then once where they stand with its
+/// surface relaxed (two TetGen runs: `-Y/2`, then without `-Y`).
 #[cfg(unix)]
 #[test]
 fn a_build_whose_parts_always_fail_gives_up_saying_why() {
@@ -1735,11 +1787,14 @@ fn a_build_whose_parts_always_fail_gives_up_saying_why() {
     let scene = knot_grid(1, 120, 12);
     match build_tree_with_memory_limit(&scene, &eight_parts(), &options) {
         Err(SeamError::GaveUp { why, last }) => {
-            assert!(why.contains("failed after"), "{why}");
+            assert!(
+                why.contains("failed after") && why.contains("relaxed"),
+                "{why}"
+            );
             assert!(matches!(*last, SeamError::PartsFailed(ref all) if all.len() == 8));
         }
         other => panic!("{:?}", other.map(|_| ())),
     }
     let runs = std::fs::read_to_string(&runs).unwrap().lines().count();
-    assert_eq!(runs, 8 * (MAX_PART_MOVES + 1), "{runs} runs");
+    assert_eq!(runs, 8 * (MAX_PART_MOVES + 1) + 8 * 2, "{runs} runs");
 }

@@ -222,6 +222,7 @@ pub fn seam_options(
         parallel_parts: 1,
         tree_limit_bytes: None,
         resolve: (!flags.no_resolve).then(Default::default),
+        surface_relaxed_parts: Vec::new(),
     })
 }
 

@@ -12,7 +12,9 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use tet_build::bbox::EnclosingBox;
 use tet_build::outofcore::admission::{builder_bytes, worker_share};
-use tet_build::outofcore::seam::{SeamOptions, SeamReport, build_slabs, build_slabs_to_file};
+use tet_build::outofcore::seam::{
+    SeamOptions, SeamReport, SurfaceMode, build_slabs, build_slabs_to_file,
+};
 use tet_build::outofcore::split::{SlabPlan, SplitOptions, plan_slabs, plan_split_within};
 use tet_build::outofcore::stream::{StreamOptions, StreamSummary};
 use tet_build::outofcore::tree::{
@@ -24,7 +26,7 @@ use tet_core::scene::SceneInfo;
 
 use super::options::Planner;
 use super::predict::predict;
-use super::types::{Limited, MemoryReport, Written, mib};
+use super::types::{Limited, MemoryReport, RelaxedPart, Written, mib};
 use crate::load::build_flags::{BuildFlags, Walls};
 use crate::load::{BuildSummary, CleaningSummary};
 
@@ -223,6 +225,7 @@ impl Limited<'_> {
             part_split_pieces: vec![0],
             plane_moves: 0,
             part_failures: Vec::new(),
+            surface_relaxed: Vec::new(),
             parts_reused: 0,
             total_s: start.elapsed().as_secs_f64(),
             merge: "in-core".to_string(),
@@ -492,6 +495,16 @@ impl Limited<'_> {
             depth: shape.depth,
             plane_moves: shape.plane_moves,
             part_failures: shape.part_failures.clone(),
+            surface_relaxed: report
+                .part_surface
+                .iter()
+                .enumerate()
+                .filter(|(_, m)| **m != SurfaceMode::Preserved)
+                .map(|(part, m)| RelaxedPart {
+                    part,
+                    mode: m.name().to_string(),
+                })
+                .collect(),
             parts_reused: report.parts_reused,
             triangles_cut: report.triangles_cut,
             part_points: report.part_points,

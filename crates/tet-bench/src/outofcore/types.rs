@@ -121,6 +121,12 @@ pub struct MemoryReport {
     /// order met; empty for slabs and one-piece builds.
     #[serde(default)]
     pub part_failures: Vec<String>,
+    /// The parts built with their surface relaxed, as `{part, mode}`
+    /// (`steiner-off-surface`: TetGen `-Y/2`; `unlocked`: without `-Y`),
+    /// after their walls moved twice and TetGen still failed; empty when
+    /// every part kept `-Y`.
+    #[serde(default)]
+    pub surface_relaxed: Vec<RelaxedPart>,
     /// Parts the retries took as the attempt before built them (their
     /// input unchanged by the moves), summed over retries.
     pub parts_reused: usize,
@@ -161,4 +167,13 @@ pub struct Written {
     pub constrained: usize,
     /// Bytes of the file.
     pub file_bytes: u64,
+}
+
+/// A part built with its surface relaxed ([`MemoryReport::surface_relaxed`]).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RelaxedPart {
+    /// The part.
+    pub part: usize,
+    /// `steiner-off-surface` or `unlocked`.
+    pub mode: String,
 }

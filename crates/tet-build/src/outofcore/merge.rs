@@ -116,6 +116,7 @@ pub(super) fn record_part(report: &mut SeamReport, s: &PartStats) {
     report.part_tets.push(s.tets);
     report.part_peak_kib.push(s.peak_kib);
     report.part_split_pieces.push(s.split_pieces);
+    report.part_surface.push(s.surface);
     report
         .part_predicted_bytes
         .push(super::memory_model::predict_part_peak_memory(

@@ -1,6 +1,7 @@
 //! The parts of a split and their TetGen runs: [`SeamOptions`], each part's
 //! PLC run through TetGen `-pY` (every seam facet must come back as exactly
-//! one face, see [`super::facet_faces`]), several parts at a time, and the
+//! one face, see [`super::facet_faces`]) or, as a last resort, with its
+//! surface relaxed ([`SurfaceMode`]), several parts at a time, and the
 //! [`SeamReport`] of a split build.
 
 use std::collections::HashMap;
@@ -63,6 +64,10 @@ pub struct SeamReport {
     /// Parts a retry took as an earlier attempt built them, their input
     /// unchanged by the planes the retry moved (0 without a retry).
     pub parts_reused: usize,
+    /// How each part's TetGen run kept the surface: [`SurfaceMode::Preserved`]
+    /// but for the parts built with the surface relaxed
+    /// ([`SeamOptions::surface_relaxed_parts`]).
+    pub part_surface: Vec<SurfaceMode>,
 }
 
 /// Options of [`build_slabs`](super::seam::build_slabs).
@@ -70,7 +75,8 @@ pub struct SeamReport {
 pub struct SeamOptions {
     /// Box around the scene (the whole mesh's boundary).
     pub enclosing_box: BoxSpec,
-    /// TetGen switches (`-Y` is required and forced on).
+    /// TetGen switches (`-Y` is forced on, but for
+    /// [`SeamOptions::surface_relaxed_parts`]).
     pub tetgen: TetgenOptions,
     /// Where TetGen runs.
     pub isolation: Isolation,
@@ -89,7 +95,50 @@ pub struct SeamOptions {
     /// ([`crate::resolve`], as the in-core build does); `None` hands
     /// crossing triangles to TetGen as they are.
     pub resolve: Option<ResolveOptions>,
+    /// Parts (by index) TetGen builds with the surface relaxed: first with
+    /// [`SurfaceMode::SteinerOffSurface`], and where that fails with
+    /// [`SurfaceMode::Unlocked`] (walls must still come back whole: see
+    /// [`super::facet_faces`]). The last resort of a build for a part whose
+    /// walls moved and which TetGen still fails on: at 30 M triangles, a
+    /// part whose feature below TetGen's default tolerance makes `-Y` loop
+    /// wherever its walls stand. Empty by default.
+    pub surface_relaxed_parts: Vec<usize>,
 }
+
+/// How a part's TetGen run treats the scene surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SurfaceMode {
+    /// `-Y`: the surface as given; scene pieces split only where TetGen
+    /// cannot move a boundary Steiner point off them. Every part unless
+    /// relaxed.
+    #[default]
+    Preserved,
+    /// `-Y/2`: the same, but a Steiner point that recovering a segment
+    /// needs goes into the volume, not onto the segment
+    /// ([`TetgenOptions::steiner_off_surface`]).
+    SteinerOffSurface,
+    /// Without `-Y` and with a coplanar tolerance of at most
+    /// [`RELAXED_COPLANAR_TOLERANCE`]: TetGen may split scene pieces (and
+    /// walls, which the part's check then refuses) with Steiner points.
+    Unlocked,
+}
+
+impl SurfaceMode {
+    /// The mode's name in reports: `preserved`, `steiner-off-surface`,
+    /// `unlocked`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SurfaceMode::Preserved => "preserved",
+            SurfaceMode::SteinerOffSurface => "steiner-off-surface",
+            SurfaceMode::Unlocked => "unlocked",
+        }
+    }
+}
+
+/// The coplanar tolerance (`-T`) of [`SurfaceMode::Unlocked`]: on the 30 M
+/// part `-Y` looped on, TetGen without `-Y` reports a feature below its
+/// default 1e-8 (code 4) and at 1e-12 builds the part in a second.
+pub const RELAXED_COPLANAR_TOLERANCE: f64 = 1e-12;
 
 impl Default for SeamOptions {
     /// The in-core build's defaults: no box spec beyond the default,
@@ -102,7 +151,46 @@ impl Default for SeamOptions {
             parallel_parts: 0,
             tree_limit_bytes: None,
             resolve: Some(ResolveOptions::default()),
+            surface_relaxed_parts: Vec::new(),
         }
+    }
+}
+
+impl SeamOptions {
+    /// The TetGen runs to try on part `part`, in order, with their
+    /// switches: `-Y` forced on, or, for one of
+    /// [`SeamOptions::surface_relaxed_parts`], the relaxed modes.
+    pub(super) fn tetgen_for_part(&self, part: usize) -> Vec<(SurfaceMode, TetgenOptions)> {
+        let preserved = TetgenOptions {
+            preserve_surface: true,
+            steiner_off_surface: false,
+            ..self.tetgen.clone()
+        };
+        if !self.surface_relaxed_parts.contains(&part) {
+            return vec![(SurfaceMode::Preserved, preserved)];
+        }
+        let tol = preserved
+            .coplanar_tolerance
+            .map_or(RELAXED_COPLANAR_TOLERANCE, |t| {
+                t.min(RELAXED_COPLANAR_TOLERANCE)
+            });
+        vec![
+            (
+                SurfaceMode::SteinerOffSurface,
+                TetgenOptions {
+                    steiner_off_surface: true,
+                    ..preserved.clone()
+                },
+            ),
+            (
+                SurfaceMode::Unlocked,
+                TetgenOptions {
+                    preserve_surface: false,
+                    coplanar_tolerance: Some(tol),
+                    ..preserved
+                },
+            ),
+        ]
     }
 }
 
@@ -139,6 +227,8 @@ pub(super) struct PartStats {
     pub(super) peak_kib: Option<u64>,
     /// Scene pieces TetGen returned split by boundary Steiner points.
     pub(super) split_pieces: usize,
+    /// How TetGen kept the surface.
+    pub(super) surface: SurfaceMode,
 }
 
 /// One part after TetGen: f32 points, positive tets, constrained faces.
@@ -279,25 +369,58 @@ const MAX_PART_ROUNDS: usize = 4;
 /// stores ([`FeedBack::FlatTets`]: only those, unlike the in-core build).
 /// Fed-back points lie strictly inside the part's box (TetGen keeps every
 /// wall facet whole), so the walls, and the seams, do not change.
+///
+/// A part built with its surface relaxed tries each mode of
+/// [`SeamOptions::tetgen_for_part`] in turn and keeps the first that
+/// passes every check; when none does, the first mode's error is returned.
 fn run_plc(
     part: usize,
     facets: &[([Vec3; 3], FacetKind)],
-    plc: PartPlc,
+    mut plc: PartPlc,
     options: &SeamOptions,
 ) -> Result<PartMesh, SeamError> {
+    let modes = options.tetgen_for_part(part);
+    let mut first_error = None;
+    for (i, (mode, topts)) in modes.iter().enumerate() {
+        // The last mode takes the PLC, the others a copy (fed-back points
+        // change it).
+        let input = if i + 1 == modes.len() {
+            std::mem::take(&mut plc.input)
+        } else {
+            plc.input.clone()
+        };
+        match run_plc_as(part, facets, &plc, input, *mode, topts, &options.isolation) {
+            Ok(mesh) => return Ok(mesh),
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    Err(first_error.expect("at least one mode"))
+}
+
+/// [`run_plc`] in one surface mode, on `input` (the PLC's TetGen input or
+/// a copy).
+fn run_plc_as(
+    part: usize,
+    facets: &[([Vec3; 3], FacetKind)],
+    plc: &PartPlc,
+    mut input: TetgenInput,
+    surface: SurfaceMode,
+    topts: &TetgenOptions,
+    isolation: &Isolation,
+) -> Result<PartMesh, SeamError> {
     let PartPlc {
-        points,
-        mut input,
+        ref points,
         wall_points,
         wall_triangles,
-    } = plc;
+        ..
+    } = *plc;
     let plc_points = input.points.len();
     let plc_triangles = input.triangles.len();
-    let mut topts = options.tetgen.clone();
-    topts.preserve_surface = true;
     let mut last_bad = 0;
     for round in 1..=MAX_PART_ROUNDS {
-        let out = match tetrahedralize(&input, &topts, &options.isolation) {
+        let out = match tetrahedralize(&input, topts, isolation) {
             Ok(out) => out,
             // A repair round failed (a rounded point too close to a facet).
             Err(_) if round > 1 => {
@@ -307,7 +430,7 @@ fn run_plc(
                 });
             }
             Err(TetgenError::SelfIntersection) => {
-                return Err(self_intersection(part, facets, &points, &input.triangles));
+                return Err(self_intersection(part, facets, points, &input.triangles));
             }
             Err(source) => return Err(SeamError::Tetgen { part, source }),
         };
@@ -349,6 +472,7 @@ fn run_plc(
                     tets: tets.len(),
                     peak_kib: out.worker_peak_kib,
                     split_pieces: constrained.split_pieces,
+                    surface,
                 },
                 points: p32,
                 tets,

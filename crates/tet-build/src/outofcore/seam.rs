@@ -53,7 +53,7 @@ use crate::procedural::BOX_TRIANGLES;
 use crate::scene::Scene;
 
 pub use super::error::SeamError;
-pub use super::parts::{SeamOptions, SeamReport};
+pub use super::parts::{RELAXED_COPLANAR_TOLERANCE, SeamOptions, SeamReport, SurfaceMode};
 pub use super::plane::{
     NEAR_PLANE, Piece, clip_polygon, crossing_point, cut_triangle, near_plane_vertex,
 };

@@ -241,7 +241,13 @@ fn parse_switches(s: &str) -> Option<TetgenOptions> {
         i += 1;
         match c {
             b'p' | b'z' | b'Q' => {}
-            b'Y' => o.preserve_surface = true,
+            b'Y' => {
+                o.preserve_surface = true;
+                if b[i..].starts_with(b"/2") {
+                    o.steiner_off_surface = true;
+                    i += 2;
+                }
+            }
             b'c' => o.keep_convex_hull = true,
             b'n' if o.neighbors => o.face_tets = true,
             b'n' => o.neighbors = true,
@@ -585,6 +591,7 @@ mod tests {
                 face_tets: false,
                 keep_convex_hull: false,
                 preserve_surface: false,
+                steiner_off_surface: false,
                 optimization: Some(Optimization {
                     level: 7,
                     scheme: 3,
@@ -606,11 +613,17 @@ mod tests {
                 face_tets: true,
                 ..TetgenOptions::default()
             },
+            TetgenOptions {
+                steiner_off_surface: true,
+                coplanar_tolerance: Some(1e-12),
+                ..TetgenOptions::default()
+            },
         ];
         for o in cases {
             assert_eq!(parse_switches(&o.switches()), Some(o));
         }
         assert_eq!(parse_switches("pYczQx"), None);
+        assert_eq!(parse_switches("pY/3czQ"), None);
         assert_eq!(parse_switches("pYczO7zQ"), None);
     }
 

@@ -35,9 +35,9 @@ pub enum InputFault {
         /// The version this reader knows.
         expected: u32,
     },
-    /// A header word that must be 0 is not.
-    #[error("reserved header word is {0}, expected 0")]
-    Reserved(u32),
+    /// The header's flags word has a bit this reader does not know.
+    #[error("header flags are {0:#x}; this reader knows bit 0 alone")]
+    Flags(u32),
     /// The counts in the header do not add up to the file's length.
     #[error("{facets} facets and {box_faces} box faces need {expected} bytes, the file has {len}")]
     Length {

@@ -213,6 +213,11 @@ pub struct PartRecord {
     pub wall_triangles: usize,
     /// The memory model's prediction of the part's TetGen peak, bytes (with margin).
     pub predicted_peak_bytes: u64,
+    /// Built with its surface relaxed (`SeamOptions::surface_relaxed_parts`), as its input
+    /// file says: the planner's last resort for a part TetGen failed on
+    /// wherever its walls stood. Absent (false) in older plans.
+    #[serde(default)]
+    pub surface_relaxed: bool,
 }
 
 /// A seam between parts: plane and rectangle.

@@ -10,7 +10,7 @@
 //! | 8  | 4 | version `1` ([`VERSION`]) |
 //! | 12 | 4 | part index |
 //! | 16 | 4 | scene triangles (the ids below are `< ` this) |
-//! | 20 | 4 | reserved, 0 |
+//! | 20 | 4 | flags: bit 0 ([`FLAG_SURFACE_RELAXED`]) builds the part with its surface relaxed; other bits 0 |
 //! | 24 | 8 | facets `F` |
 //! | 32 | 8 | box faces `B` |
 //! | 40 | 40·F | facets: 3 vertices × `[f32; 3]`, then `u32` the *input* scene triangle it is a piece of, or `0xFFFF_FFFF` for a seam-only triangle |
@@ -19,7 +19,7 @@
 //!
 //! [`decode`] checks the length before anything else (so a count in the
 //! header never sizes an allocation beyond the file), then the magic, the
-//! version, the reserved word, the counts against the length, the
+//! version, the flags (no unknown bit), the counts against the length, the
 //! checksum, every id against the scene's triangles and every coordinate
 //! for finiteness; each failure is an [`InputFault`]. The file's digest in
 //! the plan is [`super::digest::format_digest`] of the checksum.
@@ -43,6 +43,12 @@ pub const FACET_BYTES: usize = 40;
 pub const BOX_FACE_BYTES: usize = 36;
 /// The id of a seam-only facet.
 pub const SEAM_FACET: u32 = u32::MAX;
+/// Header flag: build the part with its surface relaxed (TetGen with
+/// `-Y/2`, else without `-Y`; `SeamOptions::surface_relaxed_parts`), the planner's last resort
+/// for a part TetGen failed on wherever its walls stood. Part of the
+/// file, so of its digest: a relaxed input is another input than the one
+/// that failed.
+pub const FLAG_SURFACE_RELAXED: u32 = 1;
 
 /// One part's TetGen input.
 #[derive(Clone, Debug, PartialEq)]
@@ -56,13 +62,21 @@ pub struct PartInput {
     pub facets: Vec<([Vec3; 3], u32)>,
     /// Unmarked box faces (a slab's outer walls).
     pub box_faces: Vec<[Vec3; 3]>,
+    /// Build it with its surface relaxed ([`FLAG_SURFACE_RELAXED`]).
+    pub surface_relaxed: bool,
 }
 
 impl PartInput {
     /// Part `k` of `inputs` as its input file holds it, made from its PLC
-    /// `list`. Facets carry the *input* scene triangle, so that a part
-    /// needs no map back from the cleaned scene.
-    pub(super) fn of_part(inputs: &PartInputs, k: usize, list: &PartFacetList) -> PartInput {
+    /// `list`, relaxed when `relaxed` names it. Facets carry the *input*
+    /// scene triangle, so that a part needs no map back from the cleaned
+    /// scene.
+    pub(super) fn of_part(
+        inputs: &PartInputs,
+        k: usize,
+        list: &PartFacetList,
+        relaxed: &[usize],
+    ) -> PartInput {
         PartInput {
             part: k as u32,
             triangle_count: inputs.triangle_count,
@@ -78,6 +92,7 @@ impl PartInput {
                 })
                 .collect(),
             box_faces: list.box_faces.clone(),
+            surface_relaxed: relaxed.contains(&k),
         }
     }
 
@@ -117,7 +132,12 @@ pub fn encode(input: &PartInput) -> (Vec<u8>, u64) {
     out.extend_from_slice(&VERSION.to_le_bytes());
     out.extend_from_slice(&input.part.to_le_bytes());
     out.extend_from_slice(&input.triangle_count.to_le_bytes());
-    out.extend_from_slice(&0u32.to_le_bytes());
+    let flags = if input.surface_relaxed {
+        FLAG_SURFACE_RELAXED
+    } else {
+        0
+    };
+    out.extend_from_slice(&flags.to_le_bytes());
     out.extend_from_slice(&(input.facets.len() as u64).to_le_bytes());
     out.extend_from_slice(&(input.box_faces.len() as u64).to_le_bytes());
     for (t, id) in &input.facets {
@@ -169,9 +189,9 @@ pub fn decode(bytes: &[u8]) -> Result<(PartInput, u64), InputFault> {
             expected: VERSION,
         });
     }
-    let reserved = u32_at(bytes, 20);
-    if reserved != 0 {
-        return Err(InputFault::Reserved(reserved));
+    let flags = u32_at(bytes, 20);
+    if flags & !FLAG_SURFACE_RELAXED != 0 {
+        return Err(InputFault::Flags(flags));
     }
     let (part, triangle_count) = (u32_at(bytes, 12), u32_at(bytes, 16));
     let (facets, box_faces) = (u64_at(bytes, 24), u64_at(bytes, 32));
@@ -199,6 +219,7 @@ pub fn decode(bytes: &[u8]) -> Result<(PartInput, u64), InputFault> {
         triangle_count,
         facets: Vec::with_capacity(facets as usize),
         box_faces: Vec::with_capacity(box_faces as usize),
+        surface_relaxed: flags & FLAG_SURFACE_RELAXED != 0,
     };
     for i in 0..facets as usize {
         let at = HEADER_BYTES + FACET_BYTES * i;

@@ -160,15 +160,18 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
     };
     let seam = &options.seam;
     let prepared = std::cell::OnceCell::new();
+    // Parts the tree planner relaxed (their walls moved and failed).
+    let mut relaxed = Vec::new();
     let tree = match options.planner {
         Planner::Slabs => None,
         _ => {
-            match plan_tree_with_moves(scene, &split, seam, |t| {
+            match plan_tree_with_moves(scene, &split, seam, |t, relaxed| {
                 let (inputs, report) = tree_part_inputs_once(scene, &prepared, t, seam)?;
-                fail_known_inputs(&inputs, &failed_inputs)?;
+                fail_known_inputs(&inputs, &failed_inputs, relaxed)?;
                 Ok((inputs, report))
             }) {
                 Ok(((inputs, report), plan)) => {
+                    relaxed = plan.surface_relaxed_parts.clone();
                     let mut next = 0;
                     let node = TreeNode::from_cut_tree(&plan.cuts, &mut next);
                     let partition = Partition::Tree {
@@ -209,7 +212,7 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
         }
     };
     std::fs::create_dir_all(dir).map_err(JobError::io(dir))?;
-    let parts = write_inputs(&inputs, dir)?;
+    let parts = write_inputs(&inputs, &relaxed, dir)?;
     let (camera, lights) = MergePlan::scene_records(&options.scene_info);
     let manifest = JobManifest {
         schema: JOB_SCHEMA.into(),
@@ -256,14 +259,18 @@ fn merge_plan(
     }
 }
 
-/// Writes every part's input file, one part's facets at a time; the
-/// parts' plan records.
-fn write_inputs(inputs: &PartInputs, dir: &Path) -> Result<Vec<PartRecord>, JobError> {
+/// Writes every part's input file, one part's facets at a time (those
+/// `relaxed` names with their surface relaxed); the parts' plan records.
+fn write_inputs(
+    inputs: &PartInputs,
+    relaxed: &[usize],
+    dir: &Path,
+) -> Result<Vec<PartRecord>, JobError> {
     let mut records = Vec::with_capacity(inputs.parts.len());
     for k in 0..inputs.parts.len() {
         let list = inputs.parts.facets(k).map_err(JobError::Plan)?;
         let plc = PartPlc::new(&list.facets, &list.box_faces);
-        let input = PartInput::of_part(inputs, k, &list);
+        let input = PartInput::of_part(inputs, k, &list, relaxed);
         drop(list);
         let (bytes, sum) = encode(&input);
         let name = format!("part-{k}.input");
@@ -279,6 +286,7 @@ fn write_inputs(inputs: &PartInputs, dir: &Path) -> Result<Vec<PartRecord>, JobE
             wall_points: plc.wall_points,
             wall_triangles: plc.wall_triangles,
             predicted_peak_bytes: plc.predicted_peak_bytes(),
+            surface_relaxed: input.surface_relaxed,
         });
     }
     Ok(records)

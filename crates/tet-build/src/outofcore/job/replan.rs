@@ -61,12 +61,15 @@ pub(super) fn known_failures(dir: &Path, scene_digest: &str) -> Result<Vec<Faile
     Ok(failed)
 }
 
-/// Fails every part of `inputs` whose input is one of `failed`
+/// Fails every part of `inputs` whose input (with its surface relaxed
+/// where `relaxed` names it) is one of `failed`
 /// ([`SeamError::FailedBefore`], several in [`SeamError::PartsFailed`]),
-/// so that the planner moves their walls; `Ok` when none is.
+/// so that the planner moves their walls, or relaxes them; `Ok` when none
+/// is.
 pub(super) fn fail_known_inputs(
     inputs: &PartInputs,
     failed: &[FailedInput],
+    relaxed: &[usize],
 ) -> Result<(), SeamError> {
     if failed.is_empty() {
         return Ok(());
@@ -74,7 +77,7 @@ pub(super) fn fail_known_inputs(
     let mut again = Vec::new();
     for k in 0..inputs.parts.len() {
         let list = inputs.parts.facets(k)?;
-        let (_, sum) = encode(&PartInput::of_part(inputs, k, &list));
+        let (_, sum) = encode(&PartInput::of_part(inputs, k, &list, relaxed));
         let digest = format_digest(sum);
         if let Some(f) = failed.iter().find(|f| f.input_digest == digest) {
             again.push(SeamError::FailedBefore {

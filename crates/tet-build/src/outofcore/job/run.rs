@@ -206,6 +206,11 @@ fn build(
         // A stuck part fails after a time scaled to its size, as in a
         // local build, so that planning again can move its walls soon.
         isolation: timed_for_part(isolation, record.points, record.triangles),
+        surface_relaxed_parts: if input.surface_relaxed {
+            vec![k]
+        } else {
+            Vec::new()
+        },
         ..SeamOptions::default()
     };
     let built = |source: SeamError| JobError::Build { part: k, source };

@@ -274,6 +274,10 @@ pub struct TreePlan {
     /// Each failure of TetGen on a part that a retry moved the part's
     /// walls for, in the order met (its message: the part and why).
     pub part_failures: Vec<String>,
+    /// Parts built with the surface relaxed
+    /// ([`SeamOptions::surface_relaxed_parts`]) after their walls moved
+    /// [`MAX_PART_MOVES`] times and TetGen still failed on them.
+    pub surface_relaxed_parts: Vec<usize>,
 }
 
 /// How many times [`build_tree_with_memory_limit`] moves planes that met
@@ -284,7 +288,8 @@ pub const MAX_PLANE_MOVES: usize = 8;
 
 /// How many times [`build_tree_with_memory_limit`] moves the walls of one
 /// part TetGen failed or crashed on or ran past its time limit on before
-/// giving up.
+/// it relaxes the part's surface (one last attempt without `-Y`) and then
+/// gives up.
 pub const MAX_PART_MOVES: usize = 2;
 
 /// How many attempts after the first [`build_tree_with_memory_limit`]
@@ -307,7 +312,9 @@ pub const MAX_PART_RETRIES: usize = 6;
 /// runs past its time limit on are moved by about a step (likewise to
 /// the clearest value within half a step of it), at most
 /// [`MAX_PART_MOVES`] times per part and in at most [`MAX_PART_RETRIES`]
-/// attempts. An attempt goes on past such a part, so that one retry
+/// attempts; a part TetGen still fails on then has its surface relaxed
+/// ([`SeamOptions::surface_relaxed_parts`]: `-Y/2`, else without `-Y`) for one
+/// last attempt. An attempt goes on past such a part, so that one retry
 /// moves the walls of every part that failed; it gives each part's TetGen
 /// run a time limit scaled to the part's size (10 s and 2 ms per point
 /// and triangle, under the worker's own limit), so that a stuck part
@@ -343,23 +350,28 @@ fn build_tree_with_memory_limit_with<M: Merge>(
 ) -> Result<(M::Output, SeamReport, TreePlan), SeamError> {
     let cache = PartCache::default();
     let prepared = std::cell::OnceCell::new();
-    let ((output, report), plan) = plan_tree_with_moves(scene, split, options, |tree| {
+    let ((output, report), plan) = plan_tree_with_moves(scene, split, options, |tree, relaxed| {
         let (inputs, report) = tree_part_inputs_once(scene, &prepared, tree, options)?;
-        finish_parts(inputs, report, options, merge, Some(&cache))
+        let options = SeamOptions {
+            surface_relaxed_parts: relaxed.to_vec(),
+            ..options.clone()
+        };
+        finish_parts(inputs, report, &options, merge, Some(&cache))
     })?;
     Ok((output, report, plan))
 }
 
 /// Plans the recursive split of `scene` under `split.limit_bytes` and
-/// calls `build` on its cut tree; a plane meeting a degenerate
+/// calls `build` on its cut tree and the parts to build with their
+/// surface relaxed (in increasing order); a plane meeting a degenerate
 /// configuration ([`SeamError::PlaneNearPoint`],
-/// [`SeamError::DegenerateCut`]) is moved and `build` called again (see
-/// [`build_tree_with_memory_limit`]).
+/// [`SeamError::DegenerateCut`]) is moved and `build` called again, and
+/// so are a failed part's walls (see [`build_tree_with_memory_limit`]).
 pub(in crate::outofcore) fn plan_tree_with_moves<T>(
     scene: &Scene,
     split: &super::split::SplitOptions,
     options: &SeamOptions,
-    mut build: impl FnMut(&CutTree) -> Result<T, SeamError>,
+    mut build: impl FnMut(&CutTree, &[usize]) -> Result<T, SeamError>,
 ) -> Result<(T, TreePlan), SeamError> {
     let (cleaned, _) = clean_scene(scene)?;
     if cleaned.triangles.is_empty() {
@@ -391,13 +403,15 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
     let mut part_failures = Vec::new();
     // Wall moves per part (by leaf index, which moves do not change).
     let mut part_moves = std::collections::HashMap::<usize, usize>::new();
+    // Parts whose walls moved `MAX_PART_MOVES` times and still failed.
+    let mut relaxed: Vec<usize> = Vec::new();
     let tolerance = NEAR_PLANE * (b.max - b.min).max_element() as f64;
     let mut clear = ClearPositions::new(&scene.vertices, tolerance);
     // A part's walls move by about this much (to the clearest value within
     // half of it; see `clear`).
     let step = (b.max - b.min).max_element() as f64 / 4096.0;
     loop {
-        match build(&tree) {
+        match build(&tree, &relaxed) {
             Ok(output) => {
                 return Ok((
                     output,
@@ -407,6 +421,7 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                         // One move per part failure besides.
                         plane_moves: plane_moves + part_moves.values().sum::<usize>(),
                         part_failures,
+                        surface_relaxed_parts: relaxed,
                     },
                 ));
             }
@@ -458,25 +473,32 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                 if retries >= MAX_PART_RETRIES {
                     return Err(gave_up(format!("{MAX_PART_RETRIES} retries"), e));
                 }
-                // Every failed part's walls, taken before any moves.
+                // Every failed part's walls, taken before any moves; a part
+                // whose walls moved `MAX_PART_MOVES` times is built once
+                // more where it stands, with its surface relaxed.
                 let mut walls = Vec::with_capacity(failed.len());
                 for &part in &failed {
-                    let n = part_moves.entry(part).or_default();
-                    *n += 1;
-                    if *n > MAX_PART_MOVES {
-                        let why = format!("part {part} failed after {MAX_PART_MOVES} moves");
+                    if relaxed.contains(&part) {
+                        let why =
+                            format!("part {part} failed after {MAX_PART_MOVES} moves and relaxed");
                         return Err(gave_up(why, e));
                     }
-                    walls.push(tree.leaf_walls(part).unwrap_or_default());
+                    let n = part_moves.entry(part).or_default();
+                    if *n == MAX_PART_MOVES {
+                        relaxed.push(part);
+                        continue;
+                    }
+                    *n += 1;
+                    walls.push((part, tree.leaf_walls(part).unwrap_or_default()));
                 }
                 // Each plane once: up by a step, else down (a thin
                 // neighbour's planes may stand within a step), else a
                 // quarter step either way.
                 let mut moved: Vec<SplitPlane> = Vec::new();
                 let mut stuck = Vec::new();
-                for (&part, planes) in failed.iter().zip(&walls) {
+                for (part, planes) in walls {
                     let mut any = false;
-                    for &plane in planes {
+                    for plane in planes {
                         if moved.contains(&plane) {
                             any = true;
                             continue;
@@ -499,10 +521,9 @@ pub(in crate::outofcore) fn plan_tree_with_moves<T>(
                         stuck.push(part);
                     }
                 }
-                if !stuck.is_empty() {
-                    let why = format!("no wall of part(s) {stuck:?} can move");
-                    return Err(gave_up(why, e));
-                }
+                // A part no wall of which can move is relaxed at once.
+                relaxed.extend(stuck);
+                relaxed.sort_unstable();
                 retries += 1;
                 match e {
                     SeamError::PartsFailed(all) => {
@@ -533,7 +554,7 @@ mod tests {
             ..Default::default()
         };
         let mut calls: Vec<CutTree> = Vec::new();
-        let (_, plan) = plan_tree_with_moves(&scene, &split, &SeamOptions::default(), |tree| {
+        let (_, plan) = plan_tree_with_moves(&scene, &split, &SeamOptions::default(), |tree, _| {
             calls.push(tree.clone());
             if calls.len() > 1 {
                 return Ok(());
@@ -554,6 +575,58 @@ mod tests {
         assert!(before.iter().zip(&after).any(|(b, a)| b.value != a.value));
     }
 
+    /// A part TetGen fails on wherever its walls stand has them moved
+    /// `MAX_PART_MOVES` times, is then built once more where they stand
+    /// with its surface relaxed, and, failing that too, ends the build
+    /// with the reason; a part that builds relaxed is reported so.
+    #[test]
+    fn a_part_failing_wherever_its_walls_stand_is_relaxed_then_given_up() {
+        let scene = crate::outofcore::memory_model::knot_grid(1, 60, 8);
+        let split = super::super::split::SplitOptions {
+            limit_bytes: u64::MAX,
+            min_depth: 2,
+            ..Default::default()
+        };
+        let stuck = || SeamError::Tetgen {
+            part: 1,
+            source: crate::tetgen::TetgenError::Timeout { seconds: 10.0 },
+        };
+        for relaxed_builds in [true, false] {
+            let mut calls: Vec<(CutTree, Vec<usize>)> = Vec::new();
+            let r = plan_tree_with_moves(&scene, &split, &SeamOptions::default(), |tree, r| {
+                calls.push((tree.clone(), r.to_vec()));
+                if r.contains(&1) && relaxed_builds {
+                    return Ok(());
+                }
+                Err(stuck())
+            });
+            let walls: Vec<_> = calls
+                .iter()
+                .map(|(t, _)| t.leaf_walls(1).unwrap())
+                .collect();
+            let relaxed: Vec<_> = calls.iter().map(|(_, r)| r.clone()).collect();
+            assert_eq!(calls.len(), MAX_PART_MOVES + 2, "{relaxed:?}");
+            // Moved each time but the last, which keeps the walls.
+            for w in walls.windows(2).take(MAX_PART_MOVES) {
+                assert_ne!(w[0], w[1]);
+            }
+            assert_eq!(walls[MAX_PART_MOVES], walls[MAX_PART_MOVES + 1]);
+            assert!(relaxed[..=MAX_PART_MOVES].iter().all(Vec::is_empty));
+            assert_eq!(relaxed[MAX_PART_MOVES + 1], vec![1]);
+            match r {
+                Ok((_, plan)) => {
+                    assert!(relaxed_builds);
+                    assert_eq!(plan.surface_relaxed_parts, vec![1]);
+                    assert_eq!(plan.part_failures.len(), MAX_PART_MOVES + 1);
+                }
+                Err(e) => {
+                    assert!(!relaxed_builds);
+                    assert!(e.to_string().contains("and relaxed"), "{e}");
+                }
+            }
+        }
+    }
+
     /// One retry moves every plane a clipping pass found near a point (the
     /// build here reports every wall of the part with the most at once),
     /// and counts each.
@@ -567,7 +640,7 @@ mod tests {
         };
         let mut calls: Vec<CutTree> = Vec::new();
         let mut part = 0;
-        let (_, plan) = plan_tree_with_moves(&scene, &split, &SeamOptions::default(), |tree| {
+        let (_, plan) = plan_tree_with_moves(&scene, &split, &SeamOptions::default(), |tree, _| {
             calls.push(tree.clone());
             if calls.len() > 1 {
                 return Ok(());
