@@ -68,6 +68,14 @@ pub struct SceneResult {
     /// tet20 on the default (tight-box) mesh, timed in alternating rounds
     /// with `wide_box_tet20`: the figure to compare it with.
     pub tight_box_tet20: Option<RenderDoc>,
+    /// The sorted mesh's speed-up over the unsorted one in each
+    /// alternating round (empty when not measured).
+    #[serde(default)]
+    pub sorting_round_speedups: Vec<f64>,
+    /// The tight box's speed-up over the wide one in each alternating
+    /// round (empty when not measured).
+    #[serde(default)]
+    pub tight_box_round_speedups: Vec<f64>,
     /// Accuracy against the f64 reference.
     pub accuracy: Option<CaseAccuracy>,
     /// Ray-Strips beside the BVH (Lauterbach et al. 2007, Tables 1, 3, 4, 5).

@@ -137,22 +137,24 @@ fn measure_scene(
     // builds): one that fails leaves its row empty and says why in
     // `partial_errors`, not the whole scene.
     let mut partial_errors = Vec::new();
-    let (sorted_tet20, unsorted_tet20) = optional(
+    let (sorted_tet20, unsorted_tet20, sorting_round_speedups) = optional(
         &mut partial_errors,
         spec,
         "unsorted mesh",
         sorting::measure(planned, &loaded, cache, opts, frames, pool),
     )
-    .map(|p| (p.baseline, p.variant))
-    .unzip();
-    let (tight_box_tet20, wide_box_tet20) = optional(
+    .map_or((None, None, Vec::new()), |p| {
+        (Some(p.baseline), Some(p.variant), p.round_speedups)
+    });
+    let (tight_box_tet20, wide_box_tet20, tight_box_round_speedups) = optional(
         &mut partial_errors,
         spec,
         "wide-box mesh",
         entry::measure(planned, &loaded, cache, opts, frames, pool),
     )
-    .map(|p| (p.baseline, p.variant))
-    .unzip();
+    .map_or((None, None, Vec::new()), |p| {
+        (Some(p.baseline), Some(p.variant), p.round_speedups)
+    });
     let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames);
     let (quality5, min_dihedral2, min_dihedral2_capped, one_piece) = if args.quick {
         (None, None, None, None)
@@ -212,6 +214,8 @@ fn measure_scene(
         sorted_tet20,
         wide_box_tet20,
         tight_box_tet20,
+        sorting_round_speedups,
+        tight_box_round_speedups,
         accuracy: Some(accuracy),
         partial_errors,
         error: None,
@@ -276,6 +280,8 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
                     sorted_tet20: None,
                     wide_box_tet20: None,
                     tight_box_tet20: None,
+                    sorting_round_speedups: Vec::new(),
+                    tight_box_round_speedups: Vec::new(),
                     accuracy: None,
                     gpu_renders: Vec::new(),
                     gpu_note: None,
