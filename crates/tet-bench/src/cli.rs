@@ -365,11 +365,12 @@ pub struct TablesArgs {
     /// Image height (default: 1440, or 480 with `--quick`).
     #[arg(long)]
     pub height: Option<u32>,
-    /// Timed frames per method (default: 5, or 3 with `--quick`).
+    /// Timed frames per method, at least (default: 5, or 3 with `--quick`).
     #[arg(long)]
     pub frames: Option<u32>,
-    /// Seconds each method is timed over the accuracy rays, at least, in
-    /// repeated passes (default: 0.5, or 0.2 with `--quick`).
+    /// Seconds each method is timed, at least: rendered frames (more than
+    /// `--frames` where they are fast, at most 200) and passes over the
+    /// accuracy rays (default: 0.5, or 0.2 with `--quick`).
     #[arg(long)]
     pub min_time: Option<f64>,
     /// Sizes of the large-model table (Torus Knots tessellated to about
@@ -437,7 +438,7 @@ impl TablesArgs {
         }
     }
 
-    /// Seconds each method is timed over the accuracy rays, at least.
+    /// Seconds each method is timed, at least (frames and accuracy passes).
     pub fn min_time_s(&self) -> f64 {
         self.min_time.unwrap_or(if self.quick { 0.2 } else { 0.5 })
     }

@@ -30,8 +30,12 @@ pub struct Setup {
     pub width: u32,
     /// Image size.
     pub height: u32,
-    /// Timed frames per method (best is reported).
+    /// Timed frames per method at least (best is reported).
     pub frames: u32,
+    /// Seconds of timed frames per method at least: a fast method is timed
+    /// over more frames than `frames` until this much time is spent (at
+    /// most 200 frames; each render document's `frames` says how many).
+    pub min_time_s: f64,
     /// Compile-time CPU features (`target-cpu=native` shows here).
     pub target_features: Vec<&'static str>,
     /// `--quick`.

@@ -11,6 +11,7 @@ use super::plan::{MeshCache, Planned};
 use super::variant::{Paired, speedup_cell, tet20_on_variant};
 use crate::load::Loaded;
 use crate::load::build_flags::BuildFlags;
+use crate::timing::Frames;
 
 /// tet20 on the scene built with `--wide-box` (the camera inside the mesh).
 pub fn measure(
@@ -18,7 +19,7 @@ pub fn measure(
     baseline: &Loaded,
     cache: &mut MeshCache,
     opts: &RenderOptions,
-    frames: u32,
+    frames: Frames,
     pool: &rayon::ThreadPool,
 ) -> Result<Paired> {
     let variant = |flags| BuildFlags {

@@ -28,7 +28,7 @@ use crate::load::Loaded;
 use crate::methods::bvh::BvhTracer;
 use crate::methods::layouts::strips_bytes;
 use crate::methods::method::Method;
-use crate::timing::time_method;
+use crate::timing::{Frames, time_method};
 
 /// Bytes each structure needs per triangle while it is built and timed
 /// (the structure, its build's scratch and the renderer's second counting
@@ -107,7 +107,7 @@ fn structure(
     loaded: &Loaded,
     method: Method,
     opts: &RenderOptions,
-    frames: u32,
+    frames: Frames,
     pool: &rayon::ThreadPool,
 ) -> Result<LargeStructure> {
     let triangles = loaded.mesh.constrained.len().max(1) as f64;
@@ -159,7 +159,7 @@ fn tet20(
     spec: &str,
     limit: Option<u64>,
     opts: &RenderOptions,
-    frames: u32,
+    frames: Frames,
     pool: &rayon::ThreadPool,
 ) -> Result<std::result::Result<LargeStructure, String>> {
     use super::doc::TABLE_FLAGS;
@@ -230,7 +230,7 @@ fn measure_one(
     triangles: u64,
     limit: Option<u64>,
     opts: &RenderOptions,
-    frames: u32,
+    frames: Frames,
     pool: &rayon::ThreadPool,
 ) -> Result<LargeModelRow> {
     if let Some(free) = available_memory() {
@@ -284,7 +284,7 @@ pub fn measure_all(
     sizes: &[u64],
     limit: Option<u64>,
     opts: &RenderOptions,
-    frames: u32,
+    frames: Frames,
     pool: &rayon::ThreadPool,
 ) -> Vec<LargeModelRow> {
     sizes

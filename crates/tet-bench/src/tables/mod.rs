@@ -78,7 +78,7 @@ use crate::cli::TablesArgs;
 use crate::methods::cpu_methods;
 use crate::methods::method::Method;
 use crate::output::{error_chain, outln, print_json};
-use crate::timing::{pool, target_features};
+use crate::timing::{Frames, pool, target_features};
 use doc::{QualityTrade, SceneResult, Setup, TablesDoc};
 use plan::{MeshCache, Planned, plan, scene_specs};
 use report::{markdown, write_atomic, write_outputs};
@@ -103,7 +103,7 @@ fn measure_scene(
     cache: &mut MeshCache,
     args: &TablesArgs,
     opts: &RenderOptions,
-    frames: u32,
+    frames: Frames,
     pool: &rayon::ThreadPool,
     streamed_rays: Option<u64>,
 ) -> Result<SceneResult> {
@@ -155,7 +155,7 @@ fn measure_scene(
     .map_or((None, None, Vec::new()), |p| {
         (Some(p.baseline), Some(p.variant), p.round_speedups)
     });
-    let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames);
+    let (gpu_renders, gpu_note) = gpu::measure(&loaded, opts, frames.at_least);
     let (quality5, min_dihedral2, min_dihedral2_capped, one_piece) = if args.quick {
         (None, None, None, None)
     } else {
@@ -233,7 +233,10 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
     };
     let width = args.width.unwrap_or(width).max(1);
     let height = args.height.unwrap_or(height).max(1);
-    let frames = args.frames.unwrap_or(frames).max(1);
+    let frames = Frames {
+        at_least: args.frames.unwrap_or(frames).max(1),
+        min_s: args.min_time_s(),
+    };
     let opts = RenderOptions {
         width,
         height,
@@ -244,7 +247,8 @@ pub fn run(args: &TablesArgs, json: bool) -> Result<()> {
         threads: pool.current_num_threads(),
         width,
         height,
-        frames,
+        frames: frames.at_least,
+        min_time_s: frames.min_s,
         target_features: target_features(),
         quick: args.quick,
         platform: format!("{}-{}", std::env::consts::OS, std::env::consts::ARCH),

@@ -56,7 +56,7 @@ mod measuring {
         spec: &str,
         loaded: &Loaded,
         opts: &RenderOptions,
-        frames: u32,
+        frames: crate::timing::Frames,
         pool: &rayon::ThreadPool,
     ) -> Vec<OutOfCoreRow> {
         let (Some(scene), Some(build)) = (&loaded.scene, &loaded.build) else {

@@ -42,7 +42,7 @@ mod measuring {
     pub fn measure_all(
         sizes: &[u64],
         opts: &RenderOptions,
-        frames: u32,
+        frames: crate::timing::Frames,
         pool: &rayon::ThreadPool,
     ) -> Vec<LargeOutOfCoreRow> {
         sizes
@@ -75,7 +75,7 @@ mod measuring {
         spec: &str,
         row: &mut LargeOutOfCoreRow,
         opts: &RenderOptions,
-        frames: u32,
+        frames: crate::timing::Frames,
         pool: &rayon::ThreadPool,
     ) -> Result<()> {
         let scene = Scene::load(spec).with_context(|| format!("cannot make `{spec}`"))?;

@@ -18,7 +18,7 @@ use super::plan::{MeshCache, Planned};
 use crate::load::BuildSummary;
 use crate::load::build_flags::{BuildFlags, MaxSteiner};
 use crate::methods::method::Method;
-use crate::timing::time_method;
+use crate::timing::{Frames, time_method};
 
 /// The papers' setting: `-q5`, at most 2 M Steiner points.
 pub const QUALITY5: BuildFlags = BuildFlags {
@@ -58,7 +58,7 @@ pub fn measure(
     planned: &Planned,
     cache: &mut MeshCache,
     opts: &RenderOptions,
-    frames: u32,
+    frames: Frames,
     pool: &rayon::ThreadPool,
     flags: &BuildFlags,
     label: &str,

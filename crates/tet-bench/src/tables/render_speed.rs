@@ -14,7 +14,7 @@ use super::paper::paper_scene;
 use crate::load::Loaded;
 use crate::methods::cpu_methods;
 use crate::methods::method::Method;
-use crate::timing::{RenderDoc, time_method};
+use crate::timing::{Frames, RenderDoc, time_method};
 
 /// neptun (the authors' C++ code) on a 2-core machine, Torus Knots,
 /// 1920×1440 primary rays, 2 threads, Mrays/s, measured once for this
@@ -37,7 +37,7 @@ pub fn measure(
     spec: &str,
     loaded: &Loaded,
     opts: &RenderOptions,
-    frames: u32,
+    frames: Frames,
     pool: &rayon::ThreadPool,
 ) -> Result<Vec<RenderDoc>> {
     let mut renders = Vec::new();

@@ -11,7 +11,7 @@ use tet_trace_cpu::render::RenderOptions;
 use super::doc::TablesDoc;
 use crate::load::Loaded;
 use crate::methods::method::Method;
-use crate::timing::{RenderDoc, time_method};
+use crate::timing::{Frames, RenderDoc, time_method};
 
 /// Rounds of every method in turn; a method's row is its round with the
 /// fastest frame.
@@ -31,7 +31,7 @@ pub fn measure(
     spec: &str,
     loaded: &Loaded,
     opts: &RenderOptions,
-    frames: u32,
+    frames: Frames,
     pool: &rayon::ThreadPool,
 ) -> Result<Vec<RenderDoc>> {
     let mixed = RenderOptions {

@@ -16,7 +16,7 @@ use crate::load::Loaded;
 use crate::methods::bvh::BvhTracer;
 use crate::methods::method::Method;
 use crate::methods::strips::StripsTracer;
-use crate::timing::time_method;
+use crate::timing::{Frames, time_method};
 
 /// The paper's Bunny row (67 k triangles): Table 1 MB (Ray-Strips total,
 /// geometry, hierarchy; BVH hierarchy; indexed-list + BVH total;
@@ -57,7 +57,7 @@ pub fn measure(
     spec: &str,
     loaded: &Loaded,
     opts: &RenderOptions,
-    frames: u32,
+    frames: Frames,
     pool: &rayon::ThreadPool,
 ) -> Result<StripsRow> {
     let mesh = &loaded.mesh;

@@ -16,7 +16,7 @@ use super::plan::{MeshCache, Planned};
 use crate::load::Loaded;
 use crate::load::build_flags::BuildFlags;
 use crate::methods::method::Method;
-use crate::timing::{RenderDoc, time_method};
+use crate::timing::{Frames, RenderDoc, time_method};
 
 /// Rounds of the alternating measurement (each of `frames` frames).
 const ROUNDS: usize = 3;
@@ -43,7 +43,7 @@ pub fn tet20_on_variant(
     cache: &mut MeshCache,
     variant: impl FnOnce(BuildFlags) -> BuildFlags,
     what: &str,
-    (opts, frames, pool): (&RenderOptions, u32, &rayon::ThreadPool),
+    (opts, frames, pool): (&RenderOptions, Frames, &rayon::ThreadPool),
 ) -> Result<Paired> {
     eprintln!("  {}: {what}", planned.spec);
     let mesh = cache.load(planned, &variant(TABLE_FLAGS), false)?.0;

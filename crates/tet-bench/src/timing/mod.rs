@@ -111,15 +111,42 @@ pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
     Ok(b.build()?)
 }
 
-/// Renders `frames` timed frames (plus a warm-up) and summarises them;
-/// returns the last frame for images.
+/// How long a method is timed: at least `at_least` frames, and more until
+/// `min_s` seconds of frames are spent (at most [`Frames::MAX`]), so that a
+/// fast method's best frame is the best of enough frames to be stable.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frames {
+    /// Frames timed at least.
+    pub at_least: u32,
+    /// Seconds of timed frames at least (0: `at_least` alone).
+    pub min_s: f64,
+}
+
+impl Frames {
+    /// The most frames a minimum time asks for.
+    pub const MAX: u32 = 200;
+}
+
+impl From<u32> for Frames {
+    /// Exactly `frames` frames (at least one).
+    fn from(frames: u32) -> Frames {
+        Frames {
+            at_least: frames,
+            min_s: 0.0,
+        }
+    }
+}
+
+/// Renders the timed frames of `frames` (plus a warm-up) and summarises
+/// them; returns the last frame for images.
 pub fn time_method(
     loaded: &Loaded,
     method: Method,
     opts: &RenderOptions,
-    frames: u32,
+    frames: impl Into<Frames>,
     pool: &rayon::ThreadPool,
 ) -> Result<(RenderDoc, Frame)> {
+    let frames: Frames = frames.into();
     let setup = Instant::now();
     let t: Box<dyn Tracer + '_> = tracer(method, false, &loaded.mesh)?;
     let setup_s = setup.elapsed().as_secs_f64();
@@ -128,7 +155,10 @@ pub fn time_method(
     let mut frame = pool.install(run).context("render failed")?;
     let mut stats: Vec<FrameStats> = Vec::new();
     // Timed frames reuse the warm-up frame's buffers.
-    for _ in 0..frames.max(1) {
+    let timing = Instant::now();
+    while stats.len() < frames.at_least.max(1) as usize
+        || (timing.elapsed().as_secs_f64() < frames.min_s && stats.len() < Frames::MAX as usize)
+    {
         pool.install(|| render_into(t.as_ref(), &loaded.camera, &loaded.lights, opts, &mut frame))?;
         stats.push(frame.stats);
     }
@@ -164,7 +194,7 @@ pub fn time_method(
         width: opts.width,
         height: opts.height,
         threads: pool.current_num_threads(),
-        frames: frames.max(1),
+        frames: stats.len() as u32,
         best_ms: best.ms,
         median_ms: ms[ms.len() / 2],
         mrays_per_s: best.mrays_per_s(),
