@@ -283,6 +283,23 @@ fn the_plan_records_every_tetgen_option() {
     );
 }
 
+/// A knot of 120 segments to plan in four parts, a temporary directory
+/// and the job directory in it.
+fn four_part_job() -> (
+    tet_build::scene::Scene,
+    tempfile::TempDir,
+    std::path::PathBuf,
+    PlanOptions,
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let jobdir = dir.path().join("job");
+    let options = PlanOptions {
+        parts: 4,
+        ..PlanOptions::default()
+    };
+    (knot_grid(1, 120, 12), dir, jobdir, options)
+}
+
 /// A part TetGen is stuck on in a job (its worker hangs) fails after a
 /// time scaled to its size, not the worker's ten minutes, and its error
 /// record says moving its walls may cure it. Planning the job again into
@@ -294,13 +311,7 @@ fn the_plan_records_every_tetgen_option() {
 #[test]
 fn a_part_stuck_in_a_job_is_cured_by_planning_again() {
     use std::os::unix::fs::PermissionsExt;
-    let scene = knot_grid(1, 120, 12);
-    let dir = tempfile::tempdir().unwrap();
-    let jobdir = dir.path().join("job");
-    let options = PlanOptions {
-        parts: 4,
-        ..PlanOptions::default()
-    };
+    let (scene, dir, jobdir, options) = four_part_job();
     let job = plan_job(&scene, &options, &jobdir).unwrap();
     assert!(job.failed_inputs.is_empty());
     let n = job.parts.len();
@@ -395,27 +406,10 @@ fn a_part_stuck_in_a_job_is_cured_by_planning_again() {
 #[cfg(unix)]
 #[test]
 fn a_part_failing_wherever_its_walls_stand_is_planned_with_its_surface_relaxed() {
-    use std::os::unix::fs::PermissionsExt;
     use tet_build::outofcore::tree::MAX_PART_MOVES;
-    let scene = knot_grid(1, 120, 12);
-    let dir = tempfile::tempdir().unwrap();
-    let jobdir = dir.path().join("job");
-    let options = PlanOptions {
-        parts: 4,
-        ..PlanOptions::default()
-    };
-    let script = dir.path().join("no-y.sh");
-    std::fs::write(
-        &script,
-        format!(
-            "#!/bin/sh\nreq=$(mktemp)\ncat > \"$req\"\n\
-             if head -c 64 \"$req\" | grep -q -a pYc; then rm -f \"$req\"; kill -SEGV $$; fi\n\
-             '{worker}' \"$@\" < \"$req\"; rc=$?; rm -f \"$req\"; exit $rc\n",
-            worker = env!("CARGO_BIN_EXE_tet-build-worker"),
-        ),
-    )
-    .unwrap();
-    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let (scene, dir, jobdir, options) = four_part_job();
+    let (script, _) =
+        common::crashing_on_plain_y(dir.path(), env!("CARGO_BIN_EXE_tet-build-worker"));
     let no_y = Isolation::Worker(WorkerCommand {
         program: script,
         args: vec![],

@@ -1610,28 +1610,12 @@ fn first_run_fails_then_walls_move(first: &str, timeout_s: u64) {
 #[cfg(unix)]
 #[test]
 fn parts_failing_wherever_their_walls_stand_are_built_with_the_surface_relaxed() {
-    use std::os::unix::fs::PermissionsExt;
     use tet_build::outofcore::seam::SurfaceMode;
     use tet_build::outofcore::tree::{MAX_PART_MOVES, build_tree_with_memory_limit};
 
     let dir = tempfile::tempdir().unwrap();
-    let (script, runs) = (dir.path().join("no-y.sh"), dir.path().join("runs"));
-    std::fs::write(
-        &script,
-        format!(
-            "#!/bin/sh
-req=$(mktemp)
-cat > \"$req\"
-             if head -c 64 \"$req\" | grep -q -a pYc; then echo Y >> '{runs}'; rm -f \"$req\"; kill -SEGV $$; fi
-             echo relaxed >> '{runs}'
-             '{worker}' \"$@\" < \"$req\"; rc=$?; rm -f \"$req\"; exit $rc
-",
-            runs = runs.display(),
-            worker = env!("CARGO_BIN_EXE_tet-build-worker"),
-        ),
-    )
-    .unwrap();
-    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let (script, runs) =
+        common::crashing_on_plain_y(dir.path(), env!("CARGO_BIN_EXE_tet-build-worker"));
     let scene = knot_grid(1, 120, 12);
     let split = SplitOptions {
         limit_bytes: u64::MAX,

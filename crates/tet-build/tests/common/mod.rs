@@ -61,3 +61,32 @@ pub fn canonical(m: &TetMesh) -> Canonical {
     faces.sort_unstable();
     (points, tets, faces)
 }
+
+/// A TetGen worker script in `dir` that crashes (SIGSEGV) on every request
+/// whose switches keep the surface with plain `-Y` (read from the
+/// request's first bytes: `pYc`, not `pY/2c`), as TetGen does on a part
+/// no wall position cures, and is the real worker `worker` otherwise;
+/// each run adds a line, `Y` or `relaxed`, to the file returned second.
+#[cfg(unix)]
+#[allow(dead_code)] // not every test binary uses it
+pub fn crashing_on_plain_y(
+    dir: &std::path::Path,
+    worker: &str,
+) -> (std::path::PathBuf, std::path::PathBuf) {
+    use std::os::unix::fs::PermissionsExt;
+    let (script, runs) = (dir.join("no-y.sh"), dir.join("runs"));
+    std::fs::write(
+        &script,
+        format!(
+            "#!/bin/sh\nreq=$(mktemp)\ncat > \"$req\"\n\
+             if head -c 64 \"$req\" | grep -q -a pYc; then\n\
+             echo Y >> '{runs}'; rm -f \"$req\"; kill -SEGV $$\nfi\n\
+             echo relaxed >> '{runs}'\n\
+             '{worker}' \"$@\" < \"$req\"; rc=$?; rm -f \"$req\"; exit $rc\n",
+            runs = runs.display(),
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    (script, runs)
+}
