@@ -11,12 +11,12 @@ use tet_core::scene::SceneInfo;
 use super::digest::{Xxh64, format_digest};
 use super::error::JobError;
 use super::manifest::{
-    BuildRecord, ExactF32, JOB_FILE, JOB_SCHEMA, JOB_VERSION, JobManifest, MergePlan, PartRecord,
-    Partition, SceneRecord, SeamRecord, TreeNode,
+    BuildRecord, ExactF32, FailedInput, JOB_FILE, JOB_SCHEMA, JOB_VERSION, JobManifest, MergePlan,
+    PartRecord, Partition, SceneRecord, SeamRecord, TreeNode,
 };
 use super::part_input::{PartInput, encode};
 use super::records::write_atomic;
-use super::replan::{fail_known_inputs, known_failures};
+use super::replan::known_failures;
 use crate::bbox::EnclosingBox;
 use crate::clean::clean_scene;
 use crate::outofcore::error::SeamError;
@@ -160,25 +160,31 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
     };
     let seam = &options.seam;
     let prepared = std::cell::OnceCell::new();
-    // Parts the tree planner relaxed (their walls moved and failed).
-    let mut relaxed = Vec::new();
+    std::fs::create_dir_all(dir).map_err(JobError::io(dir))?;
     let tree = match options.planner {
         Planner::Slabs => None,
         _ => {
+            // Each attempt writes its inputs as it makes them: a part whose
+            // facets cannot be made, or whose input is known to fail,
+            // fails the attempt so that the planner moves its walls (an
+            // error of the files ends the planning, `Ok(Err)`).
             match plan_tree_with_moves(scene, &split, seam, |t, relaxed| {
                 let (inputs, report) = tree_part_inputs_once(scene, &prepared, t, seam)?;
-                fail_known_inputs(&inputs, &failed_inputs, relaxed)?;
-                Ok((inputs, report))
+                match write_inputs(&inputs, relaxed, &failed_inputs, dir) {
+                    Ok(parts) => Ok(Ok((inputs, report, parts))),
+                    Err(JobError::Plan(e)) => Err(e),
+                    Err(e) => Ok(Err(e)),
+                }
             }) {
-                Ok(((inputs, report), plan)) => {
-                    relaxed = plan.surface_relaxed_parts.clone();
+                Ok((written, plan)) => {
+                    let (inputs, report, parts) = written?;
                     let mut next = 0;
                     let node = TreeNode::from_cut_tree(&plan.cuts, &mut next);
                     let partition = Partition::Tree {
                         tree: node,
                         plane_moves: plan.plane_moves,
                     };
-                    Some((inputs, report, partition))
+                    Some((inputs, report, parts, partition))
                 }
                 Err(SeamError::LimitTooSmall { .. }) if options.planner == Planner::Auto => None,
                 Err(SeamError::LimitTooSmall { limit_bytes }) => {
@@ -188,7 +194,7 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
             }
         }
     };
-    let (inputs, report, partition) = match tree {
+    let (inputs, report, parts, partition) = match tree {
         Some(t) => t,
         None => {
             let (cleaned, _) =
@@ -208,11 +214,11 @@ pub fn plan_job(scene: &Scene, options: &PlanOptions, dir: &Path) -> Result<JobM
                 axis: plan.axis,
                 values: plan.values.iter().map(|&v| ExactF32(v)).collect(),
             };
-            (inputs, report, partition)
+            // Slab plans do not move planes: no known failures to avoid.
+            let parts = write_inputs(&inputs, &[], &[], dir)?;
+            (inputs, report, parts, partition)
         }
     };
-    std::fs::create_dir_all(dir).map_err(JobError::io(dir))?;
-    let parts = write_inputs(&inputs, &relaxed, dir)?;
     let (camera, lights) = MergePlan::scene_records(&options.scene_info);
     let manifest = JobManifest {
         schema: JOB_SCHEMA.into(),
@@ -261,24 +267,48 @@ fn merge_plan(
 
 /// Writes every part's input file, one part's facets at a time (those
 /// `relaxed` names with their surface relaxed); the parts' plan records.
+/// A part whose facets fail in a way moving its walls may cure
+/// ([`SeamError::part_to_retry`]), or whose input is one of `failed`
+/// ([`SeamError::FailedBefore`]), is not written; the others are, and
+/// then all such parts are returned together ([`SeamError::parts_failed`]
+/// in [`JobError::Plan`]), so that the planner moves all their walls at
+/// once.
 fn write_inputs(
     inputs: &PartInputs,
     relaxed: &[usize],
+    failed: &[FailedInput],
     dir: &Path,
 ) -> Result<Vec<PartRecord>, JobError> {
     let mut records = Vec::with_capacity(inputs.parts.len());
+    let mut again = Vec::new();
     for k in 0..inputs.parts.len() {
-        let list = inputs.parts.facets(k).map_err(JobError::Plan)?;
+        let list = match inputs.parts.facets(k) {
+            Ok(list) => list,
+            Err(e) if e.part_to_retry().is_some() => {
+                again.push(e);
+                continue;
+            }
+            Err(e) => return Err(JobError::Plan(e)),
+        };
         let plc = PartPlc::new(&list.facets, &list.box_faces);
         let input = PartInput::of_part(inputs, k, &list, relaxed);
         drop(list);
         let (bytes, sum) = encode(&input);
+        let digest = format_digest(sum);
+        if let Some(f) = failed.iter().find(|f| f.input_digest == digest) {
+            again.push(SeamError::FailedBefore {
+                part: k,
+                input_digest: digest,
+                message: f.message.clone(),
+            });
+            continue;
+        }
         let name = format!("part-{k}.input");
         write_atomic(&dir.join(&name), &bytes)?;
         records.push(PartRecord {
             index: k,
             input: name,
-            input_digest: format_digest(sum),
+            input_digest: digest,
             input_bytes: bytes.len() as u64,
             result: format!("part-{k}.tmesh"),
             points: plc.input.points.len(),
@@ -289,5 +319,8 @@ fn write_inputs(
             surface_relaxed: input.surface_relaxed,
         });
     }
-    Ok(records)
+    match SeamError::parts_failed(again) {
+        Some(e) => Err(JobError::Plan(e)),
+        None => Ok(records),
+    }
 }

@@ -5,8 +5,10 @@
 //! again is. [`plan_job`](super::plan_job) reads the inputs known to fail
 //! (`known_failures`: `job.json`'s `failed_inputs` and the error records
 //! of its parts) and the planner moves the walls of every part whose new
-//! input is one of them (`fail_known_inputs`), as a local build moves the
-//! walls of a part that fails in it (`tree::plan_tree_with_moves`).
+//! input is one of them (met as the planner writes the inputs), as a local
+//! build moves the walls of a part that fails in it
+//! (`tree::plan_tree_with_moves`); a part whose walls moved twice is
+//! planned with its surface relaxed, which makes it another input.
 //!
 //! Planning is deterministic and the plan keeps every input known to fail
 //! (`failed_inputs`), so planning again reaches the same moved walls and
@@ -17,13 +19,9 @@
 
 use std::path::Path;
 
-use super::digest::format_digest;
 use super::error::JobError;
 use super::manifest::{FailedInput, JobManifest};
-use super::part_input::{PartInput, encode};
 use super::records::{ErrorRecord, read_json};
-use crate::outofcore::error::SeamError;
-use crate::outofcore::merge::PartInputs;
 
 /// The part inputs known to fail in the job planned in `dir` from the
 /// scene of digest `scene_digest`: those its `job.json` keeps and those
@@ -59,33 +57,4 @@ pub(super) fn known_failures(dir: &Path, scene_digest: &str) -> Result<Vec<Faile
         }
     }
     Ok(failed)
-}
-
-/// Fails every part of `inputs` whose input (with its surface relaxed
-/// where `relaxed` names it) is one of `failed`
-/// ([`SeamError::FailedBefore`], several in [`SeamError::PartsFailed`]),
-/// so that the planner moves their walls, or relaxes them; `Ok` when none
-/// is.
-pub(super) fn fail_known_inputs(
-    inputs: &PartInputs,
-    failed: &[FailedInput],
-    relaxed: &[usize],
-) -> Result<(), SeamError> {
-    if failed.is_empty() {
-        return Ok(());
-    }
-    let mut again = Vec::new();
-    for k in 0..inputs.parts.len() {
-        let list = inputs.parts.facets(k)?;
-        let (_, sum) = encode(&PartInput::of_part(inputs, k, &list, relaxed));
-        let digest = format_digest(sum);
-        if let Some(f) = failed.iter().find(|f| f.input_digest == digest) {
-            again.push(SeamError::FailedBefore {
-                part: k,
-                input_digest: digest,
-                message: f.message.clone(),
-            });
-        }
-    }
-    SeamError::parts_failed(again).map_or(Ok(()), Err)
 }
