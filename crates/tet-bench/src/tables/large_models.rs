@@ -140,7 +140,7 @@ fn tet20(
     _: &str,
     _: Option<u64>,
     _: &RenderOptions,
-    _: u32,
+    _: Frames,
     _: &rayon::ThreadPool,
 ) -> Result<std::result::Result<LargeStructure, String>> {
     Ok(Err(

@@ -117,7 +117,7 @@ mod measuring {
 pub fn measure_all(
     _: &[u64],
     _: &tet_trace_cpu::render::RenderOptions,
-    _: u32,
+    _: crate::timing::Frames,
     _: &rayon::ThreadPool,
 ) -> Vec<LargeOutOfCoreRow> {
     Vec::new()
