@@ -194,6 +194,48 @@ fn random_outside_rays_agree_with_reference() {
     assert!(missed > 20, "too few rays missed the mesh: {missed}");
 }
 
+/// A boundary of many small faces (a 12-cell grid: 1,728 boundary faces),
+/// where the entry search walks across the faces from the one it starts
+/// at (face 0, or the previous ray's) instead of testing each: every ray
+/// from outside starts and ends as the brute force says, single rays and
+/// a coherent batch alike.
+#[test]
+fn rays_find_their_entry_across_many_boundary_faces() {
+    let mesh = grid(12, 0.12, 0.02, false, 6);
+    let strict = exact(&mesh);
+    let mut rng = SplitMix64(10);
+    let mut clear = 0;
+    let c = Vec3::splat(6.0);
+    for _ in 0..120 {
+        let o = c + random_direction(&mut rng) * 20.0;
+        let towards = c + random_direction(&mut rng) * rng.range_f32(0.0, 8.0);
+        clear += check(&mesh, &strict, &Ray::new(o, towards - o), true);
+    }
+    assert!(clear > 80, "too few unambiguous rays: {clear}");
+    // A fan of rays from one viewpoint, batched (each starts its search
+    // at the previous ray's face), against the same rays one by one.
+    let eye = Vec3::new(-9.0, 17.0, 25.0);
+    let rays: Vec<Ray> = (0..400)
+        .map(|i| {
+            let (u, v) = ((i % 20) as f32 * 0.7 - 1.0, (i / 20) as f32 * 0.7 - 1.0);
+            Ray::new(eye, Vec3::new(u, v, 6.0) - eye)
+        })
+        .collect();
+    let view = Viewpoint::locate(&mesh, eye).unwrap();
+    for t in &strict {
+        let mut batch = vec![TraceOutcome::Miss { tets_visited: 0 }; rays.len()];
+        view.trace_batch(t.as_ref(), &rays, &mut batch);
+        for (ray, b) in rays.iter().zip(&batch) {
+            assert_eq!(
+                *b,
+                trace_outside(t.as_ref(), &view, ray),
+                "{} {ray:?}",
+                t.name()
+            );
+        }
+    }
+}
+
 /// Constrained faces on the boundary itself (the grid marks boundary faces
 /// too): a ray entering through one hits it first, with no tet visited and
 /// the outside (`NO_TET`) as its near side; with `t_min` beyond it, the ray

@@ -67,6 +67,10 @@ pub struct EntryHint {
 #[derive(Clone, Debug)]
 pub struct BoundaryEntry {
     faces: Vec<EntryFace>,
+    /// Per face and edge `e` (`ids[e]` → `ids[e + 1]`), the kept face
+    /// across it ([`NO_FACE`] where none is kept): the entry search walks
+    /// across the faces instead of testing them one by one.
+    across: Vec<[u32; 3]>,
     /// The viewpoint every kept face faces ([`BoundaryEntry::seen_from`]):
     /// rays from it skip the per-face orientation test.
     seen_from: Option<Vec3>,
@@ -107,6 +111,7 @@ impl BoundaryEntry {
         check_convex(mesh, &faces)?;
         let (lo, hi) = mesh.point_bounds();
         Ok(BoundaryEntry {
+            across: across(&faces),
             faces,
             seen_from: None,
             lo: lo.as_dvec3(),
@@ -117,13 +122,14 @@ impl BoundaryEntry {
     /// The faces whose plane has `origin` on its outer side or on it: the
     /// only faces a ray from `origin` can enter through.
     pub fn seen_from(&self, mesh: &TetMesh, origin: Vec3) -> BoundaryEntry {
-        let faces = self
+        let faces: Vec<EntryFace> = self
             .faces
             .iter()
             .filter(|f| faces_origin(mesh, f, origin))
             .copied()
             .collect();
         BoundaryEntry {
+            across: across(&faces),
             faces,
             seen_from: Some(origin),
             lo: self.lo,
@@ -265,6 +271,35 @@ impl BoundaryEntry {
             hint.outside = true;
             return None;
         }
+        // A walk across the faces toward the ray, from the previous face:
+        // through the edge the ray's line passes outside of. At most one
+        // face winds around the line (see the module docs), so the face the
+        // walk finds is the one a search of every face finds; a walk that
+        // reaches the edge of the kept faces or goes on too long (it may
+        // circle where the faces seen along the ray are not a Delaunay
+        // triangulation) leaves the search to the scan of every face.
+        let mut at = first;
+        for _ in 0..walk_steps(n) {
+            let f = &self.faces[at];
+            let p = project(f);
+            let outside = (0..3).find(|&e| {
+                let g = (e + 1) % 3;
+                !proj.left(p[e], f.ids[e], p[g], f.ids[g])
+            });
+            let Some(e) = outside else {
+                if winds(f, &p) {
+                    hint.face = at;
+                    return Some(
+                        self.nearest_if_flat::<P>(mesh, ray, at, &p, |f| winds(f, &project(f))),
+                    );
+                }
+                break;
+            };
+            match self.across[at][e] {
+                NO_FACE => break,
+                next => at = next as usize,
+            }
+        }
         let (k, p) = (1..n).map(|i| (first + i) % n).find_map(|k| {
             let p = project(&self.faces[k]);
             winds(&self.faces[k], &p).then_some((k, p))
@@ -338,6 +373,36 @@ fn slab_misses(ray: &Ray, lo: DVec3, hi: DVec3, pad: f64) -> bool {
         t1 = t1.min(u.max(v));
     }
     t0 > t1 * (1.0 + 1e-12)
+}
+
+/// [`BoundaryEntry::across`] of a face with no kept face across an edge.
+const NO_FACE: u32 = u32::MAX;
+
+/// For every face and edge, the face across it (running the edge the
+/// other way), or [`NO_FACE`].
+fn across(faces: &[EntryFace]) -> Vec<[u32; 3]> {
+    let mut by_edge: HashMap<(u32, u32), u32> = HashMap::with_capacity(faces.len() * 3);
+    for (i, f) in faces.iter().enumerate() {
+        for e in 0..3 {
+            by_edge.insert((f.ids[e], f.ids[(e + 1) % 3]), i as u32);
+        }
+    }
+    faces
+        .iter()
+        .map(|f| {
+            std::array::from_fn(|e| {
+                let (a, b) = (f.ids[e], f.ids[(e + 1) % 3]);
+                by_edge.get(&(b, a)).copied().unwrap_or(NO_FACE)
+            })
+        })
+        .collect()
+}
+
+/// Steps the entry walk takes over `n` faces before it leaves the search
+/// to the scan: a walk across the faces seen from a viewpoint crosses
+/// about their square root.
+fn walk_steps(n: usize) -> usize {
+    4 * (n as f64).sqrt() as usize + 16
 }
 
 /// True when `origin` lies on the outer side of face `f`'s plane or on it.
