@@ -108,10 +108,11 @@ impl BoundaryEntry {
         if faces.is_empty() {
             return Err(ViewpointError::NoBoundary);
         }
-        check_convex(mesh, &faces)?;
+        let across = across(&faces);
+        check_convex(mesh, &faces, &across)?;
         let (lo, hi) = mesh.point_bounds();
         Ok(BoundaryEntry {
-            across: across(&faces),
+            across,
             faces,
             seen_from: None,
             lo: lo.as_dvec3(),
@@ -413,28 +414,29 @@ fn faces_origin(mesh: &TetMesh, f: &EntryFace, origin: Vec3) -> bool {
 }
 
 /// Checks that every two boundary faces sharing an edge bend outward or are
-/// coplanar: the far vertex of each lies on or inside the other's plane.
-fn check_convex(mesh: &TetMesh, faces: &[EntryFace]) -> Result<(), ViewpointError> {
-    let mut by_edge: HashMap<(u32, u32), usize> = HashMap::with_capacity(faces.len() * 3);
-    for (i, f) in faces.iter().enumerate() {
-        for e in 0..3 {
-            let (a, b) = (f.ids[e], f.ids[(e + 1) % 3]);
-            by_edge.insert((a, b), i);
-        }
-    }
+/// coplanar: the far vertex of each lies on or inside the other's plane
+/// (`across`: the faces' [`across`] table).
+fn check_convex(
+    mesh: &TetMesh,
+    faces: &[EntryFace],
+    across: &[[u32; 3]],
+) -> Result<(), ViewpointError> {
     let p = |i: u32| mesh.points[i as usize];
-    for f in faces {
+    for (f, across) in faces.iter().zip(across) {
         let [a, b, c] = mesh.face_vertices(f.tet, f.face as usize);
-        for e in 0..3 {
+        for (e, &g) in across.iter().enumerate() {
             let (x, y) = (f.ids[e], f.ids[(e + 1) % 3]);
             // The neighbour across the edge runs it the other way.
-            let Some(&g) = by_edge.get(&(y, x)) else {
+            if g == NO_FACE {
                 return Err(ViewpointError::NotConvex {
                     tet: f.tet,
                     face: f.face,
                 });
-            };
-            let far = faces[g].ids.into_iter().find(|&v| v != x && v != y);
+            }
+            let far = faces[g as usize]
+                .ids
+                .into_iter()
+                .find(|&v| v != x && v != y);
             let bends_in = far.is_some_and(|v| orient3d_f32(p(a), p(b), p(c), p(v)) > 0.0);
             if bends_in {
                 return Err(ViewpointError::NotConvex {

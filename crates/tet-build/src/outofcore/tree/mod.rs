@@ -288,8 +288,8 @@ pub const MAX_PLANE_MOVES: usize = 8;
 
 /// How many times [`build_tree_with_memory_limit`] moves the walls of one
 /// part TetGen failed or crashed on or ran past its time limit on before
-/// it relaxes the part's surface (one last attempt without `-Y`) and then
-/// gives up.
+/// it relaxes the part's surface (one last attempt, with `-Y/2`, else
+/// without `-Y`: [`SeamOptions::surface_relaxed_parts`]) and then gives up.
 pub const MAX_PART_MOVES: usize = 2;
 
 /// How many attempts after the first [`build_tree_with_memory_limit`]
